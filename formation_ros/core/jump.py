@@ -1,0 +1,185 @@
+"""Jump functions of Lemma 1 (eqs. 5-7) and the collision terms built from them (eq. 11).
+
+A jump function ``h(x, a, b)`` is 0 for ``x <= a``, 1 for ``x >= b`` and climbs smoothly in between.
+The controller only ever needs it at ``a = 0``, ``b = b_ij**2 / 2`` and ``x = ||q_ij||**2 / 2``
+(eq. 11 read as in ERRATA 1), but the functions here take any ``0 <= a < b``.
+
+Two kinds of ``g`` (eq. 7) are implemented:
+
+* ``PolyJump(p)``: ``g(y) = y**p`` for an integer ``p >= 1``. Then ``h`` is the regularized
+  incomplete beta function ``I_t(p + 1, p + 1)`` with ``t = (x - a) / (b - a)`` (ERRATA 4), written
+  here as the finite binomial sum ``t**(p+1) * S(t)`` so that ``h'/h`` stays exact as ``t -> 0``.
+* ``SmoothJump()``: ``g(y) = exp(-1/y)`` (Corollary 1). ``h`` needs an integral, evaluated by
+  adaptive quadrature (``scipy.integrate.quad``, relative tolerance 1e-13) in a scaled form that
+  cannot underflow; ``h'`` is closed form.
+
+All functions are vectorised over ``x`` (any shape), never modify their inputs and return float
+arrays of the shape of ``x``. Units: ``x``, ``a``, ``b`` in m**2 (half squared distances); ``h`` is
+dimensionless; ``h'`` and ``h'/h`` are in 1/m**2.
+"""
+
+from functools import lru_cache
+import math
+
+import numpy as np
+from scipy import integrate, special
+
+JUMP_KINDS = ('poly', 'smooth')
+
+
+def _check_interval(a, b):
+    if not (0.0 <= a < b):
+        raise ValueError(f'jump function needs 0 <= a < b, got a={a!r}, b={b!r}')
+
+
+class PolyJump:
+    """p times differentiable jump function with ``g(y) = y**p`` (Lemma 1, ERRATA 4)."""
+
+    kind = 'poly'
+
+    def __init__(self, order):
+        """Build the jump function of order ``order`` (integer p >= 1)."""
+        if isinstance(order, bool) or int(order) != order or order < 1:
+            raise ValueError(f'jump order p must be an integer >= 1, got {order!r}')
+        self.order = int(order)
+        p = self.order
+        n = 2 * p + 1
+        # S(t) = sum_{j=p+1}^{n} C(n, j) t^(j-p-1) (1-t)^(n-j), so that h = t^(p+1) S(t).
+        self._binomials = np.array([math.comb(n, j) for j in range(p + 1, n + 1)], dtype=float)
+        self._t_powers = np.arange(0, p + 1)
+        self._one_minus_t_powers = n - np.arange(p + 1, n + 1)
+        self._inv_beta = 1.0 / special.beta(p + 1, p + 1)
+
+    def __repr__(self):
+        """Return a short description."""
+        return f'PolyJump(order={self.order})'
+
+    def _sum_s(self, t):
+        t = t[..., None]
+        return np.sum(self._binomials * t ** self._t_powers
+                      * (1.0 - t) ** self._one_minus_t_powers, axis=-1)
+
+    def h(self, x, a, b):
+        """Jump function h(x, a, b) of eq. (5): shape of ``x``, values in [0, 1]."""
+        _check_interval(a, b)
+        t = np.clip((np.asarray(x, dtype=float) - a) / (b - a), 0.0, 1.0)
+        return t ** (self.order + 1) * self._sum_s(t)
+
+    def dh(self, x, a, b):
+        """Closed-form derivative dh/dx (ERRATA 4), in 1/m**2; zero outside (a, b)."""
+        _check_interval(a, b)
+        x = np.asarray(x, dtype=float)
+        p = self.order
+        inside = (x > a) & (x < b)
+        xc = np.where(inside, x, a)
+        value = (xc - a) ** p * (b - xc) ** p * self._inv_beta / (b - a) ** (2 * p + 1)
+        return np.where(inside, value, 0.0)
+
+    def ratio(self, x, a, b):
+        """Return betabar' = h'(x) / h(x) (eq. 13), in 1/m**2.
+
+        Zero for ``x >= b``; ``+inf`` for ``x <= a`` (a collision). Near ``a`` it behaves like
+        ``(p + 1) / (x - a)`` and is computed without forming the two tiny factors.
+        """
+        _check_interval(a, b)
+        x = np.asarray(x, dtype=float)
+        t = (x - a) / (b - a)
+        inside = (t > 0.0) & (t < 1.0)
+        tc = np.where(inside, t, 0.5)
+        value = (1.0 - tc) ** self.order * self._inv_beta / ((b - a) * tc * self._sum_s(tc))
+        return np.where(inside, value, np.where(t <= 0.0, np.inf, 0.0))
+
+
+class SmoothJump:
+    """Smooth jump function with ``g(y) = exp(-1/y)`` (Corollary 1).
+
+    With ``L = b - a``, ``s = (x - a) / L`` and ``Phi(s) = (1/L) / (s (1 - s))`` the integrand of
+    eq. (5) is ``exp(-Phi(s))``. The code evaluates, for ``s <= 1/2``,
+    ``K(s) = int_0^s exp(Phi(s) - Phi(sigma)) d sigma`` (an integrand in [0, 1], so nothing
+    underflows) and writes ``h = exp(Phi(1/2) - Phi(s)) K(s) / (2 K(1/2))``,
+    ``h'/h = 1 / (L K(s))``; for ``s > 1/2`` it uses the symmetry ``h(s) = 1 - h(1 - s)``.
+    """
+
+    kind = 'smooth'
+    order = None
+
+    def __repr__(self):
+        """Return a short description."""
+        return 'SmoothJump()'
+
+    @staticmethod
+    @lru_cache(maxsize=4096)
+    def _k_scaled(s, inv_len):
+        """K(s) for 0 < s <= 1/2 with Phi built from ``inv_len = 1 / (b - a)``.
+
+        For s < 0.3 the integral is taken in ``w = Phi(sigma) - Phi(s)`` on [0, inf), where it
+        reads ``int exp(-w) k / ((1 - 2 sigma) P**2) dw`` with ``P = Phi(s) + w``, ``k = 1/L``:
+        smooth, with no boundary layer however small s is. Nearer 1/2 it is taken directly.
+        """
+        k = inv_len
+        phi_s = k / (s * (1.0 - s))
+        if s < 0.3:
+            def integrand(w):
+                big_p = phi_s + w
+                return math.exp(-w) * k / (math.sqrt(1.0 - 4.0 * k / big_p) * big_p * big_p)
+
+            value, _ = integrate.quad(integrand, 0.0, math.inf, epsabs=0.0, epsrel=1e-13,
+                                      limit=400)
+            return value
+
+        def integrand(sigma):
+            if sigma <= 0.0:
+                return 0.0
+            return math.exp(phi_s - k / (sigma * (1.0 - sigma)))
+
+        width = s * s * (1.0 - s) ** 2 / (k * max(1.0 - 2.0 * s, 1e-300))
+        points = [s - width] if width < 0.1 * s else None
+        value, _ = integrate.quad(integrand, 0.0, s, epsabs=0.0, epsrel=1e-13, limit=400,
+                                  points=points)
+        return value
+
+    def _scaled(self, x, a, b):
+        """Return s, the mask 0 < s < 1, s clipped inside, Phi(1/2) - Phi(s), 1/L, K(1/2)."""
+        _check_interval(a, b)
+        inv_len = 1.0 / (b - a)
+        s = (np.asarray(x, dtype=float) - a) * inv_len
+        inside = (s > 0.0) & (s < 1.0)
+        sc = np.where(inside, s, 0.5)
+        log_f_rel = 4.0 * inv_len - inv_len / (sc * (1.0 - sc))
+        return s, inside, sc, log_f_rel, inv_len, self._k_scaled(0.5, inv_len)
+
+    def _k_near(self, sc, inv_len):
+        """K(min(s, 1 - s)) element by element, same shape as ``sc``."""
+        near = np.minimum(sc, 1.0 - sc)
+        values = [self._k_scaled(float(v), inv_len) for v in near.ravel()]
+        return np.array(values, dtype=float).reshape(near.shape)
+
+    def h(self, x, a, b):
+        """Jump function h(x, a, b) of eq. (5): shape of ``x``, values in [0, 1]."""
+        s, inside, sc, log_f_rel, inv_len, k_half = self._scaled(x, a, b)
+        tail = np.exp(log_f_rel) * self._k_near(sc, inv_len) / (2.0 * k_half)
+        value = np.where(sc <= 0.5, tail, 1.0 - tail)
+        return np.where(inside, value, np.where(s <= 0.0, 0.0, 1.0))
+
+    def dh(self, x, a, b):
+        """Closed-form derivative dh/dx = f(x - a) f(b - x) / norm, in 1/m**2."""
+        _, inside, _, log_f_rel, inv_len, k_half = self._scaled(x, a, b)
+        return np.where(inside, np.exp(log_f_rel) * inv_len / (2.0 * k_half), 0.0)
+
+    def ratio(self, x, a, b):
+        """Return betabar' = h'(x) / h(x) (eq. 13), in 1/m**2; 0 for x >= b, +inf for x <= a."""
+        s, inside, sc, log_f_rel, inv_len, k_half = self._scaled(x, a, b)
+        k_near = self._k_near(sc, inv_len)
+        tail = np.exp(log_f_rel) * k_near / (2.0 * k_half)
+        high = np.exp(log_f_rel) * inv_len / (2.0 * k_half) / np.maximum(1.0 - tail, 1e-300)
+        value = np.where(sc <= 0.5, inv_len / k_near, high)
+        return np.where(inside, value, np.where(s <= 0.0, np.inf, 0.0))
+
+
+def make_jump(kind, order=2):
+    """Return the jump function named by ``jump.kind`` ('poly' or 'smooth') and ``jump.order``."""
+    if kind == 'poly':
+        return PolyJump(order)
+    if kind == 'smooth':
+        return SmoothJump()
+    raise ValueError(f'unknown jump kind {kind!r}; expected one of {JUMP_KINDS}')

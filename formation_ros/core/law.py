@@ -1,0 +1,192 @@
+"""The bounded formation control law: eqs. (8)-(14) and the tracking transform (21), (25).
+
+Conventions: positions are rows, ``q`` has shape (N, dim) in metres, ``dim`` is 2 or 3; velocities
+are in m/s. ``vertices`` (N, dim) are the robots' places in the formation frame (``q_if`` for
+stabilisation, ``qhat_id`` for tracking). Nothing here imports ROS and no function modifies its
+arguments.
+
+The one formula for the repulsive part of eq. (13) lives in :func:`repulsion_terms`; the per-robot
+form (what a robot node calls) and the vectorised all-robots form (what the simulator calls) both
+use it, so they agree to rounding.
+"""
+
+from dataclasses import dataclass
+import math
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from formation_ros.core.frames import STATIONARY, from_frame_velocity, to_frame, to_frame_vectors
+from formation_ros.core.jump import make_jump
+
+PSI_FUNCTIONS = {
+    'arctan': (np.arctan, math.pi / 2.0),
+    'tanh': (np.tanh, 1.0),
+}
+
+
+@dataclass(frozen=True)
+class LawParams:
+    """Constants of the control law.
+
+    gain: c of eq. (14), m/s per unit of psi; kappa: kappa of eqs. (8), (13);
+    psi: 'arctan' or 'tanh' (eq. 15); jump: a jump function object (``core.jump``);
+    repulsion_radius: b_ij of eq. (11) in m, the same for every pair.
+    """
+
+    gain: float
+    kappa: float
+    psi: str
+    jump: object
+    repulsion_radius: float
+
+    def __post_init__(self):
+        """Check the constants once, so that the hot path need not."""
+        if self.psi not in PSI_FUNCTIONS:
+            raise ValueError(f'psi must be one of {sorted(PSI_FUNCTIONS)}, got {self.psi!r}')
+        for name in ('gain', 'kappa', 'repulsion_radius'):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0.0):
+                raise ValueError(f'{name} must be a finite number > 0, got {value!r}')
+
+    @property
+    def psi_bound(self):
+        """M1 of eq. (15): the bound of |psi| (pi/2 for arctan, 1 for tanh)."""
+        return PSI_FUNCTIONS[self.psi][1]
+
+    @property
+    def u_bound(self):
+        """Bound c * M1 on every component of the stabilising command (eq. 14), m/s."""
+        return self.gain * self.psi_bound
+
+
+def make_law(gain, kappa, psi, jump_kind, jump_order, repulsion_radius):
+    """Build :class:`LawParams` from the parameter values of the YAML file."""
+    return LawParams(float(gain), float(kappa), psi, make_jump(jump_kind, jump_order),
+                     float(repulsion_radius))
+
+
+def psi(omega, law):
+    """Apply psi element by element (eq. 14); same shape as ``omega``."""
+    return PSI_FUNCTIONS[law.psi][0](omega)
+
+
+def beta(distance_sq, law):
+    """Return beta_ij of eq. (11) (ERRATA 1) from squared distances ||q_ij||**2, any shape."""
+    b = law.repulsion_radius
+    return law.jump.h(0.5 * np.asarray(distance_sq, dtype=float), 0.0, 0.5 * b * b)
+
+
+def repulsion_terms(q_ij, law):
+    """Return betabar'_ij * q_ij for rows of relative positions q_ij = q_i - q_j.
+
+    q_ij: (K, dim) in m. Returns (K, dim) in 1/m. betabar' = h'/h (eq. 13, ERRATA 3) is zero for
+    ||q_ij|| >= b. A row with q_ij exactly zero (two robots at one point) has no direction and
+    contributes zero; the callers report such a collision.
+    """
+    q_ij = np.asarray(q_ij, dtype=float)
+    d2 = np.einsum('kd,kd->k', q_ij, q_ij)
+    b = law.repulsion_radius
+    weight = law.jump.ratio(0.5 * d2, 0.0, 0.5 * b * b)
+    with np.errstate(invalid='ignore'):
+        terms = weight[:, None] * q_ij
+    terms[d2 == 0.0] = 0.0
+    return terms
+
+
+def omega(error, repulsion_sum, law):
+    """Omega_i of eq. (13): ``(q_i - q_if) - kappa * sum_j betabar'_ij q_ij``, shape of error."""
+    return np.asarray(error, dtype=float) - law.kappa * np.asarray(repulsion_sum, dtype=float)
+
+
+def bounded_command(omega_value, law):
+    """Bounded command u_i = -c psi(Omega_i) of eq. (14), same shape as ``omega_value``."""
+    return -law.gain * psi(omega_value, law)
+
+
+@dataclass(frozen=True)
+class Command:
+    """A command and its parts.
+
+    u: the world-frame velocity q' = u (eq. 25; equal to u_hat when stabilising);
+    u_hat: the bounded command of eq. (14) in the formation frame, |u_hat| <= c M1;
+    omega: Omega of eq. (13) in the formation frame.
+    """
+
+    u: np.ndarray
+    u_hat: np.ndarray
+    omega: np.ndarray
+
+
+def robot_command(q_i, vertex_i, neighbours, sensing_radius, law, frame=STATIONARY):
+    """Control of one robot from what it knows (eqs. 13, 14, 21, 25).
+
+    q_i: (dim,) own position, world frame, m. vertex_i: (dim,) own place in the formation frame.
+    neighbours: (K, dim) positions the robot has sensed, world frame; those at distance
+    >= ``sensing_radius`` (R_i) are ignored. frame: a ``FrameSample`` of the reference (the
+    default is stabilisation: q_od = 0, J = I). Returns a :class:`Command` with (dim,) arrays.
+    """
+    q_i = np.asarray(q_i, dtype=float)
+    neighbours = np.asarray(neighbours, dtype=float).reshape(-1, q_i.shape[0])
+    q_ij = q_i[None, :] - neighbours
+    in_range = np.einsum('kd,kd->k', q_ij, q_ij) < sensing_radius ** 2
+    q_hat_ij = to_frame_vectors(q_ij[in_range], frame)
+    error_hat = to_frame(q_i[None, :], frame)[0] - np.asarray(vertex_i, dtype=float)
+    omega_hat = omega(error_hat, repulsion_terms(q_hat_ij, law).sum(axis=0), law)
+    u_hat = bounded_command(omega_hat, law)
+    u = from_frame_velocity(u_hat[None, :], q_i[None, :], frame)[0]
+    return Command(u=u, u_hat=u_hat, omega=omega_hat)
+
+
+def neighbour_pairs(q, radius):
+    """Pairs (i, j), i < j, with ||q_i - q_j|| <= radius, from a k-d tree: (P, 2) int array."""
+    tree = cKDTree(np.asarray(q, dtype=float))
+    return tree.query_pairs(r=radius, output_type='ndarray').reshape(-1, 2)
+
+
+def team_command(q, vertices, sensing_radii, law, frame=STATIONARY):
+    """Control of every robot at once (the vectorised form of :func:`robot_command`).
+
+    q: (N, dim) positions, world frame, m. vertices: (N, dim). sensing_radii: (N,) R_i in m.
+    Neighbours are found with a k-d tree within b (betabar' vanishes beyond b and b <= R_i), then
+    each robot keeps only those within its own R_i, so a step costs O(N log N).
+    Returns a :class:`Command` with (N, dim) arrays.
+    """
+    q = np.asarray(q, dtype=float)
+    radii = np.asarray(sensing_radii, dtype=float)
+    n, dim = q.shape
+    q_hat = to_frame(q, frame)
+    pairs = neighbour_pairs(q, law.repulsion_radius)
+    i, j = pairs[:, 0], pairs[:, 1]
+    q_hat_ij = q_hat[i] - q_hat[j]
+    d2 = np.einsum('kd,kd->k', q_hat_ij, q_hat_ij)
+    terms = repulsion_terms(q_hat_ij, law)
+    heard_by_i = terms * (d2 < radii[i] ** 2)[:, None]
+    heard_by_j = terms * (d2 < radii[j] ** 2)[:, None]
+    rep = np.stack([np.bincount(i, heard_by_i[:, axis], n) - np.bincount(j, heard_by_j[:, axis], n)
+                    for axis in range(dim)], axis=1)
+    omega_hat = omega(q_hat - np.asarray(vertices, dtype=float), rep, law)
+    u_hat = bounded_command(omega_hat, law)
+    return Command(u=from_frame_velocity(u_hat, q, frame), u_hat=u_hat, omega=omega_hat)
+
+
+def log_potential(q, vertices, law, frame=STATIONARY):
+    """Return log(phi + 1) = gamma - kappa * sum_{i<j} log beta_ij (eqs. 8-11), a float.
+
+    phi itself overflows quickly (e**gamma / beta**kappa); its logarithm is monotone in phi and
+    its gradient with respect to q_i (formation frame) is exactly Omega_i of eq. (13). Returns
+    +inf at a collision within b.
+    """
+    q_hat = to_frame(np.asarray(q, dtype=float), frame)
+    gamma = 0.5 * float(np.sum((q_hat - np.asarray(vertices, dtype=float)) ** 2))
+    pairs = neighbour_pairs(q_hat, law.repulsion_radius)
+    diff = q_hat[pairs[:, 0]] - q_hat[pairs[:, 1]]
+    with np.errstate(divide='ignore'):
+        log_beta = np.log(beta(np.einsum('kd,kd->k', diff, diff), law))
+    return gamma - law.kappa * float(np.sum(log_beta))
+
+
+def potential(q, vertices, law, frame=STATIONARY):
+    """Potential phi of eq. (8) (may overflow to +inf far from the formation)."""
+    with np.errstate(over='ignore'):
+        return float(np.expm1(log_potential(q, vertices, law, frame)))

@@ -1,0 +1,125 @@
+"""Moving references q_od(t) for formation tracking (Section 6) and their frames.
+
+The path parameter s of the paper is time here (``ds/dt = 1``), so ``qdot_od = q_od'(t)``.
+Kinds (the ``reference.*`` parameters):
+
+* ``fixed``: ``q_od = origin``; J = I (stabilisation about ``origin``).
+* ``line``: ``q_od = origin + velocity * t``.
+* ``circle``: centred on ``origin``, radius r, starts at angle 0 (``origin + (r, 0)``) and runs
+  counter-clockwise about +z at path speed ``speed``; in 3D it lies in the plane z = origin_z.
+* ``figure_eight``: the lemniscate of Gerono ``origin + r (sin a, sin a cos a)``, a = omega t,
+  starting at its crossing (an inflection point); omega is chosen so that one loop of length
+  ``L_8`` takes ``L_8 / speed`` seconds (``speed`` is the mean path speed).
+* ``helix`` (3D): the circle rising along +z by ``pitch`` per turn at constant path speed.
+
+2D frames come from atan2 of the velocity; the helix uses the Frenet triad; the planar kinds in
+3D use the planar frame of :mod:`formation_ros.core.frames`.
+"""
+
+import math
+
+import numpy as np
+from scipy import integrate
+
+from formation_ros.core.frames import (FrameSample, frame_2d, frame_frenet_3d, frame_planar_3d,
+                                       stationary_frame)
+
+REFERENCE_KINDS = ('fixed', 'line', 'circle', 'figure_eight', 'helix')
+Z_AXIS = np.array([0.0, 0.0, 1.0])
+GERONO_LOOP_LENGTH = integrate.quad(
+    lambda a: math.sqrt(math.cos(a) ** 2 + math.cos(2.0 * a) ** 2), 0.0, 2.0 * math.pi,
+    epsabs=0.0, epsrel=1e-13, limit=200)[0]
+
+
+class Reference:
+    """A moving desired formation centre q_od(t) with its frame J(t).
+
+    dim: 2 or 3. ``sample(t)`` returns a :class:`FrameSample`; ``derivatives(t)`` returns
+    (q, q', q'', q''') as (dim,) arrays (m, m/s, m/s**2, m/s**3).
+    """
+
+    def __init__(self, kind, dim, origin=None, velocity=None, radius=1.0, speed=0.0, pitch=0.0):
+        """Build a reference (values already validated by ``core.params``)."""
+        if kind not in REFERENCE_KINDS:
+            raise ValueError(f'unknown reference kind {kind!r}; expected one of {REFERENCE_KINDS}')
+        if dim not in (2, 3):
+            raise ValueError(f'dim must be 2 or 3, got {dim!r}')
+        if kind == 'helix' and dim != 3:
+            raise ValueError('a helix reference needs dim 3')
+        self.kind = kind
+        self.dim = dim
+        self.origin = np.zeros(dim) if origin is None else np.array(origin, dtype=float)
+        self.velocity = np.zeros(dim) if velocity is None else np.array(velocity, dtype=float)
+        self.radius = float(radius)
+        self.speed = float(speed)
+        self.pitch = float(pitch)
+        self.rate = self._angular_rate()
+
+    def _angular_rate(self):
+        if self.kind == 'circle':
+            return self.speed / self.radius
+        if self.kind == 'figure_eight':
+            return 2.0 * math.pi * self.speed / (self.radius * GERONO_LOOP_LENGTH)
+        if self.kind == 'helix':
+            rise = self.pitch / (2.0 * math.pi)
+            return self.speed / math.hypot(self.radius, rise)
+        return 0.0
+
+    @property
+    def is_stationary(self):
+        """True when q_od never moves (fixed, or a line with zero velocity)."""
+        return self.kind == 'fixed' or (self.kind == 'line' and not np.any(self.velocity))
+
+    def derivatives(self, t):
+        """Return (q_od, q_od', q_od'', q_od''') at time t, each (dim,)."""
+        dim = self.dim
+        zero = np.zeros(dim)
+        if self.kind == 'fixed':
+            return self.origin.copy(), zero, zero.copy(), zero.copy()
+        if self.kind == 'line':
+            return self.origin + self.velocity * t, self.velocity.copy(), zero, zero.copy()
+        r, w = self.radius, self.rate
+        a = w * t
+        ca, sa = math.cos(a), math.sin(a)
+        if self.kind == 'figure_eight':
+            c2, s2 = math.cos(2.0 * a), math.sin(2.0 * a)
+            planar = (np.array([sa, 0.5 * s2]), np.array([w * ca, w * c2]),
+                      np.array([-w * w * sa, -2.0 * w * w * s2]),
+                      np.array([-w ** 3 * ca, -4.0 * w ** 3 * c2]))
+            rise = (0.0, 0.0, 0.0, 0.0)
+        else:
+            planar = (np.array([ca, sa]), np.array([-w * sa, w * ca]),
+                      np.array([-w * w * ca, -w * w * sa]),
+                      np.array([w ** 3 * sa, -w ** 3 * ca]))
+            c = self.pitch / (2.0 * math.pi) if self.kind == 'helix' else 0.0
+            rise = (c * a, c * w, 0.0, 0.0)
+        out = []
+        for order in range(4):
+            vec = np.zeros(dim)
+            vec[:2] = r * planar[order]
+            if dim == 3:
+                vec[2] = rise[order]
+            out.append(vec)
+        out[0] = out[0] + self.origin
+        return tuple(out)
+
+    def sample(self, t):
+        """Return the :class:`FrameSample` (q_od, qdot_od, J, Jdot) at time t in s."""
+        if self.kind == 'fixed':
+            return stationary_frame(self.dim, self.origin, t)
+        q, q1, q2, q3 = self.derivatives(t)
+        if self.dim == 2:
+            jmat, jdot = frame_2d(q1, q2)
+        elif self.kind == 'helix':
+            jmat, jdot = frame_frenet_3d(q1, q2, q3)
+        else:
+            jmat, jdot = frame_planar_3d(q1, q2, self._plane_normal(q1))
+        return FrameSample(float(t), q, q1, jmat, jdot)
+
+    def _plane_normal(self, qdot):
+        """Fixed plane normal for the planar 3D frame: +z, or +y for a line along z."""
+        if self.kind == 'line':
+            speed = float(np.linalg.norm(qdot))
+            if speed > 0.0 and np.linalg.norm(np.cross(Z_AXIS, qdot / speed)) < 1e-6:
+                return np.array([0.0, 1.0, 0.0])
+        return Z_AXIS

@@ -1,0 +1,150 @@
+"""Figures of a formation run (PNG), in the style of the paper's Fig. 1.
+
+Every function takes a :class:`formation_ros.trajectory.Trajectory` and writes one file; nothing
+is computed here that ``core.metrics`` does not provide.
+"""
+
+import os
+
+import matplotlib
+
+matplotlib.use('Agg')
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from formation_ros.core.law import beta  # noqa: E402
+from formation_ros.core.metrics import (dis_all_series, dis_min_series,  # noqa: E402
+                                        formation_errors)
+
+FIGURES = ('trajectories.png', 'distances.png', 'controls.png', 'formation_error.png')
+MAX_PATHS = 200
+THICK = 2.2
+
+
+def _polygon(points):
+    return np.vstack([points, points[:1]])
+
+
+def plot_trajectories(traj, path, title='Trajectories'):
+    """Paths, start (o) and end (x) points, the desired formation polygon, the reference path."""
+    q, desired = traj.q, traj.q_desired
+    n = traj.num_robots
+    shown = np.unique(np.linspace(0, n - 1, min(n, MAX_PATHS)).astype(int))
+    fig = plt.figure(figsize=(7, 6.5))
+    three_d = traj.dim == 3
+    ax = fig.add_subplot(111, projection='3d' if three_d else None)
+    coords = (lambda pts: (pts[..., 0], pts[..., 1], pts[..., 2])) if three_d else \
+        (lambda pts: (pts[..., 0], pts[..., 1]))
+    moving = np.ptp(traj.q_od, axis=0).max() > 1e-9
+    if moving:
+        ax.plot(*coords(traj.q_od), color='0.6', linestyle='--', linewidth=1.0,
+                label='reference path q_od')
+    for i in shown:
+        ax.plot(*coords(q[:, i]), linewidth=THICK if i == 0 else 0.7,
+                color='k' if i == 0 else None)
+    ax.plot(*coords(_polygon(desired[-1])), color='tab:red', linewidth=1.2,
+            label='desired formation (end)')
+    ax.scatter(*coords(q[0]), marker='o', s=14, color='tab:blue', label='start')
+    ax.scatter(*coords(q[-1]), marker='x', s=24, color='k', label='end')
+    if n <= 30:
+        for i in range(n):
+            ax.text(*coords(q[-1, i]), f' {i + 1}', fontsize=8)
+    ax.set_xlabel('x [m]')
+    ax.set_ylabel('y [m]')
+    if three_d:
+        ax.set_zlabel('z [m]')
+    else:
+        ax.set_aspect('equal', adjustable='datalim')
+        ax.grid(True, alpha=0.3)
+    ax.set_title(f'{title}: N = {n}, robot 1 thick')
+    ax.legend(loc='best', fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_distances(traj, law, path):
+    """dis_min, dis_all (ERRATA 7), ||q_1j|| and beta_1j over time (Fig. 1 C, D)."""
+    t, q = traj.t, traj.q
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
+    if traj.num_robots <= 30:
+        d1 = np.linalg.norm(q[:, :1, :] - q[:, 1:, :], axis=2)
+        top.plot(t, d1, linewidth=0.6, color='0.55')
+        bottom.plot(t, beta(d1 ** 2, law), linewidth=0.8)
+        bottom.set_title('beta_1j, j = 2..N (eq. 11)')
+    else:
+        bottom.set_title('beta_1j not drawn for N > 30')
+    top.plot(t, dis_min_series(q), color='tab:red', linewidth=1.5, label='dis_min (closest pair)')
+    t_all, values = dis_all_series(t, q)
+    if len(values):
+        top.plot(t_all, values, color='k', linewidth=THICK, label='dis_all (geometric mean)')
+    top.axhline(law.repulsion_radius, color='tab:blue', linestyle=':', label='b')
+    top.set_ylabel('distance [m]')
+    top.set_yscale('log')
+    top.legend(fontsize=8)
+    top.grid(True, alpha=0.3)
+    top.set_title('Distances (thin: ||q_1j||)')
+    bottom.set_xlabel('t [s]')
+    bottom.set_ylim(-0.05, 1.05)
+    bottom.grid(True, alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_controls(traj, u_bound, path):
+    """Components of u_hat (robot 1 thick, envelope of all robots) against +-c M1 (Fig. 1 B)."""
+    t = traj.t
+    tracking = np.ptp(traj.q_od, axis=0).max() > 1e-9
+    rows = 2 if tracking else 1
+    fig, axes = plt.subplots(rows, 1, figsize=(8, 3.6 * rows), sharex=True, squeeze=False)
+    series = [('u_hat (bounded, eq. 14)', traj.u_hat)]
+    if tracking:
+        series.append(('u (world command, eq. 25)', traj.u))
+    for ax, (label, values) in zip(axes[:, 0], series):
+        envelope = np.max(np.abs(values), axis=(1, 2))
+        ax.fill_between(t, -envelope, envelope, color='0.85', label='max |component|, all robots')
+        for axis, name in enumerate('xyz'[:traj.dim]):
+            ax.plot(t, values[:, 0, axis], linewidth=1.4, label=f'robot 1, {name}')
+        ax.axhline(u_bound, color='tab:red', linestyle='--', label='+- c M1')
+        ax.axhline(-u_bound, color='tab:red', linestyle='--')
+        ax.set_ylabel(f'{label} [m/s]')
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8, loc='upper right')
+    axes[-1, 0].set_xlabel('t [s]')
+    axes[0, 0].set_title('Control components')
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_formation_error(traj, metrics, path):
+    """Largest and mean ||q_i - q_i,desired|| over time, the 0.05 m band and the settle time."""
+    errors = formation_errors(traj.q, traj.q_desired)
+    fig, ax = plt.subplots(figsize=(8, 4))
+    ax.semilogy(traj.t, np.max(errors, axis=1), color='k', linewidth=1.6, label='max error')
+    ax.semilogy(traj.t, np.mean(errors, axis=1), color='tab:blue', linewidth=1.0,
+                label='mean error')
+    ax.axhline(metrics['settle_tolerance'], color='tab:red', linestyle=':',
+               label=f"{metrics['settle_tolerance']} m")
+    if metrics.get('settle_time') is not None:
+        ax.axvline(metrics['settle_time'], color='tab:green', linestyle='--',
+                   label=f"settled at {metrics['settle_time']:.2f} s")
+    ax.set_xlabel('t [s]')
+    ax.set_ylabel('||q_i - q_i,desired|| [m]')
+    ax.set_title('Formation error')
+    ax.grid(True, which='both', alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def write_figures(traj, law, metrics, out_dir):
+    """Write the four figures of :data:`FIGURES` into ``out_dir``; returns their paths."""
+    paths = [os.path.join(out_dir, name) for name in FIGURES]
+    plot_trajectories(traj, paths[0])
+    plot_distances(traj, law, paths[1])
+    plot_controls(traj, metrics['u_bound'], paths[2])
+    plot_formation_error(traj, metrics, paths[3])
+    return paths

@@ -1,0 +1,207 @@
+"""Offline simulator ``formation_sim``: the closed loop q' = u of eqs. (1), (14), (25).
+
+Default: adaptive RK45 at rtol 1e-8 (the paper's continuous-time system). ``--dt`` switches to a
+fixed step with the command held over each step (zero-order hold), which is what the plant node
+does. Writes trajectory.npz, metrics.json, a copy of the parameters and the figures.
+"""
+
+import argparse
+import json
+import math
+import os
+import shutil
+import sys
+import time
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from formation_ros.core.frames import desired_positions
+from formation_ros.core.law import team_command
+from formation_ros.core.metrics import compute_metrics
+from formation_ros.core.params import load_config, ParamError
+from formation_ros.trajectory import Trajectory
+
+RTOL = 1e-8
+ATOL = 1e-10
+DEFAULT_SAMPLE_DT = 0.01
+
+
+class Progress:
+    """Prints how far a long run is, at most every 10 % of simulated time, once past 2 s wall."""
+
+    def __init__(self, duration, stream=sys.stderr, quiet=False):
+        """Track a run of ``duration`` simulated seconds."""
+        self.duration = duration
+        self.stream = stream
+        self.quiet = quiet
+        self.start = time.monotonic()
+        self.next_mark = 0.1
+
+    def update(self, t):
+        """Report simulated time t if a new 10 % mark was passed and the run is slow enough."""
+        fraction = t / self.duration
+        if self.quiet or fraction < self.next_mark:
+            return
+        elapsed = time.monotonic() - self.start
+        self.next_mark = math.floor(fraction * 10.0 + 1.0) / 10.0
+        if elapsed > 2.0:
+            print(f'formation_sim: t = {t:.2f} / {self.duration:.2f} s '
+                  f'({100.0 * fraction:.0f} %), {elapsed:.1f} s elapsed',
+                  file=self.stream, flush=True)
+
+    @property
+    def elapsed(self):
+        """Wall-clock seconds since the start."""
+        return time.monotonic() - self.start
+
+
+def sample_times(duration, sample_dt):
+    """Sample times 0, sample_dt, ..., duration (the end always included): (T,)."""
+    count = int(math.floor(duration / sample_dt + 1e-9))
+    times = np.arange(count + 1) * sample_dt
+    if duration - times[-1] > 1e-9 * max(1.0, duration):
+        times = np.append(times, duration)
+    return times
+
+
+def _assemble(times, states, config, law, reference):
+    commands, desired, centres = [], [], []
+    for t, q in zip(times, states):
+        frame = reference.sample(t)
+        commands.append(team_command(q, config.vertices, config.sensing_radii, law, frame))
+        desired.append(desired_positions(config.vertices, frame))
+        centres.append(frame.q_od)
+    return Trajectory(t=np.asarray(times, dtype=float), q=np.asarray(states),
+                      u=np.array([c.u for c in commands]),
+                      u_hat=np.array([c.u_hat for c in commands]),
+                      q_desired=np.array(desired), q_od=np.array(centres))
+
+
+def simulate(config, duration=None, dt=None, sample_dt=DEFAULT_SAMPLE_DT, progress=None):
+    """Run the closed loop from ``config.start`` and return a :class:`Trajectory`.
+
+    duration: s (default ``config.duration``). dt: None for RK45 (rtol 1e-8, atol 1e-10), else
+    the fixed zero-order-hold step in s. sample_dt: spacing of the returned samples in s (with
+    ``dt`` it is rounded to a whole number of steps, at least one).
+    """
+    duration = config.duration if duration is None else float(duration)
+    law = config.law()
+    reference = config.reference()
+    progress = progress or Progress(duration, quiet=True)
+    n, dim = config.num_robots, config.dim
+
+    if dt is None:
+        def rhs(t, y):
+            progress.update(t)
+            q = y.reshape(n, dim)
+            frame = reference.sample(t)
+            return team_command(q, config.vertices, config.sensing_radii, law, frame).u.ravel()
+
+        times = sample_times(duration, sample_dt)
+        solution = solve_ivp(rhs, (0.0, duration), config.start.ravel(), method='RK45',
+                             t_eval=times, rtol=RTOL, atol=ATOL)
+        if not solution.success:
+            raise RuntimeError(f'RK45 failed: {solution.message}')
+        states = solution.y.T.reshape(-1, n, dim)
+        return _assemble(solution.t, states, config, law, reference)
+
+    steps = int(round(duration / dt))
+    stride = max(1, int(round(sample_dt / dt)))
+    q = config.start.copy()
+    times, states = [], []
+    for k in range(steps + 1):
+        t = k * dt
+        if k % stride == 0 or k == steps:
+            times.append(t)
+            states.append(q)
+        if k == steps:
+            break
+        progress.update(t)
+        frame = reference.sample(t)
+        q = q + dt * team_command(q, config.vertices, config.sensing_radii, law, frame).u
+    return _assemble(times, states, config, law, reference)
+
+
+def run_metrics(trajectory, config, integrator):
+    """metrics.json content for a simulated trajectory."""
+    extra = {'reference_kind': config.reference_kind, 'integrator': integrator}
+    return compute_metrics(trajectory.t, trajectory.q, trajectory.u, trajectory.u_hat,
+                           trajectory.q_desired, config.law().u_bound, extra)
+
+
+def format_summary(metrics, out_dir=None):
+    """Human-readable summary lines of a metrics dictionary."""
+    settle = metrics['settle_time']
+    settle_text = f'{settle:.2f} s' if settle is not None else 'not settled by the end'
+    collision = 'no collision' if metrics['min_pair_distance'] > 0.0 else 'COLLISION'
+    lines = [
+        f"  robots: {metrics['num_robots']} in {metrics['dim']}D, "
+        f"{metrics['duration']:.2f} s, reference {metrics.get('reference_kind', '?')}",
+        f"  settle time (every error <= {metrics['settle_tolerance']} m): {settle_text}",
+        f"  final max error: {metrics['final_max_error']:.3g} m",
+        f"  min pair distance: {metrics['min_pair_distance']:.4g} m ({collision})",
+        f"  max |u_hat| component: {metrics['max_abs_u_hat_component']:.4g} m/s "
+        f"(bound c*M1 = {metrics['u_bound']:.4g} m/s, {metrics['bound_violations']} above)",
+        f"  max |u| component: {metrics['max_abs_u_component']:.4g} m/s",
+    ]
+    if out_dir:
+        lines.append(f'  results in {out_dir}')
+    return '\n'.join(lines)
+
+
+def build_parser():
+    """Command-line interface of formation_sim."""
+    parser = argparse.ArgumentParser(
+        prog='formation_sim',
+        description='Simulate the bounded formation controller offline (no ROS needed) and '
+                    'write trajectory.npz, metrics.json and figures.',
+        epilog='Example: formation_sim config/paper_section5.yaml --out /tmp/section5')
+    parser.add_argument('params', help='ROS 2 parameters YAML file (/**: ros__parameters: ...)')
+    parser.add_argument('--out', required=True, help='output directory (created if missing)')
+    parser.add_argument('--duration', type=float, help='simulated seconds (default: duration '
+                                                       'in the parameters file)')
+    parser.add_argument('--dt', type=float, help='fixed step with zero-order hold, s (default: '
+                                                 'adaptive RK45 at rtol 1e-8)')
+    parser.add_argument('--sample-dt', type=float, default=DEFAULT_SAMPLE_DT,
+                        help='spacing of saved samples, s (default %(default)s)')
+    parser.add_argument('--no-plots', action='store_true', help='skip the figures')
+    parser.add_argument('--quiet', action='store_true', help='print no progress')
+    return parser
+
+
+def main(argv=None):
+    """Entry point of ``formation_sim``; returns the exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    for name in ('duration', 'dt', 'sample_dt'):
+        value = getattr(args, name)
+        if value is not None and not (math.isfinite(value) and value > 0.0):
+            parser.error(f"--{name.replace('_', '-')} must be a number > 0, got {value}")
+    try:
+        config = load_config(args.params)
+    except ParamError as exc:
+        print(f'formation_sim: invalid parameters in {args.params}:\n{exc}', file=sys.stderr)
+        return 2
+    duration = config.duration if args.duration is None else args.duration
+    os.makedirs(args.out, exist_ok=True)
+    integrator = 'RK45' if args.dt is None else f'zero-order hold, dt = {args.dt:g} s'
+    progress = Progress(duration, quiet=args.quiet)
+    trajectory = simulate(config, duration, args.dt, args.sample_dt, progress)
+    metrics = run_metrics(trajectory, config, integrator)
+    metrics['wall_time'] = progress.elapsed
+    trajectory.save(os.path.join(args.out, 'trajectory.npz'))
+    shutil.copyfile(args.params, os.path.join(args.out, 'params.yaml'))
+    with open(os.path.join(args.out, 'metrics.json'), 'w', encoding='utf-8') as stream:
+        json.dump(metrics, stream, indent=2)
+        stream.write('\n')
+    if not args.no_plots:
+        from formation_ros import plots
+        plots.write_figures(trajectory, config.law(), metrics, args.out)
+    print(f'formation_sim: {integrator}, {duration:g} s simulated in {progress.elapsed:.1f} s')
+    print(format_summary(metrics, args.out))
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

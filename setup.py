@@ -1,0 +1,30 @@
+"""Build script for the formation_ros ament_python package."""
+
+from glob import glob
+
+from setuptools import find_packages, setup
+
+package_name = 'formation_ros'
+
+setup(
+    name=package_name,
+    version='0.1.0',
+    packages=find_packages(exclude=['test', 'test.*']),
+    data_files=[
+        ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
+        ('share/' + package_name, ['package.xml']),
+        ('share/' + package_name + '/config', glob('config/*.yaml')),
+    ],
+    install_requires=['setuptools'],
+    zip_safe=True,
+    maintainer='formation_ros maintainers',
+    maintainer_email='formation-ros@example.com',
+    description='Bounded decentralized formation control for mobile robots with limited sensing.',
+    license='Apache-2.0',
+    tests_require=['pytest'],
+    entry_points={
+        'console_scripts': [
+            'formation_sim = formation_ros.sim:main',
+        ],
+    },
+)
