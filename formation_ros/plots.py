@@ -1,4 +1,5 @@
-"""Figures of a formation run (PNG), in the style of the paper's Fig. 1.
+"""
+Figures of a formation run (PNG), in the style of the paper's Fig. 1.
 
 Every function takes a :class:`formation_ros.trajectory.Trajectory` and writes one file; nothing
 is computed here that ``core.metrics`` does not provide.
@@ -6,15 +7,13 @@ is computed here that ``core.metrics`` does not provide.
 
 import os
 
+from formation_ros.core.law import beta
+from formation_ros.core.metrics import dis_all_series, dis_min_series, formation_errors
 import matplotlib
+import numpy as np
 
 matplotlib.use('Agg')
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from formation_ros.core.law import beta  # noqa: E402
-from formation_ros.core.metrics import (dis_all_series, dis_min_series,  # noqa: E402
-                                        formation_errors)
+import matplotlib.pyplot as plt  # noqa: E402, I100
 
 FIGURES = ('trajectories.png', 'distances.png', 'controls.png', 'formation_error.png')
 MAX_PATHS = 200
@@ -106,11 +105,12 @@ def plot_controls(traj, u_bound, path):
         ax.fill_between(t, -envelope, envelope, color='0.85', label='max |component|, all robots')
         for axis, name in enumerate('xyz'[:traj.dim]):
             ax.plot(t, values[:, 0, axis], linewidth=1.4, label=f'robot 1, {name}')
-        ax.axhline(u_bound, color='tab:red', linestyle='--', label='+- c M1')
-        ax.axhline(-u_bound, color='tab:red', linestyle='--')
         ax.set_ylabel(f'{label} [m/s]')
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8, loc='upper right')
+    axes[0, 0].axhline(u_bound, color='tab:red', linestyle='--', label='+- c M1')
+    axes[0, 0].axhline(-u_bound, color='tab:red', linestyle='--')
+    axes[0, 0].legend(fontsize=8, loc='upper right')
     axes[-1, 0].set_xlabel('t [s]')
     axes[0, 0].set_title('Control components')
     fig.tight_layout()

@@ -1,4 +1,5 @@
-"""Offline simulator ``formation_sim``: the closed loop q' = u of eqs. (1), (14), (25).
+"""
+Offline simulator ``formation_sim``: the closed loop q' = u of eqs. (1), (14), (25).
 
 Default: adaptive RK45 at rtol 1e-8 (the paper's continuous-time system). ``--dt`` switches to a
 fixed step with the command held over each step (zero-order hold), which is what the plant node
@@ -13,14 +14,13 @@ import shutil
 import sys
 import time
 
-import numpy as np
-from scipy.integrate import solve_ivp
-
 from formation_ros.core.frames import desired_positions
 from formation_ros.core.law import team_command
 from formation_ros.core.metrics import compute_metrics
 from formation_ros.core.params import load_config, ParamError
 from formation_ros.trajectory import Trajectory
+import numpy as np
+from scipy.integrate import solve_ivp
 
 RTOL = 1e-8
 ATOL = 1e-10
@@ -79,7 +79,8 @@ def _assemble(times, states, config, law, reference):
 
 
 def simulate(config, duration=None, dt=None, sample_dt=DEFAULT_SAMPLE_DT, progress=None):
-    """Run the closed loop from ``config.start`` and return a :class:`Trajectory`.
+    """
+    Run the closed loop from ``config.start`` and return a :class:`Trajectory`.
 
     duration: s (default ``config.duration``). dt: None for RK45 (rtol 1e-8, atol 1e-10), else
     the fixed zero-order-hold step in s. sample_dt: spacing of the returned samples in s (with

@@ -10,7 +10,8 @@ ARRAYS = ('t', 'q', 'u', 'u_hat', 'q_desired', 'q_od')
 
 @dataclass(frozen=True)
 class Trajectory:
-    """Samples of a run.
+    """
+    Samples of a run.
 
     t: (T,) s; q, q_desired: (T, N, dim) m; u: (T, N, dim) world-frame commands, m/s;
     u_hat: (T, N, dim) bounded formation-frame commands of eq. (14), m/s;

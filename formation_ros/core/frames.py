@@ -1,4 +1,5 @@
-"""The moving formation frame of Section 6: J, its time derivative, and eqs. (20), (21), (25).
+"""
+The moving formation frame of Section 6: J, its time derivative, and eqs. (20), (21), (25).
 
 J (dim x dim) rotates world vectors into the formation frame: ``qhat = J (q - q_od)`` (eq. 21).
 Rows of J are the frame's axes written in world coordinates. With positions stored as rows
@@ -30,7 +31,8 @@ SPEED_EPS = 1e-12
 
 @dataclass(frozen=True)
 class FrameSample:
-    """The reference at one time.
+    """
+    The reference at one time.
 
     t: time in s; q_od: (dim,) centre of the formation, m; qdot_od: (dim,) its velocity, m/s;
     J: (dim, dim) rotation world -> formation frame; Jdot: (dim, dim) its time derivative, 1/s.
@@ -66,7 +68,8 @@ def to_frame_vectors(v, frame):
 
 
 def from_frame_velocity(u_hat, q, frame):
-    """Eq. (25) with ERRATA 5: ``u = qdot_od + J^{-1} (u_hat - Jdot (q - q_od))``.
+    """
+    Eq. (25) with ERRATA 5: ``u = qdot_od + J^{-1} (u_hat - Jdot (q - q_od))``.
 
     u_hat: (N, dim) commands in the formation frame; q: (N, dim) world positions.
     Returns (N, dim) world velocities in m/s.
@@ -87,12 +90,13 @@ def desired_positions(vertices, frame):
 
 
 def skew(w):
-    """Cross-product matrix [w]x of a 3-vector, so that ``skew(w) @ v == cross(w, v)``."""
+    """Return the cross-product matrix [w]x of a 3-vector w (times v gives w x v)."""
     return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
 
 
 def frame_2d(qdot, qddot):
-    """J and Jdot in 2D from the reference velocity and acceleration (ERRATA 6).
+    """
+    J and Jdot in 2D from the reference velocity and acceleration (ERRATA 6).
 
     Returns (J, Jdot), each (2, 2). A reference at rest has J = I, Jdot = 0.
     """
@@ -109,7 +113,8 @@ def frame_2d(qdot, qddot):
 
 
 def frame_planar_3d(qdot, qddot, normal):
-    """J and Jdot in 3D for a path in a plane with unit ``normal`` (module docstring).
+    """
+    J and Jdot in 3D for a path in a plane with unit ``normal`` (module docstring).
 
     For a straight line ``normal`` only fixes the roll of the frame: any unit vector not parallel
     to the line. Returns (J, Jdot), each (3, 3); a reference at rest has J = I, Jdot = 0.
@@ -129,7 +134,8 @@ def frame_planar_3d(qdot, qddot, normal):
 
 
 def frame_frenet_3d(qdot, qddot, qdddot):
-    """Frenet J and Jdot = -[w]x J, w = v (tau, 0, k) (Section 6, ERRATA 6).
+    """
+    Frenet J and Jdot = -[w]x J, w = v (tau, 0, k) (Section 6, ERRATA 6).
 
     Needs a curvature bounded away from zero (the helix). Returns (J, Jdot), each (3, 3).
     """

@@ -1,6 +1,7 @@
-"""Jump functions of Lemma 1 (eqs. 5-7) and the collision terms built from them (eq. 11).
+"""
+Jump functions of Lemma 1 (eqs. 5-7) and the collision terms built from them (eq. 11).
 
-A jump function ``h(x, a, b)`` is 0 for ``x <= a``, 1 for ``x >= b`` and climbs smoothly in between.
+A jump function ``h(x, a, b)`` is 0 for ``x <= a``, 1 for ``x >= b``, smooth in between.
 The controller only ever needs it at ``a = 0``, ``b = b_ij**2 / 2`` and ``x = ||q_ij||**2 / 2``
 (eq. 11 read as in ERRATA 1), but the functions here take any ``0 <= a < b``.
 
@@ -60,7 +61,7 @@ class PolyJump:
                       * (1.0 - t) ** self._one_minus_t_powers, axis=-1)
 
     def h(self, x, a, b):
-        """Jump function h(x, a, b) of eq. (5): shape of ``x``, values in [0, 1]."""
+        """Evaluate the jump function of eq. (5) at x: shape of ``x``, values in [0, 1]."""
         _check_interval(a, b)
         t = np.clip((np.asarray(x, dtype=float) - a) / (b - a), 0.0, 1.0)
         return t ** (self.order + 1) * self._sum_s(t)
@@ -76,7 +77,8 @@ class PolyJump:
         return np.where(inside, value, 0.0)
 
     def ratio(self, x, a, b):
-        """Return betabar' = h'(x) / h(x) (eq. 13), in 1/m**2.
+        """
+        Return betabar' = h'(x) / h(x) (eq. 13), in 1/m**2.
 
         Zero for ``x >= b``; ``+inf`` for ``x <= a`` (a collision). Near ``a`` it behaves like
         ``(p + 1) / (x - a)`` and is computed without forming the two tiny factors.
@@ -91,7 +93,8 @@ class PolyJump:
 
 
 class SmoothJump:
-    """Smooth jump function with ``g(y) = exp(-1/y)`` (Corollary 1).
+    """
+    Smooth jump function with ``g(y) = exp(-1/y)`` (Corollary 1).
 
     With ``L = b - a``, ``s = (x - a) / L`` and ``Phi(s) = (1/L) / (s (1 - s))`` the integrand of
     eq. (5) is ``exp(-Phi(s))``. The code evaluates, for ``s <= 1/2``,
@@ -110,7 +113,8 @@ class SmoothJump:
     @staticmethod
     @lru_cache(maxsize=4096)
     def _k_scaled(s, inv_len):
-        """K(s) for 0 < s <= 1/2 with Phi built from ``inv_len = 1 / (b - a)``.
+        """
+        K(s) for 0 < s <= 1/2 with Phi built from ``inv_len = 1 / (b - a)``.
 
         For s < 0.3 the integral is taken in ``w = Phi(sigma) - Phi(s)`` on [0, inf), where it
         reads ``int exp(-w) k / ((1 - 2 sigma) P**2) dw`` with ``P = Phi(s) + w``, ``k = 1/L``:
@@ -155,7 +159,7 @@ class SmoothJump:
         return np.array(values, dtype=float).reshape(near.shape)
 
     def h(self, x, a, b):
-        """Jump function h(x, a, b) of eq. (5): shape of ``x``, values in [0, 1]."""
+        """Evaluate the jump function of eq. (5) at x: shape of ``x``, values in [0, 1]."""
         s, inside, sc, log_f_rel, inv_len, k_half = self._scaled(x, a, b)
         tail = np.exp(log_f_rel) * self._k_near(sc, inv_len) / (2.0 * k_half)
         value = np.where(sc <= 0.5, tail, 1.0 - tail)

@@ -1,4 +1,5 @@
-"""The bounded formation control law: eqs. (8)-(14) and the tracking transform (21), (25).
+"""
+The bounded formation control law: eqs. (8)-(14) and the tracking transform (21), (25).
 
 Conventions: positions are rows, ``q`` has shape (N, dim) in metres, ``dim`` is 2 or 3; velocities
 are in m/s. ``vertices`` (N, dim) are the robots' places in the formation frame (``q_if`` for
@@ -13,11 +14,10 @@ use it, so they agree to rounding.
 from dataclasses import dataclass
 import math
 
+from formation_ros.core.frames import from_frame_velocity, STATIONARY, to_frame, to_frame_vectors
+from formation_ros.core.jump import make_jump
 import numpy as np
 from scipy.spatial import cKDTree
-
-from formation_ros.core.frames import STATIONARY, from_frame_velocity, to_frame, to_frame_vectors
-from formation_ros.core.jump import make_jump
 
 PSI_FUNCTIONS = {
     'arctan': (np.arctan, math.pi / 2.0),
@@ -27,7 +27,8 @@ PSI_FUNCTIONS = {
 
 @dataclass(frozen=True)
 class LawParams:
-    """Constants of the control law.
+    """
+    Constants of the control law.
 
     gain: c of eq. (14), m/s per unit of psi; kappa: kappa of eqs. (8), (13);
     psi: 'arctan' or 'tanh' (eq. 15); jump: a jump function object (``core.jump``);
@@ -78,7 +79,8 @@ def beta(distance_sq, law):
 
 
 def repulsion_terms(q_ij, law):
-    """Return betabar'_ij * q_ij for rows of relative positions q_ij = q_i - q_j.
+    """
+    Return betabar'_ij * q_ij for rows of relative positions q_ij = q_i - q_j.
 
     q_ij: (K, dim) in m. Returns (K, dim) in 1/m. betabar' = h'/h (eq. 13, ERRATA 3) is zero for
     ||q_ij|| >= b. A row with q_ij exactly zero (two robots at one point) has no direction and
@@ -106,7 +108,8 @@ def bounded_command(omega_value, law):
 
 @dataclass(frozen=True)
 class Command:
-    """A command and its parts.
+    """
+    A command and its parts.
 
     u: the world-frame velocity q' = u (eq. 25; equal to u_hat when stabilising);
     u_hat: the bounded command of eq. (14) in the formation frame, |u_hat| <= c M1;
@@ -119,7 +122,8 @@ class Command:
 
 
 def robot_command(q_i, vertex_i, neighbours, sensing_radius, law, frame=STATIONARY):
-    """Control of one robot from what it knows (eqs. 13, 14, 21, 25).
+    """
+    Control of one robot from what it knows (eqs. 13, 14, 21, 25).
 
     q_i: (dim,) own position, world frame, m. vertex_i: (dim,) own place in the formation frame.
     neighbours: (K, dim) positions the robot has sensed, world frame; those at distance
@@ -145,7 +149,8 @@ def neighbour_pairs(q, radius):
 
 
 def team_command(q, vertices, sensing_radii, law, frame=STATIONARY):
-    """Control of every robot at once (the vectorised form of :func:`robot_command`).
+    """
+    Control of every robot at once (the vectorised form of :func:`robot_command`).
 
     q: (N, dim) positions, world frame, m. vertices: (N, dim). sensing_radii: (N,) R_i in m.
     Neighbours are found with a k-d tree within b (betabar' vanishes beyond b and b <= R_i), then
@@ -171,7 +176,8 @@ def team_command(q, vertices, sensing_radii, law, frame=STATIONARY):
 
 
 def log_potential(q, vertices, law, frame=STATIONARY):
-    """Return log(phi + 1) = gamma - kappa * sum_{i<j} log beta_ij (eqs. 8-11), a float.
+    """
+    Return log(phi + 1) = gamma - kappa * sum_{i<j} log beta_ij (eqs. 8-11), a float.
 
     phi itself overflows quickly (e**gamma / beta**kappa); its logarithm is monotone in phi and
     its gradient with respect to q_i (formation frame) is exactly Omega_i of eq. (13). Returns

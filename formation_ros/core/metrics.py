@@ -1,4 +1,5 @@
-"""Numbers that show the controller kept its promises, from sampled runs (Section 5).
+"""
+Numbers that show the controller kept its promises, from sampled runs (Section 5).
 
 Inputs are sampled trajectories: t (T,) in s, q and q_desired (T, N, dim) in m, u and u_hat
 (T, N, dim) in m/s. The same functions serve ``formation_sim`` and the bag report.
@@ -22,7 +23,8 @@ def formation_errors(q, q_desired):
 
 
 def settle_time(t, errors, tolerance=SETTLE_TOLERANCE):
-    """First sample time after which every error stays <= tolerance; None if never.
+    """
+    First sample time after which every error stays <= tolerance; None if never.
 
     t: (T,); errors: (T, N). Measured on the samples, so its resolution is the sample spacing.
     """
@@ -48,13 +50,14 @@ def dis_min_series(q):
 
 
 def dis_all(points):
-    """The 'mean-product' distance of Section 5 with ERRATA 7: geometric mean of all ||q_ij||."""
+    """Return the 'mean-product' distance of Section 5 (ERRATA 7): geometric mean of ||q_ij||."""
     with np.errstate(divide='ignore'):
         return float(np.exp(np.mean(np.log(pdist(np.asarray(points, dtype=float))))))
 
 
 def dis_all_series(t, q):
-    """dis_all over time: (times (K,), values (K,)), thinned to at most 400 samples.
+    """
+    dis_all over time: (times (K,), values (K,)), thinned to at most 400 samples.
 
     Empty arrays when N > 2000 (N**2 / 2 distances per sample would dominate the run).
     """
@@ -66,7 +69,8 @@ def dis_all_series(t, q):
 
 
 def compute_metrics(t, q, u, u_hat, q_desired, u_bound, extra=None):
-    """The metrics.json dictionary of a run.
+    """
+    Return the metrics.json dictionary of a run.
 
     u_bound: c * M1 (m/s), the bound every component of u_hat must keep; with a fixed reference
     u equals u_hat. extra: more keys to merge (e.g. reference kind, integrator).

@@ -1,4 +1,5 @@
-"""Parameter schema, YAML loading and validation shared by ``formation_sim`` and every node.
+"""
+Parameter schema, YAML loading and validation shared by ``formation_sim`` and every node.
 
 One standard ROS 2 parameters file drives everything::
 
@@ -22,12 +23,11 @@ import difflib
 import math
 import re
 
-import numpy as np
-import yaml
-
 from formation_ros.core.jump import JUMP_KINDS
 from formation_ros.core.law import make_law, PSI_FUNCTIONS
 from formation_ros.core.reference import Reference, REFERENCE_KINDS
+import numpy as np
+import yaml
 
 MAX_START_TRIES = 20000
 
@@ -43,7 +43,8 @@ class ParamError(ValueError):
 
 @dataclass(frozen=True)
 class Param:
-    """One entry of the schema.
+    """
+    One entry of the schema.
 
     kind: 'int', 'double', 'string', 'bool' or 'double_array' (the ROS parameter type);
     default: value when absent (None: optional with no value; REQUIRED: must be given);
@@ -114,11 +115,12 @@ SCHEMA_BY_NAME = {p.name: p for p in SCHEMA}
 EXTRA_ALLOWED = {'use_sim_time'}
 
 # PyYAML follows YAML 1.1, where 1e-3 is a string; ROS reads it as a double, and so do we.
-_FLOAT_PATTERN = re.compile(r'''^(?:[-+]?(?:[0-9][0-9_]*)\.[0-9_]*(?:[eE][-+]?[0-9]+)?
-    |[-+]?(?:[0-9][0-9_]*)(?:[eE][-+]?[0-9]+)
-    |\.[0-9_]+(?:[eE][-+][0-9]+)?
-    |[-+]?\.(?:inf|Inf|INF)
-    |\.(?:nan|NaN|NAN))$''', re.X)
+_FLOAT_PATTERN = re.compile(
+    r'^(?:[-+]?[0-9][0-9_]*\.[0-9_]*(?:[eE][-+]?[0-9]+)?'
+    r'|[-+]?[0-9][0-9_]*[eE][-+]?[0-9]+'
+    r'|[-+]?\.[0-9_]+(?:[eE][-+]?[0-9]+)?'
+    r'|[-+]?\.(?:inf|Inf|INF)'
+    r'|\.(?:nan|NaN|NAN))$')
 
 
 class _Loader(yaml.SafeLoader):
@@ -146,7 +148,8 @@ def flatten(tree, prefix=''):
 
 
 def load_params_file(path):
-    """Read a ROS 2 parameters YAML file and return the flat ``/**`` parameters.
+    """
+    Read a ROS 2 parameters YAML file and return the flat ``/**`` parameters.
 
     Raises ParamError (naming the file) when the file is missing, is not YAML, or has no
     ``/**: ros__parameters:`` section.
@@ -160,7 +163,7 @@ def load_params_file(path):
         raise ParamError([(str(path), f'cannot read it as YAML: {exc}')]) from None
     section = document.get('/**') if isinstance(document, dict) else None
     if not isinstance(section, dict) or not isinstance(section.get('ros__parameters'), dict):
-        raise ParamError([(str(path), "expected a ROS 2 parameters file with a top-level "
+        raise ParamError([(str(path), 'expected a ROS 2 parameters file with a top-level '
                                       "'/**:' section holding 'ros__parameters:'")])
     return flatten(section['ros__parameters'])
 
@@ -206,7 +209,8 @@ def _range_problem(param, value):
 
 
 def check_values(raw, executable='formation_sim'):
-    """Check names, types and ranges; return {name: value} with defaults filled in.
+    """
+    Check names, types and ranges; return {name: value} with defaults filled in.
 
     raw: flat {dotted name: value}. Raises ParamError listing every problem found.
     """
@@ -240,7 +244,8 @@ def check_values(raw, executable='formation_sim'):
 
 @dataclass(frozen=True)
 class FormationConfig:
-    """Validated parameters of one formation run (see :data:`SCHEMA` for meanings and units).
+    """
+    Validated parameters of one formation run (see :data:`SCHEMA` for meanings and units).
 
     Arrays: sensing_radii (N,), vertices (N, dim), start (N, dim) (None for the nodes other than
     the plant, which need no start), reference_origin (dim,), reference_velocity (dim,).
@@ -267,12 +272,12 @@ class FormationConfig:
     values: dict = field(default_factory=dict, repr=False)
 
     def law(self):
-        """The control law constants (``core.law.LawParams``)."""
+        """Return the control law constants (``core.law.LawParams``)."""
         return make_law(self.gain, self.kappa, self.psi, self.jump_kind, self.jump_order,
                         self.repulsion_radius)
 
     def reference(self):
-        """The moving reference (``core.reference.Reference``)."""
+        """Build the moving desired trajectory (``core.reference.Reference``)."""
         return Reference(self.reference_kind, self.dim, self.reference_origin,
                          self.reference_velocity, self.reference_radius, self.reference_speed,
                          self.reference_pitch)
@@ -298,7 +303,8 @@ def _closest_pair(points):
 
 
 def random_start(n, dim, radius, min_separation, seed):
-    """Uniform random positions in the disc/ball of ``radius`` about 0, pairwise >= separation.
+    """
+    Uniform random positions in the disc/ball of ``radius`` about 0, pairwise >= separation.
 
     Returns (n, dim), or None when the points do not fit after many tries.
     """
@@ -354,7 +360,8 @@ def _vector(values, name, dim, problems):
 
 
 def validate(raw, executable='formation_sim'):
-    """Check a flat parameter dict and build a :class:`FormationConfig`.
+    """
+    Check a flat parameter dict and build a :class:`FormationConfig`.
 
     executable: 'formation_sim', 'robot', 'plant' or 'reference'; only the parameters that one
     reads are required (a robot needs no start positions). Raises ParamError.

@@ -1,4 +1,5 @@
-"""Moving references q_od(t) for formation tracking (Section 6) and their frames.
+"""
+Moving references q_od(t) for formation tracking (Section 6) and their frames.
 
 The path parameter s of the paper is time here (``ds/dt = 1``), so ``qdot_od = q_od'(t)``.
 Kinds (the ``reference.*`` parameters):
@@ -18,11 +19,10 @@ Kinds (the ``reference.*`` parameters):
 
 import math
 
+from formation_ros.core.frames import (frame_2d, frame_frenet_3d, frame_planar_3d, FrameSample,
+                                       stationary_frame)
 import numpy as np
 from scipy import integrate
-
-from formation_ros.core.frames import (FrameSample, frame_2d, frame_frenet_3d, frame_planar_3d,
-                                       stationary_frame)
 
 REFERENCE_KINDS = ('fixed', 'line', 'circle', 'figure_eight', 'helix')
 Z_AXIS = np.array([0.0, 0.0, 1.0])
@@ -32,7 +32,8 @@ GERONO_LOOP_LENGTH = integrate.quad(
 
 
 class Reference:
-    """A moving desired formation centre q_od(t) with its frame J(t).
+    """
+    A moving desired formation centre q_od(t) with its frame J(t).
 
     dim: 2 or 3. ``sample(t)`` returns a :class:`FrameSample`; ``derivatives(t)`` returns
     (q, q', q'', q''') as (dim,) arrays (m, m/s, m/s**2, m/s**3).
@@ -67,7 +68,7 @@ class Reference:
 
     @property
     def is_stationary(self):
-        """True when q_od never moves (fixed, or a line with zero velocity)."""
+        """Tell whether q_od never moves (fixed, or a line with zero velocity)."""
         return self.kind == 'fixed' or (self.kind == 'line' and not np.any(self.velocity))
 
     def derivatives(self, t):
@@ -117,7 +118,7 @@ class Reference:
         return FrameSample(float(t), q, q1, jmat, jdot)
 
     def _plane_normal(self, qdot):
-        """Fixed plane normal for the planar 3D frame: +z, or +y for a line along z."""
+        """Return the plane normal of the planar 3D frame: +z, or +y for a line along z."""
         if self.kind == 'line':
             speed = float(np.linalg.norm(qdot))
             if speed > 0.0 and np.linalg.norm(np.cross(Z_AXIS, qdot / speed)) < 1e-6:
