@@ -21,7 +21,6 @@ setup(
     maintainer_email='formation-ros@example.com',
     description='Bounded decentralized formation control for mobile robots with limited sensing.',
     license='Apache-2.0',
-    tests_require=['pytest'],
     entry_points={
         'console_scripts': [
             'formation_sim = formation_ros.sim:main',

@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# Create or update the virtual environment that runs and tests formation_ros.
+set -euo pipefail
+
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+VENV="${FORMATION_VENV:-$ROOT/.venv}"
+PYTHON="${PYTHON:-python3}"
+
+usage() {
+  cat <<USAGE
+Usage: scripts/setup_env.sh [--venv DIR] [--python EXE] [--force]
+
+Creates a Python virtual environment (default: .venv in the repository) and installs
+formation_ros with everything it needs from PyPI: numpy, scipy, matplotlib, PyYAML, the ROS 2
+Jazzy wheels (rclpy with Fast DDS, common_interfaces), colcon, pytest and the ament linters.
+Nothing needs to be sourced afterwards. A second run only reinstalls when requirements.txt
+changed (or with --force).
+
+Options:
+  --venv DIR     where to create the environment (default: \$FORMATION_VENV or .venv)
+  --python EXE   interpreter to build it from, Python 3.10 to 3.13 (default: python3)
+  --force        reinstall even if requirements.txt did not change
+  -h, --help     show this help
+USAGE
+}
+
+force=0
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --venv) VENV="${2:?--venv needs a directory}"; shift 2 ;;
+    --python) PYTHON="${2:?--python needs an interpreter}"; shift 2 ;;
+    --force) force=1; shift ;;
+    -h|--help) usage; exit 0 ;;
+    *) echo "setup_env.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
+  esac
+done
+
+if ! command -v "$PYTHON" >/dev/null 2>&1; then
+  echo "setup_env.sh: no Python interpreter '$PYTHON' found" >&2
+  exit 1
+fi
+if ! "$PYTHON" -c 'import sys; sys.exit(not ((3, 10) <= sys.version_info[:2] <= (3, 13)))'; then
+  echo "setup_env.sh: the ROS 2 Jazzy wheels need Python 3.10 to 3.13;" \
+       "$("$PYTHON" --version 2>&1) found (use --python)" >&2
+  exit 1
+fi
+
+stamp="$VENV/.formation_ros_requirements"
+wanted="$(cat "$ROOT/requirements.txt" "$ROOT/setup.py")"
+if [[ $force -eq 0 && -x "$VENV/bin/python" && -f "$stamp" ]] && [[ "$(cat "$stamp")" == "$wanted" ]]; then
+  echo "setup_env.sh: $VENV is up to date"
+  exit 0
+fi
+
+echo "setup_env.sh: creating $VENV with $("$PYTHON" --version 2>&1)"
+"$PYTHON" -m venv "$VENV"
+"$VENV/bin/python" -m pip install --quiet --upgrade pip
+echo "setup_env.sh: installing requirements (a few minutes on a fresh machine)"
+"$VENV/bin/python" -m pip install --quiet -r "$ROOT/requirements.txt"
+"$VENV/bin/python" -m pip install --quiet --no-deps -e "$ROOT"
+printf '%s' "$wanted" > "$stamp"
+echo "setup_env.sh: ready ($VENV)"

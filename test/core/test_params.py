@@ -1,0 +1,157 @@
+"""Parameter files and their validation (core/params.py)."""
+
+import math
+import os
+import re
+
+from formation_ros.core.params import (load_config, load_params_file, ParamError, REQUIRED,
+                                       SCHEMA, validate)
+import numpy as np
+import pytest
+import yaml
+
+CONFIG_DIR = os.path.join(os.path.dirname(__file__), '..', '..', 'config')
+SECTION5 = os.path.join(CONFIG_DIR, 'paper_section5.yaml')
+
+
+def base():
+    return load_params_file(SECTION5)
+
+
+def test_section5_file_matches_the_paper():
+    config = load_config(SECTION5)
+    assert (config.num_robots, config.dim) == (10, 2)
+    i = np.arange(10)
+    expected = 8.0 * np.column_stack([np.sin(i * 2 * np.pi / 10), np.cos(i * 2 * np.pi / 10)])
+    assert np.allclose(config.vertices, expected, atol=1e-9)
+    assert np.all(config.sensing_radii == 2.0) and config.repulsion_radius == 1.0
+    assert (config.gain, config.kappa, config.psi) == (2.0, 1.0, 'arctan')
+    assert (config.jump_kind, config.jump_order) == ('poly', 2)
+    assert np.all(np.linalg.norm(config.start, axis=1) <= 1.0)
+    gaps = np.linalg.norm(config.start[:, None] - config.start[None], axis=2)
+    assert np.min(gaps[np.triu_indices(10, 1)]) >= 0.1
+
+
+@pytest.mark.parametrize('name', sorted(f for f in os.listdir(CONFIG_DIR) if f.endswith('.yaml')))
+def test_every_shipped_config_is_valid(name):
+    load_config(os.path.join(CONFIG_DIR, name))
+
+
+def test_random_start_is_reproducible_and_seeded():
+    raw = base()
+    first, again = validate(raw).start, validate(raw).start
+    raw['start.seed'] = 99
+    assert np.array_equal(first, again)
+    assert not np.allclose(first, validate(raw).start)
+
+
+def test_scientific_notation_is_a_double(tmp_path):
+    path = tmp_path / 'p.yaml'
+    text = open(SECTION5).read().replace('gain: 2.0', 'gain: 2e0')
+    path.write_text(text)
+    assert load_config(str(path)).gain == 2.0
+
+
+BAD_CASES = [
+    ('controller.gain', {'controller.gain': 2}, 'write 2.0'),
+    ('controller.gain', {'controller.gain': -1.0}, '>= 1e-12'),
+    ('controller.gain', {'controller.gain': 'fast'}, 'finite double'),
+    ('controller.gain', {'controller.gain': math.nan}, 'finite double'),
+    ('num_robots', {'num_robots': 'ten'}, 'integer'),
+    ('num_robots', {'num_robots': 1}, '>= 2'),
+    ('dim', {'dim': 4}, '<= 3'),
+    ('controller.psi', {'controller.psi': 'sigmoid'}, 'arctan, tanh'),
+    ('jump.kind', {'jump.kind': 'cubic'}, 'poly, smooth'),
+    ('jump.order', {'jump.order': 0}, '>= 1'),
+    ('formation.vertices', {'formation.vertices': [0.0, 1.0, 2.0]}, '10 x 2 = 20'),
+    ('formation.vertices', {'formation.vertices': [0.0, 1, 2.0]}, 'write 1.0'),
+    ('formation.vertices', {'formation.vertices': [0.0] * 20}, 'same vertex'),
+    ('start.positions', {'start.positions': [0.5] * 20, 'start.random_radius': None,
+                         'start.min_separation': None}, 'start at the same point'),
+    ('start.positions', {'start.positions': [0.5, 1.0]}, 'not both'),
+    ('start.positions', {'start.random_radius': None}, 'is required'),
+    ('start.min_separation', {'start.min_separation': 0.9}, 'do not fit'),
+    ('repulsion_radius', {'repulsion_radius': 3.0}, 'sensing radius'),
+    ('repulsion_radius', {'repulsion_radius': 1.5, 'sensing_radius': 6.0,
+                          'formation.vertices': [0.0, 0.0, 1.2, 0.0] + [
+                              float(v) for k in range(8) for v in (10.0 * k, 20.0)]},
+     'closest vertices'),
+    ('sensing_radii', {'sensing_radii': [2.0] * 9}, 'num_robots = 10'),
+    ('repulsion_radius', {'sensing_radii': [2.0] * 9 + [0.5]}, 'smallest R_i = 0.5'),
+    ('controller.gian', {'controller.gian': 2.0}, "did you mean 'controller.gain'"),
+    ('reference.kind', {'reference.kind': 'helix'}, 'dim 3'),
+    ('reference.kind', {'reference.kind': 'spiral'}, 'one of'),
+    ('reference.velocity', {'reference.kind': 'line'}, 'required for a line'),
+    ('reference.origin', {'reference.origin': [0.0, 0.0, 0.0]}, 'dim = 2'),
+    ('reference.speed', {'reference.kind': 'circle', 'reference.speed': 0.0}, '> 0'),
+    ('sensing_radius', {'sensing_radius': None}, 'is required'),
+    ('duration', {'duration': 0.0}, '>= 1e-09'),
+]
+
+
+@pytest.mark.parametrize('name,changes,message', BAD_CASES,
+                         ids=[f'{c[0]}-{i}' for i, c in enumerate(BAD_CASES)])
+def test_bad_parameter_named_with_what_is_allowed(name, changes, message):
+    raw = base()
+    for key, value in changes.items():
+        if value is None:
+            raw.pop(key, None)
+        else:
+            raw[key] = value
+    with pytest.raises(ParamError) as info:
+        validate(raw)
+    text = str(info.value)
+    assert f"parameter '{name}'" in text
+    assert message in text
+
+
+def test_every_problem_is_reported_at_once():
+    raw = base()
+    raw.update({'controller.gain': -1.0, 'dim': 7, 'typo': 1})
+    with pytest.raises(ParamError) as info:
+        validate(raw)
+    names = {name for name, _ in info.value.problems}
+    assert names == {'controller.gain', 'dim', 'typo'}
+
+
+@pytest.mark.parametrize('text,message', [
+    ('num_robots: [unclosed', 'cannot read it as YAML'),
+    ('robot:\n  ros__parameters:\n    num_robots: 3\n', "'/**:'"),
+    ('- just\n- a list\n', "'/**:'"),
+])
+def test_bad_files(tmp_path, text, message):
+    path = tmp_path / 'bad.yaml'
+    path.write_text(text)
+    with pytest.raises(ParamError, match=re.escape(message)):
+        load_params_file(str(path))
+
+
+def test_missing_file():
+    with pytest.raises(ParamError, match='file not found'):
+        load_params_file('/nonexistent/params.yaml')
+
+
+def test_nodes_need_no_start_positions():
+    raw = base()
+    for key in ('start.random_radius', 'start.min_separation', 'start.seed'):
+        raw.pop(key)
+    config = validate(raw, executable='robot')
+    assert config.start is None
+    with pytest.raises(ParamError, match='start.positions'):
+        validate(raw, executable='plant')
+
+
+def test_schema_defaults_have_their_declared_types():
+    kinds = {'int': int, 'double': float, 'string': str, 'bool': bool, 'double_array': list}
+    for param in SCHEMA:
+        if param.default is not None and param.default is not REQUIRED:
+            assert isinstance(param.default, kinds[param.kind]), param.name
+
+
+def test_section5_file_is_plain_yaml_for_ros():
+    """The ROS parser sees the same document: no Python-only YAML tags, numbers typed."""
+    with open(SECTION5) as stream:
+        document = yaml.safe_load(stream)
+    params = document['/**']['ros__parameters']
+    assert isinstance(params['controller']['gain'], float)
+    assert all(isinstance(v, float) for v in params['formation']['vertices'])

@@ -1,0 +1,16 @@
+"""Style: the ament flake8 rules (99 columns, single quotes, import order, docstrings)."""
+
+import os
+
+from ament_flake8.main import main_with_errors
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+@pytest.mark.flake8
+@pytest.mark.linter
+def test_flake8():
+    paths = [os.path.join(ROOT, name) for name in ('formation_ros', 'test', 'bench', 'setup.py')]
+    rc, errors = main_with_errors(argv=[p for p in paths if os.path.exists(p)])
+    assert rc == 0, f'{len(errors)} flake8 findings:\n' + '\n'.join(errors)

@@ -1,0 +1,16 @@
+"""Style: the ament pep257 docstring rules."""
+
+import os
+
+from ament_pep257.main import main
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+@pytest.mark.linter
+@pytest.mark.pep257
+def test_pep257():
+    paths = [os.path.join(ROOT, name) for name in ('formation_ros', 'test', 'bench')]
+    rc = main(argv=[p for p in paths if os.path.exists(p)])
+    assert rc == 0, 'pep257 findings: see the output above'

@@ -1,0 +1,124 @@
+"""The offline simulator (sim.py): Section 5 reproduced, tracking, the CLI."""
+
+import json
+import os
+import subprocess
+import sys
+
+from formation_ros.core.law import log_potential
+from formation_ros.core.metrics import formation_errors
+from formation_ros.core.params import load_config, load_params_file, validate
+from formation_ros.plots import FIGURES
+from formation_ros.sim import run_metrics, simulate
+from formation_ros.trajectory import Trajectory
+import numpy as np
+import pytest
+
+ROOT = os.path.join(os.path.dirname(__file__), '..')
+CONFIG = os.path.join(ROOT, 'config')
+SECTION5 = os.path.join(CONFIG, 'paper_section5.yaml')
+
+
+def section5(seed):
+    raw = load_params_file(SECTION5)
+    raw['start.seed'] = seed
+    return validate(raw)
+
+
+@pytest.mark.parametrize('seed', [1, 2, 3, 4, 5])
+def test_section5_reproduced(seed):
+    config = section5(seed)
+    trajectory = simulate(config)
+    metrics = run_metrics(trajectory, config, 'RK45')
+    assert metrics['settle_time'] is not None and metrics['settle_time'] < 6.0
+    assert metrics['min_pair_distance'] > 0.1
+    assert metrics['max_abs_u_component'] < np.pi
+    assert metrics['bound_violations'] == 0
+    assert metrics['final_max_error'] < 1e-6
+
+
+def test_lyapunov_function_non_increasing():
+    config = section5(2)
+    trajectory = simulate(config, duration=8.0, sample_dt=0.005)
+    law = config.law()
+    values = np.array([log_potential(q, config.vertices, law) for q in trajectory.q])
+    assert np.all(np.isfinite(values))
+    assert np.all(np.diff(values) <= 1e-9 * np.maximum(1.0, np.abs(values[1:])))
+    assert values[-1] < 1e-3 * values[0]
+
+
+@pytest.mark.parametrize('name', ['circle_2d.yaml', 'helix_3d.yaml', 'figure_eight_2d.yaml'])
+def test_tracking_converges(name):
+    config = load_config(os.path.join(CONFIG, name))
+    trajectory = simulate(config)
+    errors = formation_errors(trajectory.q, trajectory.q_desired)
+    assert np.max(errors[-1]) < 1e-4
+    assert np.max(np.abs(trajectory.u_hat)) <= config.law().u_bound
+    assert np.ptp(trajectory.q_od, axis=0).max() > 5.0
+
+
+def test_lyapunov_non_increasing_in_moving_frame():
+    config = load_config(os.path.join(CONFIG, 'helix_3d.yaml'))
+    trajectory = simulate(config, duration=6.0)
+    reference, law = config.reference(), config.law()
+    values = np.array([log_potential(q, config.vertices, law, reference.sample(t))
+                       for t, q in zip(trajectory.t, trajectory.q)])
+    assert np.all(np.diff(values) <= 1e-9 * np.maximum(1.0, np.abs(values[1:])))
+
+
+def test_fixed_step_is_zero_order_hold():
+    config = section5(3)
+    dt = 0.01
+    trajectory = simulate(config, duration=1.0, dt=dt, sample_dt=dt)
+    assert len(trajectory.t) == 101
+    step = trajectory.q[:-1] + dt * trajectory.u[:-1]
+    assert np.max(np.abs(step - trajectory.q[1:])) < 1e-14
+
+
+def test_fixed_step_approaches_continuous_time():
+    config = section5(3)
+    exact = simulate(config, duration=3.0, sample_dt=0.5)
+    coarse = simulate(config, duration=3.0, dt=0.002, sample_dt=0.5)
+    fine = simulate(config, duration=3.0, dt=0.0005, sample_dt=0.5)
+    err_coarse = np.max(np.abs(coarse.q[-1] - exact.q[-1]))
+    err_fine = np.max(np.abs(fine.q[-1] - exact.q[-1]))
+    assert err_fine < err_coarse / 2.5
+
+
+def run_cli(*args):
+    return subprocess.run([sys.executable, '-m', 'formation_ros.sim', *args],
+                          capture_output=True, text=True, cwd=ROOT, timeout=300)
+
+
+def test_cli_writes_trajectory_metrics_and_figures(tmp_path):
+    out = tmp_path / 'run'
+    result = run_cli(SECTION5, '--out', str(out), '--duration', '8')
+    assert result.returncode == 0, result.stderr
+    assert 'settle time' in result.stdout
+    trajectory = Trajectory.load(str(out / 'trajectory.npz'))
+    assert trajectory.q.shape == (801, 10, 2) and trajectory.t[-1] == pytest.approx(8.0)
+    metrics = json.loads((out / 'metrics.json').read_text())
+    for key in ('min_pair_distance', 'dis_all_final', 'final_max_error', 'settle_time',
+                'max_abs_u_component', 'u_bound', 'num_robots', 'dim'):
+        assert key in metrics
+    assert metrics['u_bound'] == pytest.approx(np.pi)
+    assert 4.0 < metrics['settle_time'] < 6.0
+    for name in FIGURES:
+        assert (out / name).read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
+    assert (out / 'params.yaml').read_text() == open(SECTION5).read()
+
+
+def test_cli_bad_parameters_exit_non_zero_and_write_nothing(tmp_path):
+    bad = tmp_path / 'bad.yaml'
+    bad.write_text(open(SECTION5).read().replace('gain: 2.0', 'gain: -2.0'))
+    out = tmp_path / 'never'
+    result = run_cli(str(bad), '--out', str(out))
+    assert result.returncode == 2
+    assert "parameter 'controller.gain'" in result.stderr
+    assert not out.exists()
+
+
+def test_cli_bad_option_and_help():
+    assert run_cli(SECTION5, '--out', '/tmp/x', '--dt', '-1').returncode == 2
+    result = run_cli('--help')
+    assert result.returncode == 0 and '--dt' in result.stdout and 'RK45' in result.stdout
