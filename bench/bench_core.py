@@ -75,8 +75,9 @@ def main():
     if len(rows) > 1:
         (n0, t0), (n1, t1) = rows[-2], rows[-1]
         exponent = math.log(t1 / t0) / math.log(n1 / n0)
+        n_log_n = math.log(n1 * math.log(n1) / (n0 * math.log(n0))) / math.log(n1 / n0)
         print(f'\ngrowth of the law step between N = {n0} and {n1}: N^{exponent:.2f} '
-              f'(N log N would be N^{math.log(n1 * math.log(n1) / (n0 * math.log(n0))) / math.log(n1 / n0):.2f})')
+              f'(N log N would be N^{n_log_n:.2f})')
 
 
 if __name__ == '__main__':
