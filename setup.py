@@ -24,6 +24,10 @@ setup(
     entry_points={
         'console_scripts': [
             'formation_sim = formation_ros.sim:main',
+            'formation_report = formation_ros.report:main',
+            'robot = formation_ros.nodes.robot:main',
+            'plant = formation_ros.nodes.plant:main',
+            'reference = formation_ros.nodes.reference:main',
         ],
     },
 )

@@ -17,7 +17,7 @@ import time
 from formation_ros.core.frames import desired_positions
 from formation_ros.core.law import team_command
 from formation_ros.core.metrics import compute_metrics
-from formation_ros.core.params import load_config, ParamError
+from formation_ros.core.params import load_config, load_params_file, ParamError, validate
 from formation_ros.trajectory import Trajectory
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -159,7 +159,12 @@ def build_parser():
                     'write trajectory.npz, metrics.json and figures.',
         epilog='Example: formation_sim config/paper_section5.yaml --out /tmp/section5')
     parser.add_argument('params', help='ROS 2 parameters YAML file (/**: ros__parameters: ...)')
-    parser.add_argument('--out', required=True, help='output directory (created if missing)')
+    parser.add_argument('--out', help='output directory (created if missing); required unless '
+                                      '--check')
+    parser.add_argument('--check', action='store_true',
+                        help='only validate the parameters for the simulator and every node, '
+                             "print 'NUM_ROBOTS WALL_MS' (robots, and milliseconds the run "
+                             'takes at plant.realtime_factor) and exit (0 valid, 2 not)')
     parser.add_argument('--duration', type=float, help='simulated seconds (default: duration '
                                                        'in the parameters file)')
     parser.add_argument('--dt', type=float, help='fixed step with zero-order hold, s (default: '
@@ -179,11 +184,22 @@ def main(argv=None):
         value = getattr(args, name)
         if value is not None and not (math.isfinite(value) and value > 0.0):
             parser.error(f"--{name.replace('_', '-')} must be a number > 0, got {value}")
+    if not args.check and not args.out:
+        parser.error('--out is required (or --check)')
     try:
         config = load_config(args.params)
+        if args.check:
+            raw = load_params_file(args.params)
+            plant = validate(raw, 'plant')
+            validate(raw, 'reference')
+            validate({**raw, 'robot_id': 1}, 'robot')
     except ParamError as exc:
         print(f'formation_sim: invalid parameters in {args.params}:\n{exc}', file=sys.stderr)
         return 2
+    if args.check:
+        wall = config.duration / plant.values['plant.realtime_factor']
+        print(config.num_robots, int(round(1000.0 * wall)))
+        return 0
     duration = config.duration if args.duration is None else args.duration
     os.makedirs(args.out, exist_ok=True)
     integrator = 'RK45' if args.dt is None else f'zero-order hold, dt = {args.dt:g} s'

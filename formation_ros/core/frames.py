@@ -81,6 +81,20 @@ def from_frame_velocity(u_hat, q, frame):
     return frame.qdot_od + (u_hat - offset @ frame.Jdot.T) @ frame.J
 
 
+def to_frame_velocity(u, q, frame):
+    """
+    Invert eq. (25): ``u_hat = J (u - qdot_od) + Jdot (q - q_od)``.
+
+    u: (N, dim) world velocities, q: (N, dim) world positions. Returns (N, dim), the bounded
+    command of eq. (14) that produced ``u``.
+    """
+    u = np.asarray(u, dtype=float)
+    if frame is None:
+        return u.copy()
+    offset = np.asarray(q, dtype=float) - frame.q_od
+    return (u - frame.qdot_od) @ frame.J.T + offset @ frame.Jdot.T
+
+
 def desired_positions(vertices, frame):
     """Eq. (20) solved for q_id: ``q_id = q_od + J^{-1} qhat_id``; (N, dim) -> (N, dim)."""
     vertices = np.asarray(vertices, dtype=float)
@@ -153,3 +167,107 @@ def frame_frenet_3d(qdot, qddot, qdddot):
     jmat = np.vstack([tangent, n_vec, b_vec])
     jdot = -skew(speed * np.array([torsion, 0.0, curvature])) @ jmat
     return jmat, jdot
+
+
+def _vee(skew_matrix):
+    return np.array([skew_matrix[2, 1], skew_matrix[0, 2], skew_matrix[1, 0]])
+
+
+def _embed(matrix):
+    """Embed a 2x2 rotation (about z) in 3x3; return a 3x3 matrix unchanged."""
+    if matrix.shape == (3, 3):
+        return matrix
+    out = np.eye(3)
+    out[:2, :2] = matrix
+    return out
+
+
+def _rotation_exp(vector):
+    """Return exp([v]x), the rotation by |v| rad about v (Rodrigues)."""
+    angle = float(np.linalg.norm(vector))
+    k = skew(vector)
+    if angle < 1e-12:
+        return np.eye(3) + k
+    return np.eye(3) + np.sin(angle) / angle * k + (1.0 - np.cos(angle)) / angle ** 2 * (k @ k)
+
+
+def quaternion_from_matrix(rotation):
+    """Return the unit quaternion (x, y, z, w), w >= 0, of a 3x3 rotation matrix."""
+    r = np.asarray(rotation, dtype=float)
+    trace = np.trace(r)
+    if trace > 0.0:
+        s = 2.0 * np.sqrt(trace + 1.0)
+        quat = [(r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s,
+                0.25 * s]
+    else:
+        i = int(np.argmax(np.diag(r)))
+        j, k = (i + 1) % 3, (i + 2) % 3
+        s = 2.0 * np.sqrt(1.0 + r[i, i] - r[j, j] - r[k, k])
+        quat = [0.0, 0.0, 0.0, (r[k, j] - r[j, k]) / s]
+        quat[i] = 0.25 * s
+        quat[j] = (r[j, i] + r[i, j]) / s
+        quat[k] = (r[k, i] + r[i, k]) / s
+    quat = np.array(quat)
+    quat /= np.linalg.norm(quat)
+    return quat if quat[3] >= 0.0 else -quat
+
+
+def matrix_from_quaternion(quat):
+    """Return the rotation matrix (3, 3) of a quaternion (x, y, z, w), normalised first."""
+    x, y, z, w = np.asarray(quat, dtype=float) / np.linalg.norm(quat)
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+    ])
+
+
+def frame_to_pose(frame, dim):
+    """
+    Express a frame as an odometry-like pose.
+
+    Returns (position (3,), quaternion (x, y, z, w), linear velocity (3,), angular velocity
+    (3,)), all in the world frame: the quaternion is the rotation J^T from formation axes to
+    world axes, the angular velocity w satisfies ``Jdot = -J [w]x``. ``None`` stands for the
+    stationary frame at the origin. 2D frames are rotations about z, with z components zero.
+    """
+    frame = stationary_frame(dim) if frame is None else frame
+    jmat, jdot = _embed(frame.J), _embed(frame.Jdot)
+    if dim == 2:
+        jdot = np.zeros((3, 3))
+        jdot[:2, :2] = frame.Jdot
+    position, linear = np.zeros(3), np.zeros(3)
+    position[:dim] = frame.q_od
+    linear[:dim] = frame.qdot_od
+    angular = _vee(-jmat.T @ jdot)
+    return position, quaternion_from_matrix(jmat.T), linear, angular
+
+
+def frame_from_pose(t, position, quaternion, linear, angular, dim):
+    """Inverse of :func:`frame_to_pose`: a :class:`FrameSample` of dimension ``dim``."""
+    jmat = matrix_from_quaternion(quaternion).T
+    jdot = -jmat @ skew(np.asarray(angular, dtype=float))
+    return FrameSample(float(t), np.array(position[:dim], dtype=float),
+                       np.array(linear[:dim], dtype=float), jmat[:dim, :dim].copy(),
+                       jdot[:dim, :dim].copy())
+
+
+def advance(frame, dt):
+    """
+    Carry a frame forward by dt seconds at constant velocity and angular velocity.
+
+    Used to bring the latest reference sample to the time of a robot's state; exact for a line
+    and a fixed reference, first order in dt otherwise. Returns a new :class:`FrameSample`.
+    """
+    if frame is None or dt == 0.0:
+        return frame
+    dim = frame.q_od.shape[0]
+    jmat, jdot = _embed(frame.J), _embed(frame.Jdot)
+    if dim == 2:
+        jdot = np.zeros((3, 3))
+        jdot[:2, :2] = frame.Jdot
+    omega = _vee(-jmat.T @ jdot)
+    moved = jmat @ _rotation_exp(-omega * dt)
+    moved_dot = -moved @ skew(omega)
+    return FrameSample(frame.t + dt, frame.q_od + frame.qdot_od * dt, frame.qdot_od.copy(),
+                       moved[:dim, :dim].copy(), moved_dot[:dim, :dim].copy())

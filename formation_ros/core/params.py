@@ -110,6 +110,37 @@ SCHEMA = (
           'Path speed of circle and helix (mean speed of the figure eight), m/s.', low=0.0),
     Param('reference.pitch', 'double', 1.0, 'Helix rise per turn along +z, m.'),
     Param('duration', 'double', 20.0, 'Length of a run, s.', low=1e-9),
+    Param('robot_id', 'int', REQUIRED, 'This robot: 1..num_robots (robot node only).', low=1,
+          users=('robot',)),
+    Param('control_rate', 'double', 50.0, 'Rate of the control timer, Hz (wall clock).',
+          low=1e-3, high=10000.0, users=('robot',)),
+    Param('input_timeout', 'double', 0.5,
+          'A robot publishes zero when no new pose, neighbours or reference arrived for this '
+          'long, s (wall clock; not in lockstep).', low=1e-3, users=('robot',)),
+    Param('plant.rate', 'double', 100.0,
+          'Integration rate of the plant, Hz of simulated time: step dt = 1 / rate.', low=1e-3,
+          high=100000.0, users=('plant',)),
+    Param('plant.input_timeout', 'double', 0.5,
+          'A command whose state stamp is older than this counts as zero, s (simulated time).',
+          low=1e-6, users=('plant',)),
+    Param('plant.publish_rate', 'double', 50.0,
+          'Rate of /robot_<i>/pose and /robot_<i>/neighbors, Hz of simulated time (at most '
+          'plant.rate; every step in lockstep).', low=1e-3, high=100000.0, users=('plant',)),
+    Param('plant.realtime_factor', 'double', 1.0,
+          'Simulated seconds per wall-clock second (an upper bound in lockstep).', low=1e-3,
+          high=1000.0, users=('plant',)),
+    Param('plant.lockstep', 'bool', False,
+          'Deterministic mode: the plant steps only when every robot answered the latest state.',
+          users=('plant', 'robot', 'reference')),
+    Param('plant.collision_distance', 'double', 1e-3,
+          'Two robots closer than this are logged as a collision, m.', low=0.0,
+          users=('plant',)),
+    Param('plant.output_dir', 'string', '',
+          'If set, the plant writes trajectory.npz and plant_stats.json there when it stops.',
+          users=('plant',)),
+    Param('reference.rate', 'double', 50.0,
+          'Publication rate of /formation/reference, Hz (simulated time with use_sim_time).',
+          low=1e-3, high=10000.0, users=('reference',)),
 )
 SCHEMA_BY_NAME = {p.name: p for p in SCHEMA}
 EXTRA_ALLOWED = {'use_sim_time'}
@@ -405,6 +436,12 @@ def validate(raw, executable='formation_sim'):
         problems.append(('reference.velocity', f'is required for a line (dim = {dim} values)'))
     if kind in ('circle', 'figure_eight', 'helix') and values['reference.speed'] <= 0.0:
         problems.append(('reference.speed', f'must be > 0 for a {kind}'))
+    if values.get('robot_id', 1) > n:
+        problems.append(('robot_id', f'must be between 1 and num_robots = {n}, '
+                                     f"got {values['robot_id']}"))
+    if values.get('plant.publish_rate', 0.0) > values.get('plant.rate', math.inf):
+        problems.append(('plant.publish_rate', 'must not exceed plant.rate = '
+                                               f"{values['plant.rate']:g} Hz"))
     origin = _vector(values, 'reference.origin', dim, problems)
     velocity = _vector(values, 'reference.velocity', dim, problems)
     if problems:

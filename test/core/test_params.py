@@ -135,7 +135,7 @@ def test_nodes_need_no_start_positions():
     raw = base()
     for key in ('start.random_radius', 'start.min_separation', 'start.seed'):
         raw.pop(key)
-    config = validate(raw, executable='robot')
+    config = validate({**raw, 'robot_id': 3}, executable='robot')
     assert config.start is None
     with pytest.raises(ParamError, match='start.positions'):
         validate(raw, executable='plant')

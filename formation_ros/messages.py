@@ -1,0 +1,114 @@
+"""Conversions between ROS messages and the numpy arrays of the core (no math beyond copying)."""
+
+from builtin_interfaces.msg import Time
+from formation_ros.core.frames import frame_from_pose, frame_to_pose
+from geometry_msgs.msg import Pose, PoseArray, PoseStamped, TwistStamped
+from nav_msgs.msg import Odometry
+import numpy as np
+
+WORLD_FRAME = 'world'
+FORMATION_FRAME = 'formation'
+NS_PER_S = 1_000_000_000
+
+
+def stamp_to_ns(stamp):
+    """Convert a builtin_interfaces/Time to integer nanoseconds."""
+    return int(stamp.sec) * NS_PER_S + int(stamp.nanosec)
+
+
+def ns_to_stamp(ns):
+    """Convert integer nanoseconds to a builtin_interfaces/Time."""
+    return Time(sec=int(ns // NS_PER_S), nanosec=int(ns % NS_PER_S))
+
+
+def _xyz(vector, dim):
+    values = [0.0, 0.0, 0.0]
+    values[:dim] = [float(v) for v in vector[:dim]]
+    return values
+
+
+def pose_stamped(position, stamp_ns, dim):
+    """Build a PoseStamped at ``position`` ((dim,), m), identity orientation, frame 'world'."""
+    msg = PoseStamped()
+    msg.header.stamp = ns_to_stamp(stamp_ns)
+    msg.header.frame_id = WORLD_FRAME
+    msg.pose.position.x, msg.pose.position.y, msg.pose.position.z = _xyz(position, dim)
+    msg.pose.orientation.w = 1.0
+    return msg
+
+
+def pose_array(points, stamp_ns, dim):
+    """Build a PoseArray of the rows of ``points`` ((K, dim), m), frame 'world'."""
+    msg = PoseArray()
+    msg.header.stamp = ns_to_stamp(stamp_ns)
+    msg.header.frame_id = WORLD_FRAME
+    for point in points:
+        pose = Pose()
+        pose.position.x, pose.position.y, pose.position.z = _xyz(point, dim)
+        pose.orientation.w = 1.0
+        msg.poses.append(pose)
+    return msg
+
+
+def twist_stamped(velocity, stamp_ns, dim):
+    """Build a TwistStamped with linear = ``velocity`` ((dim,), m/s), frame 'world'."""
+    msg = TwistStamped()
+    msg.header.stamp = ns_to_stamp(stamp_ns)
+    msg.header.frame_id = WORLD_FRAME
+    msg.twist.linear.x, msg.twist.linear.y, msg.twist.linear.z = _xyz(velocity, dim)
+    return msg
+
+
+def position_of(msg, dim):
+    """Return the position of a PoseStamped as (dim,)."""
+    p = msg.pose.position
+    return np.array([p.x, p.y, p.z][:dim])
+
+
+def points_of(msg, dim):
+    """Return the positions of a PoseArray as (K, dim)."""
+    points = np.array([[p.position.x, p.position.y, p.position.z] for p in msg.poses])
+    return points.reshape(-1, 3)[:, :dim]
+
+
+def velocity_of(msg, dim):
+    """Return the linear velocity of a TwistStamped as (dim,)."""
+    v = msg.twist.linear
+    return np.array([v.x, v.y, v.z][:dim])
+
+
+def reference_odometry(frame, stamp_ns, dim):
+    """Build the nav_msgs/Odometry of a reference sample (``core.frames.frame_to_pose``)."""
+    position, quat, linear, angular = frame_to_pose(frame, dim)
+    msg = Odometry()
+    msg.header.stamp = ns_to_stamp(stamp_ns)
+    msg.header.frame_id = WORLD_FRAME
+    msg.child_frame_id = FORMATION_FRAME
+    pose, twist = msg.pose.pose, msg.twist.twist
+    pose.position.x, pose.position.y, pose.position.z = (float(v) for v in position)
+    (pose.orientation.x, pose.orientation.y, pose.orientation.z,
+     pose.orientation.w) = (float(v) for v in quat)
+    twist.linear.x, twist.linear.y, twist.linear.z = (float(v) for v in linear)
+    twist.angular.x, twist.angular.y, twist.angular.z = (float(v) for v in angular)
+    return msg
+
+
+def frame_of(msg, dim):
+    """Return the FrameSample carried by a reference Odometry message."""
+    pose, twist = msg.pose.pose, msg.twist.twist
+    o = pose.orientation
+    return frame_from_pose(
+        stamp_to_ns(msg.header.stamp) / NS_PER_S,
+        [pose.position.x, pose.position.y, pose.position.z], [o.x, o.y, o.z, o.w],
+        [twist.linear.x, twist.linear.y, twist.linear.z],
+        [twist.angular.x, twist.angular.y, twist.angular.z], dim)
+
+
+def odometry_is_finite(msg):
+    """Tell whether every number of a reference message is finite and its quaternion non-zero."""
+    pose, twist = msg.pose.pose, msg.twist.twist
+    o = pose.orientation
+    values = [pose.position.x, pose.position.y, pose.position.z, o.x, o.y, o.z, o.w,
+              twist.linear.x, twist.linear.y, twist.linear.z,
+              twist.angular.x, twist.angular.y, twist.angular.z]
+    return bool(np.all(np.isfinite(values))) and (o.x ** 2 + o.y ** 2 + o.z ** 2 + o.w ** 2) > 0

@@ -1,0 +1,61 @@
+"""
+Reference node (executable ``reference``): broadcasts the desired formation frame (Section 6).
+
+Publishes ``/formation/reference`` (nav_msgs/Odometry) at ``reference.rate``: pose.position =
+q_od(t), orientation = the frame J as a quaternion (the rotation J^T from formation axes to world
+axes), twist.linear = qdot_od and twist.angular = the frame's angular velocity w, both in the
+world frame, with ``Jdot = -J [w]x``, so a robot has J and Jdot without differentiating.
+header.stamp is the time t of the sample. With ``use_sim_time`` t is the plant's simulated time;
+without it, t counts from the node's start. In lockstep it publishes one sample for every new
+value of the simulated clock. The topic is transient local: a late robot gets the latest sample.
+"""
+
+from formation_ros import messages, qos
+from formation_ros.nodes.common import declare_and_validate, run
+from nav_msgs.msg import Odometry
+from rclpy.clock import Clock, ClockType
+from rclpy.node import Node
+
+LOCKSTEP_POLL = 0.001
+
+
+class ReferenceNode(Node):
+    """Publishes q_od(t), J(t), qdot_od(t) and the frame's angular velocity."""
+
+    def __init__(self, **kwargs):
+        """Declare and check parameters, then start publishing."""
+        super().__init__('reference', **kwargs)
+        config = declare_and_validate(self, 'reference')
+        self.dim = config.dim
+        self.reference = config.reference()
+        self.lockstep = config.values['plant.lockstep']
+        self.sim_time = self.get_parameter('use_sim_time').value
+        self.epoch_ns = 0 if self.sim_time else self.get_clock().now().nanoseconds
+        self.last_stamp = None
+        self.pub = self.create_publisher(Odometry, '/formation/reference', qos.REFERENCE)
+        if self.lockstep:
+            self.timer = self.create_timer(LOCKSTEP_POLL, self.on_timer,
+                                           clock=Clock(clock_type=ClockType.STEADY_TIME))
+        else:
+            self.timer = self.create_timer(1.0 / config.values['reference.rate'], self.on_timer)
+        self.get_logger().info(
+            f'reference: {self.reference.kind} in {self.dim}D, '
+            + ('lockstep' if self.lockstep else f"{config.values['reference.rate']:g} Hz")
+            + (', simulated time' if self.sim_time else ', wall-clock time from start'))
+        if self.lockstep and not self.sim_time:
+            self.get_logger().warning('lockstep without use_sim_time: samples will not match '
+                                      'the plant state stamps')
+
+    def on_timer(self):
+        """Publish the sample of the current time (in lockstep: only when the clock moved)."""
+        stamp = self.get_clock().now().nanoseconds
+        if self.lockstep and stamp == self.last_stamp:
+            return
+        self.last_stamp = stamp
+        frame = self.reference.sample((stamp - self.epoch_ns) / messages.NS_PER_S)
+        self.pub.publish(messages.reference_odometry(frame, stamp, self.dim))
+
+
+def main(args=None):
+    """Entry point of ``ros2 run formation_ros reference``."""
+    return run(ReferenceNode, args, name='reference')

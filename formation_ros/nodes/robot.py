@@ -1,0 +1,165 @@
+r"""
+Robot node (executable ``robot``): one robot's bounded formation controller.
+
+It knows its own position (``pose``), the robots its range sensor sees (``neighbors``) and the
+desired formation frame (``/formation/reference``), and publishes ``cmd_vel`` with linear =
+u_i of eqs. (14), (25), computed by ``core.law.robot_command``. Run one per robot, each in its
+namespace::
+
+    ros2 run formation_ros robot --ros-args -r __ns:=/robot_1 -p robot_id:=1 \\
+        --params-file config/paper_section5.yaml
+
+The command is stamped with the stamp of the state it was computed from, so the plant can tell
+how old it is (and, in lockstep, which state it answers).
+"""
+
+from collections import deque
+
+from formation_ros import messages, qos
+from formation_ros.core.frames import advance
+from formation_ros.core.law import robot_command
+from formation_ros.nodes.common import declare_and_validate, OnceLog, run
+from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
+from nav_msgs.msg import Odometry
+import numpy as np
+from rclpy.clock import Clock, ClockType
+from rclpy.node import Node
+
+LOCKSTEP_POLL = 0.001
+REFERENCE_BUFFER = 64
+INPUTS = ('pose', 'neighbors', 'reference')
+
+
+class RobotNode(Node):
+    """One robot: stores what it hears in callbacks, computes and publishes in its timer."""
+
+    def __init__(self, **kwargs):
+        """Declare and check parameters, then set up topics and the control timer."""
+        super().__init__('robot', **kwargs)
+        config = declare_and_validate(self, 'robot')
+        values = config.values
+        self.dim = config.dim
+        self.index = values['robot_id'] - 1
+        self.vertex = config.vertices[self.index]
+        self.sensing_radius = float(config.sensing_radii[self.index])
+        self.law = config.law()
+        self.lockstep = values['plant.lockstep']
+        self.timeout_ns = int(values['input_timeout'] * 1e9)
+        self.once = OnceLog(self.get_logger())
+        self.steady = Clock(clock_type=ClockType.STEADY_TIME)
+
+        self.pose = None
+        self.neighbors = None
+        self.references = deque(maxlen=REFERENCE_BUFFER)
+        self.received_ns = dict.fromkeys(INPUTS)
+        self.pose_count = 0
+        self.answered_count = 0
+        self.rejected = dict.fromkeys(INPUTS, 0)
+
+        self.create_subscription(PoseStamped, 'pose', self.on_pose, qos.STATE)
+        self.create_subscription(PoseArray, 'neighbors', self.on_neighbors, qos.STATE)
+        self.create_subscription(Odometry, '/formation/reference', self.on_reference,
+                                 qos.REFERENCE)
+        self.cmd_pub = self.create_publisher(TwistStamped, 'cmd_vel', qos.COMMAND)
+        period = LOCKSTEP_POLL if self.lockstep else 1.0 / values['control_rate']
+        self.timer = self.create_timer(period, self.on_timer, clock=self.steady)
+        self.get_logger().info(
+            f'robot {self.index + 1}/{config.num_robots}: vertex {np.round(self.vertex, 4)}, '
+            f'R_i = {self.sensing_radius:g} m, b = {config.repulsion_radius:g} m, '
+            f'bound c*M1 = {self.law.u_bound:.4g} m/s, '
+            + ('lockstep' if self.lockstep else f"{values['control_rate']:g} Hz"))
+
+    def _now_ns(self):
+        return self.steady.now().nanoseconds
+
+    def _accept(self, name, finite):
+        if finite:
+            return True
+        self.rejected[name] += 1
+        self.once.start(f'bad-{name}', f'ignoring {name} messages with non-finite values '
+                                       f'({self.rejected[name]} so far)', 'error')
+        return False
+
+    def on_pose(self, msg):
+        """Store the latest own pose."""
+        p = msg.pose.position
+        if self._accept('pose', np.all(np.isfinite([p.x, p.y, p.z]))):
+            self.pose = msg
+            self.pose_count += 1
+            self.received_ns['pose'] = self._now_ns()
+
+    def on_neighbors(self, msg):
+        """Store the latest sensed neighbour positions."""
+        finite = all(np.isfinite([p.position.x, p.position.y, p.position.z]).all()
+                     for p in msg.poses)
+        if self._accept('neighbors', finite):
+            self.neighbors = msg
+            self.received_ns['neighbors'] = self._now_ns()
+
+    def on_reference(self, msg):
+        """Store a reference sample (a few are kept to match state stamps in lockstep)."""
+        if self._accept('reference', messages.odometry_is_finite(msg)):
+            self.references.append(msg)
+            self.received_ns['reference'] = self._now_ns()
+
+    def _reference_for(self, stamp_ns, exact):
+        """Return the reference frame at ``stamp_ns``: that sample, else the newest carried on."""
+        for msg in reversed(self.references):
+            if messages.stamp_to_ns(msg.header.stamp) == stamp_ns:
+                return messages.frame_of(msg, self.dim)
+        if exact or not self.references:
+            return None
+        newest = messages.frame_of(self.references[-1], self.dim)
+        return advance(newest, stamp_ns / messages.NS_PER_S - newest.t)
+
+    def _command(self, stamp_ns, exact):
+        frame = self._reference_for(stamp_ns, exact)
+        if frame is None:
+            return None
+        neighbours = messages.points_of(self.neighbors, self.dim)
+        own = messages.position_of(self.pose, self.dim)
+        return robot_command(own, self.vertex, neighbours, self.sensing_radius, self.law,
+                             frame).u
+
+    def on_timer(self):
+        """Compute and publish the command (or zero when inputs are stale)."""
+        if self.lockstep:
+            self._lockstep_answer()
+            return
+        now = self._now_ns()
+        stale = [name for name in INPUTS if self.received_ns[name] is None
+                 or now - self.received_ns[name] > self.timeout_ns]
+        if stale:
+            stamp = self.get_clock().now().nanoseconds if self.pose is None else \
+                messages.stamp_to_ns(self.pose.header.stamp)
+            self.cmd_pub.publish(messages.twist_stamped(np.zeros(self.dim), stamp, self.dim))
+            never = [name for name in stale if self.received_ns[name] is None]
+            if never:
+                self.once.start('stale', f"waiting for {', '.join(never)}: publishing zero",
+                                'info')
+            else:
+                self.once.start('stale', f"no new {', '.join(stale)} for "
+                                         f'{self.timeout_ns / 1e9:g} s: publishing zero')
+            return
+        self.once.end('stale', 'inputs fresh again: controlling')
+        stamp = messages.stamp_to_ns(self.pose.header.stamp)
+        self.cmd_pub.publish(messages.twist_stamped(self._command(stamp, False), stamp,
+                                                    self.dim))
+
+    def _lockstep_answer(self):
+        """Answer each state the plant sends, once, with the reference sample of its stamp."""
+        if self.pose is None or self.neighbors is None or self.pose_count == self.answered_count:
+            return
+        stamp = messages.stamp_to_ns(self.pose.header.stamp)
+        if messages.stamp_to_ns(self.neighbors.header.stamp) != stamp:
+            return
+        command = self._command(stamp, True)
+        if command is None:
+            return
+        self.cmd_pub.publish(messages.twist_stamped(command, stamp, self.dim))
+        self.answered_count = self.pose_count
+
+
+def main(args=None):
+    """Entry point of ``ros2 run formation_ros robot``."""
+    return run(RobotNode, args, name='robot')
