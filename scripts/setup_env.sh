@@ -54,6 +54,7 @@ fi
 
 echo "setup_env.sh: creating $VENV with $("$PYTHON" --version 2>&1)"
 "$PYTHON" -m venv "$VENV"
+touch "$VENV/COLCON_IGNORE"
 "$VENV/bin/python" -m pip install --quiet --upgrade pip
 echo "setup_env.sh: installing requirements (a few minutes on a fresh machine)"
 "$VENV/bin/python" -m pip install --quiet -r "$ROOT/requirements.txt"

@@ -100,7 +100,13 @@ class OnceLog:
         if key in self._active:
             return False
         self._active.add(key)
-        getattr(self._logger, level)(message)
+        # rclpy ties a severity to each call site, hence one call per level.
+        if level == 'error':
+            self._logger.error(message)
+        elif level == 'info':
+            self._logger.info(message)
+        else:
+            self._logger.warning(message)
         return True
 
     def end(self, key, message=None):

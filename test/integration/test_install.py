@@ -1,0 +1,28 @@
+"""colcon builds a normal ament_python install space."""
+
+import os
+import subprocess
+
+from conftest import exe
+
+EXECUTABLES = ('robot', 'plant', 'reference', 'formation_sim', 'formation_report')
+
+
+def test_install_layout(install):
+    for name in EXECUTABLES:
+        path = exe(install, name)
+        assert os.path.isfile(path) and os.access(path, os.X_OK), path
+    share = os.path.join(install, 'share')
+    assert os.path.isfile(os.path.join(share, 'formation_ros', 'package.xml'))
+    assert os.path.isfile(os.path.join(share, 'ament_index', 'resource_index', 'packages',
+                                       'formation_ros'))
+    configs = os.listdir(os.path.join(share, 'formation_ros', 'config'))
+    assert 'paper_section5.yaml' in configs and 'square_4.yaml' in configs
+
+
+def test_installed_executable_runs_from_install_space(install, ros_env, tmp_path):
+    params = os.path.join(install, 'share', 'formation_ros', 'config', 'square_4.yaml')
+    result = subprocess.run([exe(install, 'formation_sim'), params, '--check'], env=ros_env,
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.split()[0] == '4'
