@@ -126,7 +126,8 @@ def test_lockstep_equals_formation_sim_moving_reference(processes, install, prob
 
 
 def project_processes(install):
-    listing = subprocess.run(['ps', '-ww', '-eo', 'pid=,args='], capture_output=True, text=True).stdout
+    listing = subprocess.run(['ps', '-ww', '-eo', 'pid=,args='], capture_output=True,
+                             text=True).stdout
     return [line for line in listing.splitlines() if install in line]
 
 
