@@ -27,11 +27,15 @@ def _xyz(vector, dim):
     return values
 
 
-def pose_stamped(position, stamp_ns, dim):
-    """Build a PoseStamped at ``position`` ((dim,), m), identity orientation, frame 'world'."""
-    msg = PoseStamped()
+def _stamped(msg, stamp_ns):
     msg.header.stamp = ns_to_stamp(stamp_ns)
     msg.header.frame_id = WORLD_FRAME
+    return msg
+
+
+def pose_stamped(position, stamp_ns, dim):
+    """Build a PoseStamped at ``position`` ((dim,), m), identity orientation, frame 'world'."""
+    msg = _stamped(PoseStamped(), stamp_ns)
     msg.pose.position.x, msg.pose.position.y, msg.pose.position.z = _xyz(position, dim)
     msg.pose.orientation.w = 1.0
     return msg
@@ -39,9 +43,7 @@ def pose_stamped(position, stamp_ns, dim):
 
 def pose_array(points, stamp_ns, dim):
     """Build a PoseArray of the rows of ``points`` ((K, dim), m), frame 'world'."""
-    msg = PoseArray()
-    msg.header.stamp = ns_to_stamp(stamp_ns)
-    msg.header.frame_id = WORLD_FRAME
+    msg = _stamped(PoseArray(), stamp_ns)
     for point in points:
         pose = Pose()
         pose.position.x, pose.position.y, pose.position.z = _xyz(point, dim)
@@ -52,9 +54,7 @@ def pose_array(points, stamp_ns, dim):
 
 def twist_stamped(velocity, stamp_ns, dim):
     """Build a TwistStamped with linear = ``velocity`` ((dim,), m/s), frame 'world'."""
-    msg = TwistStamped()
-    msg.header.stamp = ns_to_stamp(stamp_ns)
-    msg.header.frame_id = WORLD_FRAME
+    msg = _stamped(TwistStamped(), stamp_ns)
     msg.twist.linear.x, msg.twist.linear.y, msg.twist.linear.z = _xyz(velocity, dim)
     return msg
 
@@ -80,9 +80,7 @@ def velocity_of(msg, dim):
 def reference_odometry(frame, stamp_ns, dim):
     """Build the nav_msgs/Odometry of a reference sample (``core.frames.frame_to_pose``)."""
     position, quat, linear, angular = frame_to_pose(frame, dim)
-    msg = Odometry()
-    msg.header.stamp = ns_to_stamp(stamp_ns)
-    msg.header.frame_id = WORLD_FRAME
+    msg = _stamped(Odometry(), stamp_ns)
     msg.child_frame_id = FORMATION_FRAME
     pose, twist = msg.pose.pose, msg.twist.twist
     pose.position.x, pose.position.y, pose.position.z = (float(v) for v in position)
