@@ -13,7 +13,7 @@ setup(
     data_files=[
         ('share/ament_index/resource_index/packages', ['resource/' + package_name]),
         ('share/' + package_name, ['package.xml']),
-        ('share/' + package_name + '/config', glob('config/*.yaml')),
+        ('share/' + package_name + '/config', glob('config/*.yaml') + glob('config/*.rviz')),
     ],
     install_requires=['setuptools'],
     zip_safe=True,
@@ -28,6 +28,7 @@ setup(
             'robot = formation_ros.nodes.robot:main',
             'plant = formation_ros.nodes.plant:main',
             'reference = formation_ros.nodes.reference:main',
+            'record = formation_ros.nodes.recorder:main',
         ],
     },
 )

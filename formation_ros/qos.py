@@ -10,7 +10,9 @@ Quality of service of every formation topic, in one place.
   answered.
 * Clock (``/clock``): reliable, keep last 1; it matches rclpy's best-effort time source and
   reliable subscribers such as a recorder.
-* Latched (diagnostics summaries, markers): reliable, keep last 1, transient local.
+* Diagnostics (``/diagnostics``): reliable, keep last 10, volatile, as diagnostic tools expect.
+* Markers (``/formation/markers``): reliable, keep last 1, transient local, so RViz started
+  later still shows the latest picture.
 """
 
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
@@ -25,4 +27,5 @@ COMMAND = _profile(10, ReliabilityPolicy.RELIABLE, DurabilityPolicy.VOLATILE)
 REFERENCE = _profile(10, ReliabilityPolicy.RELIABLE, DurabilityPolicy.TRANSIENT_LOCAL)
 STATE = _profile(1, ReliabilityPolicy.BEST_EFFORT, DurabilityPolicy.VOLATILE)
 CLOCK = _profile(1, ReliabilityPolicy.RELIABLE, DurabilityPolicy.VOLATILE)
-LATCHED = _profile(1, ReliabilityPolicy.RELIABLE, DurabilityPolicy.TRANSIENT_LOCAL)
+DIAGNOSTICS = _profile(10, ReliabilityPolicy.RELIABLE, DurabilityPolicy.VOLATILE)
+MARKERS = _profile(1, ReliabilityPolicy.RELIABLE, DurabilityPolicy.TRANSIENT_LOCAL)

@@ -1,11 +1,14 @@
 """
 ``formation_report``: metrics.json and figures of a recorded run.
 
-They are computed by the same code as ``formation_sim``.
+They are computed by the same code as ``formation_sim``. Input:
 
-Input: a directory holding ``trajectory.npz`` and ``params.yaml`` (a ``formation_sim`` output
-directory, or the output of ``scripts/launch_formation.sh --out``; a ``plant_stats.json``
-there is merged into the metrics).
+* a rosbag2 directory written by ``record`` (or ``launch_formation.sh --record``): the
+  trajectory is rebuilt from the recorded poses, commands and reference samples, and the
+  parameters come from the bag itself (``/formation/params``, else ``params.yaml`` beside
+  ``metadata.yaml``); the plant's counters come from its last ``/diagnostics`` status;
+* or a run directory holding ``trajectory.npz`` and ``params.yaml`` (``formation_sim`` output,
+  or ``launch_formation.sh --out``; a ``plant_stats.json`` there is merged into the metrics).
 """
 
 import argparse
@@ -13,7 +16,9 @@ import json
 import os
 import sys
 
-from formation_ros.core.params import load_config, ParamError
+from formation_ros.bag import (bag_params_text, BagError, PARAMS_FILE, PARAMS_TOPIC,
+                               plant_status, read_messages, trajectory_from_topics)
+from formation_ros.core.params import load_config, ParamError, parse_params_text, validate
 from formation_ros.sim import format_summary, run_metrics
 from formation_ros.trajectory import Trajectory
 
@@ -24,10 +29,36 @@ class ReportError(Exception):
     """The input cannot be reported on; the message says why."""
 
 
+def load_bag(path):
+    """Return (Trajectory, FormationConfig, extra metrics) of a recorded bag."""
+    try:
+        topics, counts = read_messages(path)
+    except (BagError, OSError, ValueError) as exc:
+        raise ReportError(f'{path}: cannot read the bag: {exc}') from None
+    text = bag_params_text(path, topics)
+    if text is None:
+        raise ReportError(f'{path}: the bag has no parameters (no {PARAMS_TOPIC} message and no '
+                          f'{PARAMS_FILE}); without the formation and the bound it cannot be '
+                          'interpreted. Record with the record node (it stores them) or put '
+                          f'the parameters file there as {PARAMS_FILE}.')
+    try:
+        config = validate(parse_params_text(text, f'{path} parameters'))
+        trajectory, info = trajectory_from_topics(topics, config)
+    except (ParamError, BagError) as exc:
+        raise ReportError(f'{path}: {exc}') from None
+    extra = {'source': 'rosbag2', 'integrator': 'recorded run (rosbag2)',
+             'messages': int(sum(counts.values()))}
+    extra.update(info)
+    extra.update(plant_status(topics))
+    return trajectory, config, extra
+
+
 def load_run(path):
-    """Return (Trajectory, FormationConfig, extra metrics) of a run directory."""
+    """Return (Trajectory, FormationConfig, extra metrics) of a bag or a run directory."""
     if not os.path.isdir(path):
         raise ReportError(f'{path}: not a directory')
+    if os.path.isfile(os.path.join(path, 'metadata.yaml')):
+        return load_bag(path)
     params = os.path.join(path, 'params.yaml')
     if not os.path.exists(params):
         raise ReportError(f'{path}: no params.yaml: the run cannot be interpreted without the '
@@ -73,8 +104,9 @@ def main(argv=None):
     parser = argparse.ArgumentParser(
         prog='formation_report',
         description='Metrics and figures of a recorded formation run.',
-        epilog='Example: formation_report runs/demo --out runs/demo')
-    parser.add_argument('input', help='run directory with trajectory.npz and params.yaml')
+        epilog='Example: formation_report runs/demo/bag --out runs/demo')
+    parser.add_argument('input', help='rosbag2 directory (metadata.yaml + MCAP) or run '
+                                      'directory with trajectory.npz and params.yaml')
     parser.add_argument('--out', required=True, help='where to write metrics.json and figures')
     parser.add_argument('--no-plots', action='store_true', help='skip the figures')
     args = parser.parse_args(argv)

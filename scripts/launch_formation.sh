@@ -21,7 +21,10 @@ Options:
   --out DIR      run directory: the plant writes trajectory.npz and plant_stats.json there,
                  PARAMS.yaml is copied there, and formation_report writes metrics.json and the
                  figures there at the end (the directory must not exist yet, or be empty)
-  --record DIR   record a rosbag2 (MCAP) of the run (not available yet)
+  --record DIR   record every formation topic into a rosbag2 directory DIR (metadata.yaml +
+                 MCAP; DIR must not exist yet), started before the other nodes and stopped
+                 after them; at the end formation_report reads the bag and writes
+                 metrics.json and the figures (into --out if given, else into DIR)
   --prefix DIR   install space of formation_ros (default: found from 'ros2', AMENT_PREFIX_PATH
                  or ./install/formation_ros)
   -h, --help     show this help
@@ -36,12 +39,13 @@ die() { echo "launch_formation.sh: $*" >&2; exit 2; }
 PARAMS=""
 DURATION=""
 OUT=""
+RECORD=""
 PREFIX="${FORMATION_PREFIX:-}"
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --duration) DURATION="${2:?--duration needs seconds}"; shift 2 ;;
     --out) OUT="${2:?--out needs a directory}"; shift 2 ;;
-    --record) die "--record is not available yet: recording comes with the recorder node" ;;
+    --record) RECORD="${2:?--record needs a directory}"; shift 2 ;;
     --prefix) PREFIX="${2:?--prefix needs a directory}"; shift 2 ;;
     -h|--help) usage; exit 0 ;;
     -*) die "unknown option '$1' (see --help)" ;;
@@ -99,9 +103,19 @@ if [[ -n "$OUT" ]]; then
   cp "$PARAMS" "$OUT/params.yaml"
 fi
 
+if [[ -n "$RECORD" ]]; then
+  if [[ -e "$RECORD" ]] && ! { [[ -d "$RECORD" ]] && [[ -z "$(ls -A "$RECORD")" ]]; }; then
+    die "--record directory '$RECORD' exists already; choose a new one"
+  fi
+  [[ -d "$RECORD" ]] && rmdir "$RECORD"
+  mkdir -p "$(dirname "$RECORD")"
+  RECORD="$(cd "$(dirname "$RECORD")" && pwd)/$(basename "$RECORD")"
+fi
+
 PIDS=()
 NAMES=()
 STOPPING=0
+RECORDER_PID=""
 
 start() {
   local name="$1"; shift
@@ -111,21 +125,28 @@ start() {
   NAMES+=("$name")
 }
 
-stop_all() {
-  [[ $STOPPING -eq 1 ]] && return 0
-  STOPPING=1
-  local pid i deadline
-  for i in "${!PIDS[@]}"; do
-    kill -INT -- "-${PIDS[$i]}" 2>/dev/null || kill -INT "${PIDS[$i]}" 2>/dev/null || true
+stop_group() {
+  local pid deadline
+  for pid in "$@"; do
+    kill -INT -- "-$pid" 2>/dev/null || kill -INT "$pid" 2>/dev/null || true
   done
   deadline=$((SECONDS + 10))
-  for pid in "${PIDS[@]}"; do
+  for pid in "$@"; do
     while kill -0 "$pid" 2>/dev/null && [[ $SECONDS -lt $deadline ]]; do sleep 0.1; done
     if kill -0 "$pid" 2>/dev/null; then
       echo "launch_formation.sh: process $pid did not stop; killing it" >&2
       kill -KILL -- "-$pid" 2>/dev/null || kill -KILL "$pid" 2>/dev/null || true
     fi
   done
+}
+
+stop_all() {
+  [[ $STOPPING -eq 1 ]] && return 0
+  STOPPING=1
+  local pid others=()
+  for pid in "${PIDS[@]}"; do [[ "$pid" != "$RECORDER_PID" ]] && others+=("$pid"); done
+  [[ ${#others[@]} -gt 0 ]] && stop_group "${others[@]}"
+  [[ -n "$RECORDER_PID" ]] && stop_group "$RECORDER_PID"
   wait 2>/dev/null || true
 }
 
@@ -140,14 +161,25 @@ trap 'stop_all' EXIT
 
 PLANT_ARGS=(--ros-args --params-file "$PARAMS")
 [[ -n "$OUT" ]] && PLANT_ARGS+=(-p "plant.output_dir:=$OUT")
+[[ -n "$RECORD" ]] && PLANT_ARGS+=(-p "plant.wait_for_subscribers:=2")
 echo "launch_formation.sh: $NUM_ROBOTS robots from $PARAMS" \
      "($( [[ $USE_ROS2 -eq 1 ]] && echo 'ros2 run' || echo "$PREFIX"))," \
      "$( [[ "$WALL_MS" == 0 ]] && echo 'until Ctrl-C' || echo "for $((WALL_MS / 1000)) s")"
+if [[ -n "$RECORD" ]]; then
+  start record record --ros-args --params-file "$PARAMS" -p "record.path:=$RECORD"
+  RECORDER_PID="${PIDS[-1]}"
+  for ((k = 0; k < 150; k++)); do
+    [[ -d "$RECORD" ]] || ! kill -0 "$RECORDER_PID" 2>/dev/null && break
+    sleep 0.1
+  done
+  [[ -d "$RECORD" ]] || die "the recorder did not start (see its output above)"
+fi
 start plant plant "${PLANT_ARGS[@]}"
 start reference reference --ros-args --params-file "$PARAMS" -p use_sim_time:=true
 for ((i = 1; i <= NUM_ROBOTS; i++)); do
   start "robot_$i" robot --ros-args -r "__ns:=/robot_$i" -p "robot_id:=$i" \
-    -p use_sim_time:=true --params-file "$PARAMS"
+    -p use_sim_time:=true --params-file "$PARAMS" \
+    -p "wait_for_subscribers:=$([[ -n "$RECORD" ]] && echo 2 || echo 1)"
 done
 
 now_ms() { echo $(( $(date +%s%N) / 1000000 )); }
@@ -171,7 +203,9 @@ if [[ -n "$failed" ]]; then
   echo "launch_formation.sh: $failed; stopped the others" >&2
   exit 1
 fi
-if [[ -n "$OUT" ]]; then
+if [[ -n "$RECORD" ]]; then
+  $(exe formation_report) "$RECORD" --out "${OUT:-$RECORD}"
+elif [[ -n "$OUT" ]]; then
   if [[ -f "$OUT/trajectory.npz" ]]; then
     $(exe formation_report) "$OUT" --out "$OUT"
   else

@@ -59,11 +59,12 @@ class Param:
     low: float = None
     high: float = None
     choices: tuple = ()
-    users: tuple = ('formation_sim', 'robot', 'plant', 'reference')
+    users: tuple = ('formation_sim', 'robot', 'plant', 'reference', 'record')
 
 
 REQUIRED = object()
-SIM_AND_PLANT = ('formation_sim', 'plant')
+START_USERS = ('formation_sim', 'plant', 'record')
+PLANT_USERS = ('plant', 'record')
 
 SCHEMA = (
     Param('num_robots', 'int', REQUIRED, 'Number of robots N (robots are numbered 1..N).',
@@ -90,15 +91,15 @@ SCHEMA = (
           "Flat list of num_robots x dim values: robot i's place in the formation frame, m."),
     Param('start.positions', 'double_array', None,
           'Flat list of num_robots x dim start positions, m (or use start.random_*).',
-          users=SIM_AND_PLANT),
+          users=START_USERS),
     Param('start.random_radius', 'double', None,
           'Random start: radius of the disc (ball in 3D) about the origin, m.', low=1e-9,
-          users=SIM_AND_PLANT),
+          users=START_USERS),
     Param('start.min_separation', 'double', None,
           'Random start: smallest distance between two robots, m.', low=1e-9,
-          users=SIM_AND_PLANT),
+          users=START_USERS),
     Param('start.seed', 'int', 0, 'Random start: seed of the random generator.', low=0,
-          high=2 ** 31 - 1, users=SIM_AND_PLANT),
+          high=2 ** 31 - 1, users=START_USERS),
     Param('reference.kind', 'string', 'fixed', 'Desired formation trajectory q_od(t).',
           choices=REFERENCE_KINDS),
     Param('reference.origin', 'double_array', None,
@@ -113,34 +114,55 @@ SCHEMA = (
     Param('robot_id', 'int', REQUIRED, 'This robot: 1..num_robots (robot node only).', low=1,
           users=('robot',)),
     Param('control_rate', 'double', 50.0, 'Rate of the control timer, Hz (wall clock).',
-          low=1e-3, high=10000.0, users=('robot',)),
+          low=1e-3, high=10000.0, users=('robot', 'record')),
     Param('input_timeout', 'double', 0.5,
           'A robot publishes zero when no new pose, neighbours or reference arrived for this '
-          'long, s (wall clock; not in lockstep).', low=1e-3, users=('robot',)),
+          'long, s (wall clock; not in lockstep).', low=1e-3, users=('robot', 'record')),
+    Param('wait_for_subscribers', 'int', 1,
+          'A robot sends its first command only once cmd_vel has this many subscribers (the '
+          'plant; 2 when a recorder listens too).', low=0, high=1000, users=('robot', 'record')),
     Param('plant.rate', 'double', 100.0,
           'Integration rate of the plant, Hz of simulated time: step dt = 1 / rate.', low=1e-3,
-          high=100000.0, users=('plant',)),
+          high=100000.0, users=PLANT_USERS),
     Param('plant.input_timeout', 'double', 0.5,
           'A command whose state stamp is older than this counts as zero, s (simulated time).',
-          low=1e-6, users=('plant',)),
+          low=1e-6, users=PLANT_USERS),
     Param('plant.publish_rate', 'double', 50.0,
           'Rate of /robot_<i>/pose and /robot_<i>/neighbors, Hz of simulated time (at most '
-          'plant.rate; every step in lockstep).', low=1e-3, high=100000.0, users=('plant',)),
+          'plant.rate; every step in lockstep).', low=1e-3, high=100000.0, users=PLANT_USERS),
     Param('plant.realtime_factor', 'double', 1.0,
           'Simulated seconds per wall-clock second (an upper bound in lockstep).', low=1e-3,
-          high=1000.0, users=('plant',)),
+          high=1000.0, users=PLANT_USERS),
     Param('plant.lockstep', 'bool', False,
           'Deterministic mode: the plant steps only when every robot answered the latest state.',
-          users=('plant', 'robot', 'reference')),
+          users=('plant', 'robot', 'reference', 'record')),
     Param('plant.collision_distance', 'double', 1e-3,
           'Two robots closer than this are logged as a collision, m.', low=0.0,
-          users=('plant',)),
+          users=PLANT_USERS),
+    Param('plant.wait_for_robots', 'bool', True,
+          'Hold the clock at 0 (resending the start state) until every robot has sent a '
+          'command, so that all robots start together.', users=PLANT_USERS),
+    Param('plant.wait_for_subscribers', 'int', 1,
+          'While waiting for the robots, also wait until every robot_<i>/pose topic has this '
+          'many subscribers (2 when a recorder listens too).', low=0, high=1000,
+          users=PLANT_USERS),
+    Param('plant.marker_rate', 'double', 5.0,
+          'Rate of /formation/markers for RViz, Hz (wall clock); 0 publishes none.', low=0.0,
+          high=100.0, users=PLANT_USERS),
     Param('plant.output_dir', 'string', '',
           'If set, the plant writes trajectory.npz and plant_stats.json there when it stops.',
-          users=('plant',)),
+          users=PLANT_USERS),
+    Param('record.path', 'string', REQUIRED,
+          'Directory of the rosbag2 (MCAP) the recorder writes; must not exist yet.',
+          users=('record',)),
+    Param('record.overwrite', 'bool', False,
+          'Let the recorder replace an existing bag directory at record.path.',
+          users=('record',)),
+    Param('record.markers', 'bool', False, 'Also record /formation/markers.',
+          users=('record',)),
     Param('reference.rate', 'double', 50.0,
-          'Publication rate of /formation/reference, Hz (simulated time with use_sim_time).',
-          low=1e-3, high=10000.0, users=('reference',)),
+          'Publication rate of /formation/reference, Hz (wall clock).',
+          low=1e-3, high=10000.0, users=('reference', 'record')),
 )
 SCHEMA_BY_NAME = {p.name: p for p in SCHEMA}
 EXTRA_ALLOWED = {'use_sim_time'}
@@ -187,10 +209,20 @@ def load_params_file(path):
     """
     try:
         with open(path, encoding='utf-8') as stream:
-            document = yaml.load(stream, Loader=_Loader)
+            text = stream.read()
     except FileNotFoundError:
         raise ParamError([(str(path), 'file not found')]) from None
-    except (OSError, yaml.YAMLError) as exc:
+    except OSError as exc:
+        raise ParamError([(str(path), f'cannot read it: {exc}')]) from None
+    return parse_params_text(text, str(path))
+
+
+def parse_params_text(text, source):
+    """Parse ROS 2 parameters YAML text (``source`` names it in errors); return flat values."""
+    path = source
+    try:
+        document = yaml.load(text, Loader=_Loader)
+    except yaml.YAMLError as exc:
         raise ParamError([(str(path), f'cannot read it as YAML: {exc}')]) from None
     section = document.get('/**') if isinstance(document, dict) else None
     if not isinstance(section, dict) or not isinstance(section.get('ros__parameters'), dict):
@@ -394,8 +426,8 @@ def validate(raw, executable='formation_sim'):
     """
     Check a flat parameter dict and build a :class:`FormationConfig`.
 
-    executable: 'formation_sim', 'robot', 'plant' or 'reference'; only the parameters that one
-    reads are required (a robot needs no start positions). Raises ParamError.
+    executable: 'formation_sim', 'robot', 'plant', 'reference' or 'record'; only the parameters
+    that one reads are required (a robot needs no start positions). Raises ParamError.
     """
     values = check_values(raw, executable)
     problems = []
@@ -409,7 +441,7 @@ def validate(raw, executable='formation_sim'):
             radii = np.array(values['sensing_radii'], dtype=float)
     vertices = _points(values, 'formation.vertices', n, dim, problems)
     start = None
-    if executable in SIM_AND_PLANT:
+    if executable in START_USERS:
         start = _start_positions(values, n, dim, problems)
     b = values['repulsion_radius']
     if b > float(np.min(radii)):

@@ -4,6 +4,7 @@ import difflib
 import signal
 import sys
 
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from formation_ros.core.params import ParamError, REQUIRED, SCHEMA, SCHEMA_BY_NAME, validate
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rcl_interfaces.msg import ParameterType
@@ -119,6 +120,27 @@ class OnceLog:
     def is_active(self, key):
         """Whether ``key`` is active."""
         return key in self._active
+
+
+DIAGNOSTICS_PERIOD = 1.0
+LEVELS = {'ok': DiagnosticStatus.OK, 'warn': DiagnosticStatus.WARN,
+          'error': DiagnosticStatus.ERROR}
+
+
+def diagnostics(stamp, name, level, message, values):
+    """
+    Build a DiagnosticArray with one status.
+
+    stamp: builtin_interfaces/Time; name: e.g. 'formation_ros/plant'; level: 'ok', 'warn' or
+    'error'; values: {key: value}, formatted with ``str`` (floats with 6 significant digits).
+    """
+    status = DiagnosticStatus(level=LEVELS[level], name=name, message=message,
+                              hardware_id='formation_ros')
+    status.values = [KeyValue(key=key, value=f'{value:.6g}' if isinstance(value, float)
+                              else str(value)) for key, value in values.items()]
+    array = DiagnosticArray(status=[status])
+    array.header.stamp = stamp
+    return array
 
 
 class _Stop(Exception):

@@ -17,15 +17,18 @@ reproduce ``formation_sim --dt 1/plant.rate``. With ``plant.output_dir`` it writ
 bound violations) when it stops; ``formation_report`` turns them into metrics and figures.
 """
 
-from collections import OrderedDict
+from collections import deque, OrderedDict
 import json
 import os
 import time
 
+from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros import messages, qos
 from formation_ros.core.frames import desired_positions, to_frame_velocity
-from formation_ros.core.metrics import compute_metrics
-from formation_ros.nodes.common import declare_and_validate, OnceLog, run
+from formation_ros.core.metrics import closest_pair_distance, compute_metrics
+from formation_ros.markers import formation_markers
+from formation_ros.nodes.common import (declare_and_validate, diagnostics, DIAGNOSTICS_PERIOD,
+                                        OnceLog, run)
 from formation_ros.report import PLANT_STATS
 from formation_ros.trajectory import Trajectory
 from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
@@ -34,12 +37,14 @@ from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock as ClockMsg
 from scipy.spatial import cKDTree
+from visualization_msgs.msg import MarkerArray
 
 LOCKSTEP_POLL = 0.001
 RESEND_AFTER = 0.05
 STATE_BUFFER = 512
 BOUND_TOLERANCE_FIXED = 1e-9
 BOUND_TOLERANCE_MOVING = 1e-3
+PATH_LENGTH = 100
 
 
 class PlantNode(Node):
@@ -80,6 +85,10 @@ class PlantNode(Node):
         self.colliding = set()
         self.last_publish_wall = None
         self.started_wall = None
+        self.waiting = values['plant.wait_for_robots'] or self.lockstep
+        self.wait_subscribers = values['plant.wait_for_subscribers']
+        self.paths = deque(maxlen=PATH_LENGTH)
+        self.rate_window = (time.monotonic(), 0)
 
         self.pose_pubs, self.neighbor_pubs = [], []
         for i in range(1, self.n + 1):
@@ -91,8 +100,17 @@ class PlantNode(Node):
                                      lambda msg, index=i - 1: self.on_command(index, msg),
                                      qos.COMMAND)
         self.clock_pub = self.create_publisher(ClockMsg, '/clock', qos.CLOCK)
+        self.diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics',
+                                                     qos.DIAGNOSTICS)
         period = LOCKSTEP_POLL if self.lockstep else self.step_ns / 1e9 / self.realtime_factor
         self.timer = self.create_timer(period, self.on_timer, clock=self.steady)
+        self.diagnostics_timer = self.create_timer(DIAGNOSTICS_PERIOD, self.on_diagnostics,
+                                                   clock=self.steady)
+        if values['plant.marker_rate'] > 0.0:
+            self.marker_pub = self.create_publisher(MarkerArray, '/formation/markers',
+                                                    qos.MARKERS)
+            self.marker_timer = self.create_timer(1.0 / values['plant.marker_rate'],
+                                                  self.on_markers, clock=self.steady)
         self.get_logger().info(
             f'plant: {self.n} robots in {self.dim}D, dt = {self.step_ns / 1e9:g} s, '
             f'reference {self.reference.kind}, '
@@ -184,12 +202,40 @@ class PlantNode(Node):
         self.steps += 1
         self._check_collisions()
 
+    def _resend_if_due(self):
+        if time.monotonic() - self.last_publish_wall > RESEND_AFTER:
+            self._publish_clock()
+            self._publish_state()
+
+    def _all_robots_up(self):
+        """While waiting: start the clock once every robot has sent a command."""
+        missing = [i + 1 for i, msg in enumerate(self.commands) if msg is None]
+        unheard = [i + 1 for i, pub in enumerate(self.pose_pubs)
+                   if pub.get_subscription_count() < self.wait_subscribers]
+        if missing or unheard:
+            self.once.start('waiting', f'waiting for {len(missing)} of {self.n} robots to send '
+                                       f'a command (robots {missing[:10]}'
+                                       f"{'...' if len(missing) > 10 else ''}) and for "
+                                       f'{self.wait_subscribers} subscribers on every pose '
+                                       'topic', 'info')
+            self._resend_if_due()
+            return False
+        self.waiting = False
+        self.started_wall = time.monotonic()
+        self.rate_window = (self.started_wall, self.steps)
+        self.once.end('waiting', f'all {self.n} robots are up: starting the clock')
+        self._publish_clock()
+        self._publish_state()
+        return True
+
     def on_timer(self):
         """Free-running: one step per tick. Lockstep: step when every robot has answered."""
         if self.started_wall is None:
             self.started_wall = time.monotonic()
             self._publish_clock()
             self._publish_state()
+            return
+        if self.waiting and not self._all_robots_up():
             return
         if self.lockstep:
             self._lockstep_tick()
@@ -208,9 +254,43 @@ class PlantNode(Node):
             self._advance(self._command_array())
             self._publish_clock()
             self._publish_state()
-        elif time.monotonic() - self.last_publish_wall > RESEND_AFTER:
-            self._publish_clock()
-            self._publish_state()
+        else:
+            self._resend_if_due()
+
+    def on_diagnostics(self):
+        """Publish the plant's status: step rate, stale commands, distances, bound, collisions."""
+        now = time.monotonic()
+        since, steps = self.rate_window
+        rate = (self.steps - steps) / (now - since) if now > since else 0.0
+        self.rate_window = (now, self.steps)
+        target = self.realtime_factor / (self.step_ns / 1e9)
+        closest = closest_pair_distance(self.q)
+        values = {'simulated time [s]': self.t_ns / 1e9, 'steps': self.steps,
+                  'step rate achieved [Hz]': rate,
+                  'step rate target [Hz]': 'lockstep' if self.lockstep else target,
+                  'min pair distance [m]': closest,
+                  'bound c*M1 [m/s]': self.law.u_bound}
+        values.update(self.counts)
+        if self.counts['collisions'] or self.counts['bound_violations']:
+            level, message = 'error', (f"{self.counts['collisions']} collisions, "
+                                       f"{self.counts['bound_violations']} commands above "
+                                       'the bound')
+        elif self.waiting:
+            level, message = 'ok', 'waiting for the robots'
+        elif not self.lockstep and rate < 0.9 * target:
+            level, message = 'warn', f'stepping at {rate:.1f} Hz of {target:.1f} Hz'
+        else:
+            level, message = 'ok', 'running'
+        self.diagnostics_pub.publish(diagnostics(self.get_clock().now().to_msg(),
+                                                 'formation_ros/plant', level, message, values))
+
+    def on_markers(self):
+        """Publish the RViz picture: robots, sensing and repulsion zones, formation, paths."""
+        self.paths.append(self.q.copy())
+        frame = self.reference.sample(self.t_ns / messages.NS_PER_S)
+        desired = desired_positions(self.config.vertices, frame)
+        self.marker_pub.publish(formation_markers(self.q, self.radii, self.law.repulsion_radius,
+                                                  desired, np.array(self.paths), self.t_ns))
 
     def trajectory(self):
         """Return the run so far as a Trajectory (a sample per published state)."""

@@ -6,12 +6,15 @@ q_od(t), orientation = the frame J as a quaternion (the rotation J^T from format
 axes), twist.linear = qdot_od and twist.angular = the frame's angular velocity w, both in the
 world frame, with ``Jdot = -J [w]x``, so a robot has J and Jdot without differentiating.
 header.stamp is the time t of the sample. With ``use_sim_time`` t is the plant's simulated time;
-without it, t counts from the node's start. In lockstep it publishes one sample for every new
-value of the simulated clock. The topic is transient local: a late robot gets the latest sample.
+without it, t counts from the node's start. The timer runs on the wall clock at
+``reference.rate``, so samples keep coming (with the same stamp) while the plant holds its clock,
+e.g. while it waits for the robots. In lockstep it publishes one sample for every new value of
+the simulated clock. The topic is transient local: a late robot gets the latest sample.
 """
 
+from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros import messages, qos
-from formation_ros.nodes.common import declare_and_validate, run
+from formation_ros.nodes.common import declare_and_validate, diagnostics, DIAGNOSTICS_PERIOD, run
 from nav_msgs.msg import Odometry
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
@@ -33,11 +36,14 @@ class ReferenceNode(Node):
         self.epoch_ns = 0 if self.sim_time else self.get_clock().now().nanoseconds
         self.last_stamp = None
         self.pub = self.create_publisher(Odometry, '/formation/reference', qos.REFERENCE)
-        if self.lockstep:
-            self.timer = self.create_timer(LOCKSTEP_POLL, self.on_timer,
-                                           clock=Clock(clock_type=ClockType.STEADY_TIME))
-        else:
-            self.timer = self.create_timer(1.0 / config.values['reference.rate'], self.on_timer)
+        self.published = 0
+        self.diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics',
+                                                     qos.DIAGNOSTICS)
+        self.diagnostics_timer = self.create_timer(
+            DIAGNOSTICS_PERIOD, self.on_diagnostics, clock=Clock(clock_type=ClockType.STEADY_TIME))
+        period = LOCKSTEP_POLL if self.lockstep else 1.0 / config.values['reference.rate']
+        self.timer = self.create_timer(period, self.on_timer,
+                                       clock=Clock(clock_type=ClockType.STEADY_TIME))
         self.get_logger().info(
             f'reference: {self.reference.kind} in {self.dim}D, '
             + ('lockstep' if self.lockstep else f"{config.values['reference.rate']:g} Hz")
@@ -54,6 +60,17 @@ class ReferenceNode(Node):
         self.last_stamp = stamp
         frame = self.reference.sample((stamp - self.epoch_ns) / messages.NS_PER_S)
         self.pub.publish(messages.reference_odometry(frame, stamp, self.dim))
+        self.published += 1
+
+    def on_diagnostics(self):
+        """Publish the reference node's status: kind, time, samples published."""
+        values = {'kind': self.reference.kind, 'samples published': self.published,
+                  'time [s]': ('none yet' if self.last_stamp is None
+                               else (self.last_stamp - self.epoch_ns) / messages.NS_PER_S)}
+        level, message = ('ok', 'publishing') if self.published else ('warn', 'no sample yet')
+        self.diagnostics_pub.publish(diagnostics(self.get_clock().now().to_msg(),
+                                                 'formation_ros/reference', level, message,
+                                                 values))
 
 
 def main(args=None):

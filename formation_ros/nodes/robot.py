@@ -15,10 +15,12 @@ how old it is (and, in lockstep, which state it answers).
 
 from collections import deque
 
+from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros import messages, qos
 from formation_ros.core.frames import advance
 from formation_ros.core.law import robot_command
-from formation_ros.nodes.common import declare_and_validate, OnceLog, run
+from formation_ros.nodes.common import (declare_and_validate, diagnostics, DIAGNOSTICS_PERIOD,
+                                        OnceLog, run)
 from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
 from nav_msgs.msg import Odometry
 import numpy as np
@@ -55,12 +57,20 @@ class RobotNode(Node):
         self.pose_count = 0
         self.answered_count = 0
         self.rejected = dict.fromkeys(INPUTS, 0)
+        self.last = None
+        self.waiting = True
+        self.wait_subscribers = values['wait_for_subscribers']
+        self.repulsion_radius = config.repulsion_radius
 
         self.create_subscription(PoseStamped, 'pose', self.on_pose, qos.STATE)
         self.create_subscription(PoseArray, 'neighbors', self.on_neighbors, qos.STATE)
         self.create_subscription(Odometry, '/formation/reference', self.on_reference,
                                  qos.REFERENCE)
         self.cmd_pub = self.create_publisher(TwistStamped, 'cmd_vel', qos.COMMAND)
+        self.diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics',
+                                                     qos.DIAGNOSTICS)
+        self.diagnostics_timer = self.create_timer(DIAGNOSTICS_PERIOD, self.on_diagnostics,
+                                                   clock=self.steady)
         period = LOCKSTEP_POLL if self.lockstep else 1.0 / values['control_rate']
         self.timer = self.create_timer(period, self.on_timer, clock=self.steady)
         self.get_logger().info(
@@ -118,8 +128,9 @@ class RobotNode(Node):
             return None
         neighbours = messages.points_of(self.neighbors, self.dim)
         own = messages.position_of(self.pose, self.dim)
-        return robot_command(own, self.vertex, neighbours, self.sensing_radius, self.law,
-                             frame).u
+        self.last = robot_command(own, self.vertex, neighbours, self.sensing_radius, self.law,
+                                  frame)
+        return self.last.u
 
     def on_timer(self):
         """Compute and publish the command (or zero when inputs are stale)."""
@@ -129,26 +140,37 @@ class RobotNode(Node):
         now = self._now_ns()
         stale = [name for name in INPUTS if self.received_ns[name] is None
                  or now - self.received_ns[name] > self.timeout_ns]
+        if self.waiting and not self._ready():
+            return
         if stale:
-            stamp = self.get_clock().now().nanoseconds if self.pose is None else \
-                messages.stamp_to_ns(self.pose.header.stamp)
+            stamp = messages.stamp_to_ns(self.pose.header.stamp)
             self.cmd_pub.publish(messages.twist_stamped(np.zeros(self.dim), stamp, self.dim))
-            never = [name for name in stale if self.received_ns[name] is None]
-            if never:
-                self.once.start('stale', f"waiting for {', '.join(never)}: publishing zero",
-                                'info')
-            else:
-                self.once.start('stale', f"no new {', '.join(stale)} for "
-                                         f'{self.timeout_ns / 1e9:g} s: publishing zero')
+            self.once.start('stale', f"no new {', '.join(stale)} for "
+                                     f'{self.timeout_ns / 1e9:g} s: publishing zero')
             return
         self.once.end('stale', 'inputs fresh again: controlling')
         stamp = messages.stamp_to_ns(self.pose.header.stamp)
         self.cmd_pub.publish(messages.twist_stamped(self._command(stamp, False), stamp,
                                                     self.dim))
 
+    def _ready(self):
+        """Start-up: every input heard once and cmd_vel has its subscribers (plant, recorder)."""
+        never = [name for name in INPUTS if self.received_ns[name] is None]
+        listeners = self.cmd_pub.get_subscription_count()
+        if never or listeners < self.wait_subscribers:
+            missing = never + ([f'{self.wait_subscribers} cmd_vel subscribers (have '
+                                f'{listeners})'] if listeners < self.wait_subscribers else [])
+            self.once.start('waiting', f"waiting for {', '.join(missing)}", 'info')
+            return False
+        self.once.end('waiting')
+        self.waiting = False
+        return True
+
     def _lockstep_answer(self):
         """Answer each state the plant sends, once, with the reference sample of its stamp."""
         if self.pose is None or self.neighbors is None or self.pose_count == self.answered_count:
+            return
+        if self.waiting and not self._ready():
             return
         stamp = messages.stamp_to_ns(self.pose.header.stamp)
         if messages.stamp_to_ns(self.neighbors.header.stamp) != stamp:
@@ -158,6 +180,34 @@ class RobotNode(Node):
             return
         self.cmd_pub.publish(messages.twist_stamped(command, stamp, self.dim))
         self.answered_count = self.pose_count
+
+    def on_diagnostics(self):
+        """Publish this robot's status: input ages, neighbours in range, command size."""
+        now = self._now_ns()
+        values = {f'{name} age [s]': ('never' if self.received_ns[name] is None
+                                      else (now - self.received_ns[name]) / 1e9)
+                  for name in INPUTS}
+        if self.neighbors is not None and self.pose is not None:
+            gaps = np.linalg.norm(messages.points_of(self.neighbors, self.dim)
+                                  - messages.position_of(self.pose, self.dim), axis=1)
+            values['neighbours heard'] = len(gaps)
+            values['neighbours within R_i'] = int(np.count_nonzero(gaps < self.sensing_radius))
+            values['neighbours within b'] = int(np.count_nonzero(gaps < self.repulsion_radius))
+        if self.last is not None:
+            values['max |u| component [m/s]'] = float(np.max(np.abs(self.last.u)))
+            values['max |u_hat| component [m/s]'] = float(np.max(np.abs(self.last.u_hat)))
+        values['bound c*M1 [m/s]'] = self.law.u_bound
+        values.update({f'rejected {name} messages': count
+                       for name, count in self.rejected.items()})
+        if self.waiting:
+            level, message = 'warn', 'waiting for its first inputs'
+        elif self.once.is_active('stale'):
+            level, message = 'warn', 'publishing zero: inputs stale'
+        else:
+            level, message = 'ok', 'lockstep' if self.lockstep else 'controlling'
+        self.diagnostics_pub.publish(diagnostics(
+            self.get_clock().now().to_msg(), f'formation_ros/robot_{self.index + 1}', level,
+            message, values))
 
 
 def main(args=None):
