@@ -12,8 +12,9 @@ Usage: scripts/launch_formation.sh PARAMS.yaml [--duration S] [--out DIR] [--rec
 Starts the plant, the reference node and N robot nodes (N = num_robots in PARAMS.yaml), robot i
 in namespace /robot_<i>, all with the same parameters file and (robots, reference) simulated
 time from the plant's /clock. Output lines are prefixed with the node's name. Stops every
-process it started when the duration ends, on Ctrl-C or on SIGTERM, and when any node exits
-on its own (then with a non-zero exit code).
+process it started when the duration ends, on Ctrl-C or on SIGTERM (then still writes the
+report of --out / --record), and when any node exits on its own (then with a non-zero exit
+code).
 
 Options:
   --duration S   wall-clock seconds to run; 0 runs until Ctrl-C
@@ -150,10 +151,10 @@ stop_all() {
   wait 2>/dev/null || true
 }
 
+INTERRUPTED=""
 on_signal() {
-  echo "launch_formation.sh: stopping ($1)" >&2
-  stop_all
-  exit 0
+  INTERRUPTED="$1"
+  if [[ ${#PIDS[@]} -eq 0 ]]; then exit 0; fi
 }
 trap 'on_signal SIGINT' INT
 trap 'on_signal SIGTERM' TERM
@@ -193,11 +194,13 @@ while :; do
       break 2
     fi
   done
-  if [[ "$WALL_MS" != 0 ]] && [[ $(now_ms) -ge $end_ms ]]; then
+  if [[ -n "$INTERRUPTED" ]] || { [[ "$WALL_MS" != 0 ]] && [[ $(now_ms) -ge $end_ms ]]; }; then
     break
   fi
-  sleep 0.5 & wait $!
+  sleep 0.5 & wait $! || true
 done
+[[ -n "$INTERRUPTED" ]] && echo "launch_formation.sh: stopping ($INTERRUPTED)" >&2
+trap - INT TERM
 stop_all
 if [[ -n "$failed" ]]; then
   echo "launch_formation.sh: $failed; stopped the others" >&2

@@ -1,0 +1,107 @@
+"""Recording real runs: rosbag2 (MCAP) from the recorder, the report, diagnostics, markers."""
+
+import json
+import os
+import signal
+
+from conftest import CONFIG, exe, write_params
+from formation_ros import qos
+from formation_ros.bag import read_messages
+from formation_ros.core.metrics import compute_metrics
+from formation_ros.core.params import load_config
+from formation_ros.sim import simulate
+from formation_ros.trajectory import Trajectory
+import numpy as np
+from rosgraph_msgs.msg import Clock as ClockMsg
+from test_system import LAUNCHER, wait_exit
+from visualization_msgs.msg import MarkerArray
+
+SQUARE = os.path.join(CONFIG, 'square_4.yaml')
+
+
+def launch_recording(processes, install, params, bag, out, duration):
+    args = ['bash', LAUNCHER, params, '--prefix', install, '--duration', str(duration),
+            '--record', str(bag)]
+    if out is not None:
+        args += ['--out', str(out)]
+    return processes.start('launcher', args)
+
+
+def test_recorded_run_reads_back_and_agrees_with_the_plant(processes, install, probe,
+                                                           tmp_path):
+    markers = []
+    probe.create_subscription(MarkerArray, '/formation/markers', markers.append, qos.MARKERS)
+    bag, out = tmp_path / 'bag', tmp_path / 'run'
+    launcher = launch_recording(processes, install, SQUARE, bag, out, 10)
+    assert wait_exit(probe, launcher, 90) == 0, processes.log('launcher')
+    topics, counts = read_messages(str(bag))
+    assert counts == {topic: len(messages) for topic, messages in topics.items()}
+    for i in range(1, 5):
+        assert counts[f'/robot_{i}/pose'] > 100 and counts[f'/robot_{i}/cmd_vel'] > 100
+    assert counts['/clock'] > 100 and counts['/formation/reference'] > 10
+    bound = load_config(SQUARE).law().u_bound
+    commands = [m for i in range(1, 5) for _, m in topics[f'/robot_{i}/cmd_vel']]
+    assert max(max(abs(m.twist.linear.x), abs(m.twist.linear.y)) for m in commands) <= bound
+    statuses = {s.name for _, m in topics['/diagnostics'] for s in m.status}
+    assert {'formation_ros/plant', 'formation_ros/reference'} <= statuses
+    assert {f'formation_ros/robot_{i}' for i in range(1, 5)} <= statuses
+    from_bag = json.loads((out / 'metrics.json').read_text())
+    plant = Trajectory.load(str(out / 'trajectory.npz'))
+    printed = compute_metrics(plant.t, plant.q, plant.u, plant.u_hat, plant.q_desired, bound)
+    assert from_bag['source'] == 'rosbag2'
+    assert from_bag['min_pair_distance'] == printed['min_pair_distance']
+    assert from_bag['max_abs_u_component'] == printed['max_abs_u_component']
+    assert abs(from_bag['final_max_error'] - printed['final_max_error']) < 1e-3
+    assert abs(from_bag['settle_time'] - printed['settle_time']) < 0.05
+    assert from_bag['collisions'] == 0 and from_bag['bound_violations'] == 0
+    assert (out / 'trajectories.png').exists()
+    assert markers and {m.ns for m in markers[-1].markers} >= {'robots', 'sensing', 'repulsion',
+                                                               'desired'}
+    robots = [m for m in markers[-1].markers if m.ns == 'robots'][0]
+    assert len(robots.points) == 4
+
+
+def test_lockstep_bag_reproduces_formation_sim(processes, install, probe, tmp_path):
+    params = write_params(tmp_path, 'circle_2d.yaml', {'plant.lockstep': True,
+                                                      'plant.realtime_factor': 200.0})
+    bag = tmp_path / 'bag'
+    launcher = launch_recording(processes, install, params, bag, None, 12)
+    assert wait_exit(probe, launcher, 90) == 0, processes.log('launcher')
+    topics, _ = read_messages(str(bag))
+    config = load_config(params)
+    poses = {}
+    for i in range(config.num_robots):
+        for _, message in topics[f'/robot_{i + 1}/pose']:
+            stamp = message.header.stamp.sec * 10 ** 9 + message.header.stamp.nanosec
+            poses.setdefault(stamp, {})[i] = (message.pose.position.x, message.pose.position.y)
+    stamps = sorted(s for s, seen in poses.items() if len(seen) == config.num_robots)
+    assert len(stamps) > 100
+    steps = [round(s / 1e7) for s in stamps]
+    sim = simulate(config, duration=steps[-1] * 0.01, dt=0.01, sample_dt=0.01)
+    recorded = np.array([[poses[s][i] for i in range(config.num_robots)] for s in stamps])
+    assert np.max(np.abs(recorded - sim.q[steps])) < 1e-9
+
+
+def test_bag_of_a_run_stopped_with_sigint_is_complete(processes, install, probe, tmp_path):
+    clock = []
+    probe.create_subscription(ClockMsg, '/clock', lambda m: clock.append(m.clock.sec), qos.CLOCK)
+    bag = tmp_path / 'bag'
+    launcher = launch_recording(processes, install, SQUARE, bag, None, 0)
+    assert probe.spin_until(lambda: clock and clock[-1] >= 2, 40), processes.log('launcher')
+    os.kill(launcher.pid, signal.SIGINT)
+    assert wait_exit(probe, launcher, 40) == 0, processes.log('launcher')
+    topics, counts = read_messages(str(bag))
+    assert counts['/robot_1/cmd_vel'] > 20, processes.log('launcher')[-3000:]
+    assert counts == {topic: len(messages) for topic, messages in topics.items()}
+    assert (bag / 'metrics.json').exists()
+
+
+def test_recorder_refuses_an_existing_bag(processes, install, tmp_path):
+    bag = tmp_path / 'bag'
+    bag.mkdir()
+    (bag / 'metadata.yaml').write_text('not yours\n')
+    process = processes.start('record', [exe(install, 'record'), '--ros-args', '--params-file',
+                                         SQUARE, '-p', f'record.path:={bag}'])
+    assert process.wait(30) == 2
+    assert 'refusing to overwrite' in processes.log('record')
+    assert (bag / 'metadata.yaml').read_text() == 'not yours\n'
