@@ -5,7 +5,7 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 VENV="${FORMATION_VENV:-$ROOT/.venv}"
 PARAMS="$ROOT/config/paper_section5.yaml"
-DURATION=24
+DURATION=32
 OUT=""
 
 usage() {
@@ -14,8 +14,9 @@ Usage: scripts/demo.sh [--params FILE] [--duration S] [--out DIR] [--venv DIR]
 
 Sets up the virtual environment (scripts/setup_env.sh), builds the package with colcon into
 install/, and runs the demo formation with scripts/launch_formation.sh: the plant, the
-reference node and one process per robot talking over DDS. At the end it prints the metrics
-summary and leaves metrics.json, trajectory.npz and the figures in the run directory.
+reference node and one process per robot talking over DDS, recorded into a rosbag2. At the
+end formation_report reads the bag and prints the metrics summary; the run directory holds
+the bag (bag/), metrics.json, the figures, trajectory.npz and plant_stats.json.
 
 Options:
   --params FILE  parameters file (default: config/paper_section5.yaml, the paper's Section 5)
@@ -51,7 +52,9 @@ echo "demo.sh: colcon build (install space: $ROOT/install)"
   echo "demo.sh: colcon build failed; see $ROOT/log/colcon_build.txt" >&2; exit 1; }
 export ROS_AUTOMATIC_DISCOVERY_RANGE="${ROS_AUTOMATIC_DISCOVERY_RANGE:-LOCALHOST}"
 PATH="$VENV/bin:$PATH" bash "$ROOT/scripts/launch_formation.sh" "$PARAMS" \
-  --duration "$DURATION" --out "$OUT"
+  --duration "$DURATION" --out "$OUT" --record "$OUT/bag"
 echo
-echo "demo: figures: $(cd "$OUT" && ls ./*.png | tr '\n' ' ')"
-echo "demo: metrics: $OUT/metrics.json"
+echo "demo: run directory: $OUT"
+echo "demo:   bag (rosbag2, MCAP): $OUT/bag"
+echo "demo:   figures: $(cd "$OUT" && ls ./*.png | tr '\n' ' ')"
+echo "demo:   metrics: $OUT/metrics.json"

@@ -60,8 +60,8 @@ def odometry_msg(stamp_ns, frame, dim):
     position, quat, linear, angular = frame_to_pose(frame, dim)
     pose = types['geometry_msgs/msg/Pose'](
         position=point(position),
-        orientation=types['geometry_msgs/msg/Quaternion'](x=quat[0], y=quat[1], z=quat[2],
-                                                           w=quat[3]))
+        orientation=types['geometry_msgs/msg/Quaternion'](
+            x=quat[0], y=quat[1], z=quat[2], w=quat[3]))
     return types['nav_msgs/msg/Odometry'](
         header=header(stamp_ns), child_frame_id='formation',
         pose=types['geometry_msgs/msg/PoseWithCovariance'](pose=pose,

@@ -62,8 +62,8 @@ def test_recorded_run_reads_back_and_agrees_with_the_plant(processes, install, p
 
 
 def test_lockstep_bag_reproduces_formation_sim(processes, install, probe, tmp_path):
-    params = write_params(tmp_path, 'circle_2d.yaml', {'plant.lockstep': True,
-                                                      'plant.realtime_factor': 200.0})
+    changes = {'plant.lockstep': True, 'plant.realtime_factor': 200.0}
+    params = write_params(tmp_path, 'circle_2d.yaml', changes)
     bag = tmp_path / 'bag'
     launcher = launch_recording(processes, install, params, bag, None, 12)
     assert wait_exit(probe, launcher, 90) == 0, processes.log('launcher')
