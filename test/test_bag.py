@@ -125,6 +125,28 @@ def test_metadata_counts_equal_messages_read(tmp_path):
     assert metadata['message_count'] == sum(counts.values())
 
 
+def test_independent_mcap_reader_decodes_every_message(tmp_path):
+    """The mcap + mcap_ros2 libraries decode the bag from its embedded definitions alone."""
+    from mcap.reader import make_reader
+    from mcap_ros2.decoder import DecoderFactory
+    config = load_config(os.path.join(CONFIG, 'circle_2d.yaml'))
+    trajectory = simulate(config, duration=0.5, dt=0.01, sample_dt=0.1)
+    write_run_as_bag(str(tmp_path / 'bag'), config, trajectory)
+    (mcap_file,) = [name for name in os.listdir(tmp_path / 'bag') if name.endswith('.mcap')]
+    decoded = {}
+    with open(tmp_path / 'bag' / mcap_file, 'rb') as stream:
+        reader = make_reader(stream, decoder_factories=[DecoderFactory()])
+        assert reader.get_header().profile == 'ros2'
+        for schema, channel, _, message in reader.iter_decoded_messages():
+            assert schema.encoding == 'ros2msg' and channel.message_encoding == 'cdr'
+            decoded.setdefault(channel.topic, []).append(message)
+    assert len(decoded['/robot_1/pose']) == len(trajectory.t)
+    assert decoded['/robot_2/pose'][-1].pose.position.x == trajectory.q[-1, 1, 0]
+    assert decoded['/robot_3/cmd_vel'][0].twist.linear.y == trajectory.u[0, 2, 1]
+    assert decoded['/formation/reference'][1].child_frame_id == 'formation'
+    assert 'num_robots: 6' in decoded[PARAMS_TOPIC][0].data
+
+
 def test_bag_stores_its_parameters(tmp_path):
     config = load_config(os.path.join(CONFIG, 'helix_3d.yaml'))
     with BagWriter(str(tmp_path / 'bag')) as bag:

@@ -64,11 +64,12 @@ def test_formation_converges_bounded_without_collision(processes, install, probe
 
 def test_tracking_follows_a_circle(processes, install, probe, tmp_path):
     out = tmp_path / 'circle'
-    launcher = launch(processes, install, os.path.join(CONFIG, 'circle_2d.yaml'), out, 14)
+    launcher = launch(processes, install, os.path.join(CONFIG, 'circle_2d.yaml'), out, 18)
     assert wait_exit(probe, launcher, 90) == 0, processes.log('launcher')
     metrics = json.loads((out / 'metrics.json').read_text())
     trajectory = Trajectory.load(str(out / 'trajectory.npz'))
-    assert np.ptp(trajectory.q_od, axis=0).max() > 4.0
+    assert trajectory.t[-1] > 8.0
+    assert np.ptp(trajectory.q_od, axis=0).max() > 3.0
     assert metrics['settle_time'] is not None
     assert metrics['final_max_error'] < 0.02
     assert metrics['bound_violations'] == 0 and metrics['collisions'] == 0
