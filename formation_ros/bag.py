@@ -228,7 +228,8 @@ def trajectory_from_topics(topics, config):
 
 def plant_status(topics):
     """Return the counters of the plant's last /diagnostics status (collisions, ...), or {}."""
-    wanted = ('collisions', 'bound_violations', 'stale_command_steps', 'bad_commands', 'steps')
+    wanted = ('collisions', 'bound_violations', 'stale_command_steps', 'bad_command_steps',
+              'steps')
     for _, message in reversed(topics.get('/diagnostics', [])):
         for status in message.status:
             if status.name == 'formation_ros/plant':

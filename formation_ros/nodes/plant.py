@@ -81,7 +81,7 @@ class PlantNode(Node):
         self.states = OrderedDict()
         self.history = []
         self.counts = {'stale_command_steps': 0, 'bound_violations': 0, 'collisions': 0,
-                       'bad_commands': 0}
+                       'bad_command_steps': 0}
         self.colliding = set()
         self.last_publish_wall = None
         self.started_wall = None
@@ -129,9 +129,10 @@ class PlantNode(Node):
             age = self.t_ns - messages.stamp_to_ns(msg.header.stamp)
             velocity = messages.velocity_of(msg, self.dim)
             if not np.all(np.isfinite(velocity)):
-                self.counts['bad_commands'] += 1
-                self.once.start(f'bad-{i}', f'robot {i + 1} sent a non-finite command; '
-                                            'using zero', 'error')
+                self.counts['bad_command_steps'] += 1
+                self.once.start(f'bad-{i}', f'robot {i + 1} sent a non-finite command; using '
+                                            'zero (logged once; counted in bad_command_steps)',
+                                'error')
                 continue
             if age > self.timeout_ns:
                 self.counts['stale_command_steps'] += 1

@@ -60,7 +60,6 @@ class RobotNode(Node):
         self.last = None
         self.waiting = True
         self.wait_subscribers = values['wait_for_subscribers']
-        self.repulsion_radius = config.repulsion_radius
 
         self.create_subscription(PoseStamped, 'pose', self.on_pose, qos.STATE)
         self.create_subscription(PoseArray, 'neighbors', self.on_neighbors, qos.STATE)
@@ -87,7 +86,7 @@ class RobotNode(Node):
             return True
         self.rejected[name] += 1
         self.once.start(f'bad-{name}', f'ignoring {name} messages with non-finite values '
-                                       f'({self.rejected[name]} so far)', 'error')
+                                       '(logged once; diagnostics count them)', 'error')
         return False
 
     def on_pose(self, msg):
@@ -192,7 +191,7 @@ class RobotNode(Node):
                                   - messages.position_of(self.pose, self.dim), axis=1)
             values['neighbours heard'] = len(gaps)
             values['neighbours within R_i'] = int(np.count_nonzero(gaps < self.sensing_radius))
-            values['neighbours within b'] = int(np.count_nonzero(gaps < self.repulsion_radius))
+            values['neighbours within b'] = int(np.count_nonzero(gaps < self.law.repulsion_radius))
         if self.last is not None:
             values['max |u| component [m/s]'] = float(np.max(np.abs(self.last.u)))
             values['max |u_hat| component [m/s]'] = float(np.max(np.abs(self.last.u_hat)))
