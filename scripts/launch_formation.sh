@@ -61,6 +61,22 @@ if [[ -n "$DURATION" ]] && ! [[ "$DURATION" =~ ^[0-9]+([.][0-9]+)?$ ]]; then
   die "--duration must be a number of seconds >= 0, got '$DURATION'"
 fi
 
+if [[ -n "$OUT" ]]; then
+  if [[ -d "$OUT" ]] && [[ -n "$(ls -A "$OUT")" ]]; then
+    die "--out directory '$OUT' is not empty; choose a new one"
+  fi
+  mkdir -p "$OUT"
+  OUT="$(cd "$OUT" && pwd)"
+fi
+if [[ -n "$RECORD" ]]; then
+  if [[ -e "$RECORD" ]] && ! { [[ -d "$RECORD" ]] && [[ -z "$(ls -A "$RECORD")" ]]; }; then
+    die "--record directory '$RECORD' exists already; choose a new one"
+  fi
+  [[ -d "$RECORD" ]] && rmdir "$RECORD"
+  mkdir -p "$(dirname "$RECORD")"
+  RECORD="$(cd "$(dirname "$RECORD")" && pwd)/$(basename "$RECORD")"
+fi
+
 find_prefix() {
   local dir
   for dir in $(tr ':' ' ' <<<"${AMENT_PREFIX_PATH:-}") "$ROOT/install/formation_ros" \
@@ -95,23 +111,8 @@ read -r NUM_ROBOTS WALL_MS <<<"$CHECK"
 if [[ -n "$DURATION" ]]; then
   WALL_MS="$(awk -v s="$DURATION" 'BEGIN { printf "%d", s * 1000 }')"
 fi
-if [[ -n "$OUT" ]]; then
-  if [[ -d "$OUT" ]] && [[ -n "$(ls -A "$OUT")" ]]; then
-    die "--out directory '$OUT' is not empty; choose a new one"
-  fi
-  mkdir -p "$OUT"
-  OUT="$(cd "$OUT" && pwd)"
-  cp "$PARAMS" "$OUT/params.yaml"
-fi
 
-if [[ -n "$RECORD" ]]; then
-  if [[ -e "$RECORD" ]] && ! { [[ -d "$RECORD" ]] && [[ -z "$(ls -A "$RECORD")" ]]; }; then
-    die "--record directory '$RECORD' exists already; choose a new one"
-  fi
-  [[ -d "$RECORD" ]] && rmdir "$RECORD"
-  mkdir -p "$(dirname "$RECORD")"
-  RECORD="$(cd "$(dirname "$RECORD")" && pwd)/$(basename "$RECORD")"
-fi
+[[ -n "$OUT" ]] && cp "$PARAMS" "$OUT/params.yaml"
 
 PIDS=()
 NAMES=()
