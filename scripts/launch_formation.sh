@@ -180,7 +180,7 @@ start plant plant "${PLANT_ARGS[@]}"
 start reference reference --ros-args --params-file "$PARAMS" -p use_sim_time:=true
 for ((i = 1; i <= NUM_ROBOTS; i++)); do
   start "robot_$i" robot --ros-args -r "__ns:=/robot_$i" -p "robot_id:=$i" \
-    -p use_sim_time:=true --params-file "$PARAMS" \
+    --params-file "$PARAMS" \
     -p "wait_for_subscribers:=$([[ -n "$RECORD" ]] && echo 2 || echo 1)"
 done
 

@@ -1,6 +1,7 @@
 """What every formation node shares: parameter declaration from the schema, start-up, shutdown."""
 
 import difflib
+import os
 import signal
 import sys
 
@@ -143,12 +144,25 @@ def diagnostics(stamp, name, level, message, values):
     return array
 
 
-class _Stop(Exception):
-    """Raised by the SIGTERM handler to leave spin the same way as Ctrl-C."""
+def make_executor():
+    """Return rclpy's EventsExecutor where it exists (far less overhead per callback)."""
+    if os.environ.get('FORMATION_EXECUTOR', 'events') == 'events':
+        try:
+            from rclpy.experimental import EventsExecutor
+            return EventsExecutor()
+        except ImportError:
+            pass
+    return SingleThreadedExecutor()
 
 
-def _raise_stop(signum, frame):
-    raise _Stop()
+class _StopRequest:
+    """Set by the SIGINT/SIGTERM handler; the spin loop checks it between callbacks."""
+
+    signal_name = None
+
+    @classmethod
+    def handler(cls, signum, frame):
+        cls.signal_name = signal.Signals(signum).name
 
 
 def run(node_class, args=None, name=None):
@@ -156,29 +170,29 @@ def run(node_class, args=None, name=None):
     Start rclpy, build the node, spin until SIGINT/SIGTERM, shut down without a traceback.
 
     Signals are handled in Python (rclpy's own handlers would invalidate the context before
-    the node could log its summary), so the executor wakes at least every 0.1 s even when no
-    timer fires (a sim-time timer whose /clock stopped); a signal ends spinning with an
-    exception, the node's
+    the node could log its summary): the handler only records the signal, and the spin loop,
+    which wakes at least every 0.1 s even when no timer fires (a sim-time timer whose /clock
+    stopped), ends between two callbacks; then the node's
     ``finish()`` (if any) runs while ROS is still up, then the node is destroyed and rclpy shut
     down. Invalid parameters end the process with exit code 2 and one line per bad parameter.
     """
     rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
-    signal.signal(signal.SIGINT, _raise_stop)
-    signal.signal(signal.SIGTERM, _raise_stop)
-    node = None
+    signal.signal(signal.SIGINT, _StopRequest.handler)
+    signal.signal(signal.SIGTERM, _StopRequest.handler)
+    node = executor = None
     code = 0
     try:
         node = node_class()
-        executor = SingleThreadedExecutor()
+        executor = make_executor()
         executor.add_node(node)
-        while rclpy.ok():
+        while rclpy.ok() and _StopRequest.signal_name is None:
             executor.spin_once(timeout_sec=SIGNAL_LATENCY)
     except ParamError as exc:
         logger = rclpy.logging.get_logger(name or node_class.__name__)
         for line in str(exc).splitlines():
             logger.error(f'invalid {line}')
         code = 2
-    except (_Stop, KeyboardInterrupt, ExternalShutdownException):
+    except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
@@ -188,5 +202,7 @@ def run(node_class, args=None, name=None):
             if finish is not None:
                 finish()
             node.destroy_node()
+        if executor is not None:
+            executor.shutdown()
         rclpy.try_shutdown()
     return code
