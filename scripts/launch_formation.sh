@@ -10,8 +10,8 @@ Usage: scripts/launch_formation.sh PARAMS.yaml [--duration S] [--out DIR] [--rec
                                    [--prefix DIR]
 
 Starts the plant, the reference node and N robot nodes (N = num_robots in PARAMS.yaml), robot i
-in namespace /robot_<i>, all with the same parameters file and (robots, reference) simulated
-time from the plant's /clock. Output lines are prefixed with the node's name. Stops every
+in namespace /robot_<i>, all with the same parameters file, the reference node on the plant's
+simulated time (/clock). Output lines are prefixed with the node's name. Stops every
 process it started when the duration ends, on Ctrl-C or on SIGTERM (then still writes the
 report of --out / --record), and when any node exits on its own (then with a non-zero exit
 code).
