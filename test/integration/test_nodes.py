@@ -80,3 +80,33 @@ def test_plant_treats_a_non_finite_command_as_zero(processes, install, probe, tm
     assert np.ptp(trajectory.q[:, 0, :], axis=0).max() == 0.0
     log = processes.log('plant')
     assert log.count('non-finite command') == 1 and 'Traceback' not in log
+
+
+def test_several_robot_nodes_share_one_process_and_executor(probe):
+    """Two RobotNode instances live in one process and executor (no module-level state)."""
+    import rclpy
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.parameter import Parameter
+    from formation_ros.nodes.robot import RobotNode
+    context = rclpy.Context()
+    rclpy.init(context=context, args=['--ros-args', '--params-file', SQUARE])
+    executor = SingleThreadedExecutor(context=context)
+    robots = [RobotNode(context=context, namespace=f'/robot_{i}',
+                        parameter_overrides=[Parameter('robot_id', Parameter.Type.INTEGER, i)])
+              for i in (1, 2)]
+    try:
+        for robot in robots:
+            executor.add_node(robot)
+        assert [robot.index for robot in robots] == [0, 1]
+        assert not np.array_equal(robots[0].vertex, robots[1].vertex)
+
+        def both_visible():
+            executor.spin_once(timeout_sec=0.01)
+            return all(probe.count_publishers(f'/robot_{i}/cmd_vel') == 1 for i in (1, 2))
+
+        assert probe.spin_until(both_visible, 20)
+    finally:
+        executor.shutdown()
+        for robot in robots:
+            robot.destroy_node()
+        rclpy.shutdown(context=context)
