@@ -5,7 +5,7 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 VENV="${FORMATION_VENV:-$ROOT/.venv}"
 PARAMS="$ROOT/config/paper_section5.yaml"
-DURATION=32
+DURATION=28
 OUT=""
 
 usage() {
