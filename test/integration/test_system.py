@@ -167,3 +167,27 @@ def test_launcher_rejects_bad_parameters_before_starting(processes, install, tmp
     assert launcher.wait(60) == 2
     assert "parameter 'repulsion_radius'" in processes.log('launcher')
     assert project_processes(install) == []
+
+
+def test_launcher_uses_ros2_run_where_ros2_knows_the_package(processes, install, probe,
+                                                             tmp_path):
+    """With a `ros2` command on PATH the launcher starts every node through `ros2 run`."""
+    shim = tmp_path / 'bin' / 'ros2'
+    shim.parent.mkdir()
+    calls = tmp_path / 'ros2_calls.txt'
+    shim.write_text(
+        '#!/usr/bin/env bash\n'
+        f'echo "$*" >> {calls}\n'
+        f'if [[ "$1 $2" == "pkg prefix" ]]; then echo {install}; exit 0; fi\n'
+        f'if [[ "$1" == run ]]; then exec {install}/lib/"$2"/"$3" "${{@:4}}"; fi\n'
+        'exit 1\n')
+    shim.chmod(0o755)
+    processes.env = dict(processes.env, PATH=f"{shim.parent}:{processes.env['PATH']}")
+    launcher = processes.start('launcher', ['bash', LAUNCHER, SQUARE, '--duration', '6',
+                                            '--out', str(tmp_path / 'run')])
+    assert wait_exit(probe, launcher, 60) == 0, processes.log('launcher')
+    used = calls.read_text()
+    for name in ('plant', 'reference', 'robot', 'formation_sim', 'formation_report'):
+        assert f'run formation_ros {name}' in used, used
+    assert 'ros2 run' in processes.log('launcher')
+    assert (tmp_path / 'run' / 'metrics.json').exists()
