@@ -14,8 +14,7 @@ commands and reference samples (header stamps, i.e. simulated time).
 import os
 import shutil
 
-from formation_ros.core.frames import (advance, desired_positions, frame_from_pose,
-                                       stationary_frame, to_frame_velocity)
+from formation_ros.core.frames import advance, frame_from_pose, stationary_frame
 from formation_ros.trajectory import Trajectory
 import numpy as np
 from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, QosReliability
@@ -218,11 +217,8 @@ def trajectory_from_topics(topics, config):
         values = np.array([commands[int(k)] for k in known])
         u[:, i - 1] = np.where((index >= 0)[:, None], values[np.maximum(index, 0)], 0.0)
     frames, source = _frames_at(stamps, topics.get('/formation/reference', []), config)
-    trajectory = Trajectory(
-        t=np.array(stamps) / NS_PER_S, q=q, u=u,
-        u_hat=np.array([to_frame_velocity(u[k], q[k], f) for k, f in enumerate(frames)]),
-        q_desired=np.array([desired_positions(config.vertices, f) for f in frames]),
-        q_od=np.array([f.q_od for f in frames]))
+    trajectory = Trajectory.from_frames(np.array(stamps) / NS_PER_S, q, u, frames,
+                                        config.vertices)
     return trajectory, {'reference_source': source}
 
 

@@ -3,6 +3,7 @@
 from dataclasses import dataclass
 import os
 
+from formation_ros.core.frames import desired_positions, to_frame_velocity
 import numpy as np
 
 ARRAYS = ('t', 'q', 'u', 'u_hat', 'q_desired', 'q_od')
@@ -38,6 +39,22 @@ class Trajectory:
     def save(self, path):
         """Write the arrays to ``path`` (a .npz file)."""
         np.savez_compressed(path, **{name: getattr(self, name) for name in ARRAYS})
+
+    @classmethod
+    def from_frames(cls, t, q, u, frames, vertices):
+        """
+        Build a trajectory from states and commands and the reference frame of each sample.
+
+        t: (T,) s; q, u: (T, N, dim); frames: T FrameSamples; vertices: (N, dim). u_hat comes
+        from inverting eq. (25), desired positions from eq. (20).
+        """
+        q = np.asarray(q, dtype=float)
+        u = np.asarray(u, dtype=float)
+        return cls(t=np.asarray(t, dtype=float), q=q, u=u,
+                   u_hat=np.array([to_frame_velocity(u_k, q_k, f)
+                                   for u_k, q_k, f in zip(u, q, frames)]),
+                   q_desired=np.array([desired_positions(vertices, f) for f in frames]),
+                   q_od=np.array([f.q_od for f in frames]))
 
     @classmethod
     def load(cls, path):

@@ -298,13 +298,10 @@ class PlantNode(Node):
         if not self.history:
             return None
         t = np.array([entry[0] for entry in self.history]) / 1e9
-        q = np.array([entry[1] for entry in self.history])
-        u = np.array([entry[2] for entry in self.history])
         frames = [self.reference.sample(time_s) for time_s in t]
-        desired = np.array([desired_positions(self.config.vertices, f) for f in frames])
-        u_hat = np.array([to_frame_velocity(u_k, q_k, f) for u_k, q_k, f in zip(u, q, frames)])
-        centres = np.array([f.q_od for f in frames])
-        return Trajectory(t=t, q=q, u=u, u_hat=u_hat, q_desired=desired, q_od=centres)
+        return Trajectory.from_frames(t, [entry[1] for entry in self.history],
+                                      [entry[2] for entry in self.history], frames,
+                                      self.config.vertices)
 
     def finish(self):
         """Log a summary of the run; with ``plant.output_dir`` write trajectory and counters."""
