@@ -3,7 +3,8 @@
 import math
 
 from formation_ros.core.frames import stationary_frame
-from formation_ros.core.law import (log_potential, make_law, robot_command, team_command)
+from formation_ros.core.law import (log_potential, make_law, potential, robot_command,
+                                    team_command)
 from formation_ros.core.reference import Reference
 import numpy as np
 import pytest
@@ -141,3 +142,18 @@ def test_bad_law_constants_rejected():
         make_law(2.0, 1.0, 'sigmoid', 'poly', 2, 1.0)
     with pytest.raises(ValueError, match='gain'):
         make_law(-2.0, 1.0, 'arctan', 'poly', 2, 1.0)
+
+
+def test_potential_is_zero_only_at_the_formation_and_infinite_at_collision():
+    """Eqs. (8)-(11): phi = e^gamma / beta^kappa - 1 >= 0, 0 at q = q_f, +inf when q_i = q_j."""
+    law = LAWS[0]
+    vertices = np.array([[0.0, 0.0], [2.0, 0.0], [0.0, 2.0]])
+    assert potential(vertices, vertices, law) == 0.0
+    moved = vertices + np.array([[0.1, 0.0], [0.0, 0.0], [0.0, 0.0]])
+    assert potential(moved, vertices, law) == pytest.approx(np.expm1(0.5 * 0.01))
+    close = np.array([[0.0, 0.0], [0.3, 0.0], [0.0, 2.0]])
+    assert potential(close, vertices, law) == pytest.approx(
+        np.expm1(log_potential(close, vertices, law)))
+    assert potential(close, vertices, law) > potential(moved, vertices, law)
+    collided = np.array([[0.0, 0.0], [0.0, 0.0], [0.0, 2.0]])
+    assert potential(collided, vertices, law) == np.inf
