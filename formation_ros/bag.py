@@ -14,7 +14,8 @@ commands and reference samples (header stamps, i.e. simulated time).
 import os
 import shutil
 
-from formation_ros.core.frames import advance, frame_from_pose, stationary_frame
+from formation_ros.core.frames import advance
+from formation_ros.fields import frame_of, NS_PER_S, position_of, stamp_to_ns, velocity_of
 from formation_ros.trajectory import Trajectory
 import numpy as np
 from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, QosReliability
@@ -26,7 +27,6 @@ import yaml
 PARAMS_TOPIC = '/formation/params'
 PARAMS_FILE = 'params.yaml'
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
-NS_PER_S = 1_000_000_000
 
 
 class BagError(Exception):
@@ -136,10 +136,6 @@ def read_messages(path):
     return topics, counts
 
 
-def _stamp(message):
-    return int(message.header.stamp.sec) * NS_PER_S + int(message.header.stamp.nanosec)
-
-
 def bag_params_text(path, topics):
     """Return the parameters YAML stored with a bag (topic, else params.yaml), or None."""
     if topics.get(PARAMS_TOPIC):
@@ -151,36 +147,31 @@ def bag_params_text(path, topics):
     return None
 
 
-def _frame_of_odometry(message, dim):
-    pose, twist = message.pose.pose, message.twist.twist
-    o = pose.orientation
-    return frame_from_pose(
-        _stamp(message) / NS_PER_S, [pose.position.x, pose.position.y, pose.position.z],
-        [o.x, o.y, o.z, o.w], [twist.linear.x, twist.linear.y, twist.linear.z],
-        [twist.angular.x, twist.angular.y, twist.angular.z], dim)
-
-
 def _frames_at(stamps, reference_messages, config):
-    """Return the reference frame at each stamp: that sample, else the last one carried on."""
+    """
+    Return the reference frame at each stamp and where it came from.
+
+    The recorded sample with that stamp, else the last earlier one carried on; before the first
+    recorded sample (or with none recorded) the reference in the parameters.
+    """
     dim = config.dim
+    reference = config.reference()
     if not reference_messages:
-        reference = config.reference()
         return [reference.sample(s / NS_PER_S) for s in stamps], 'parameters'
     by_stamp = {}
     for _, message in reference_messages:
-        by_stamp[_stamp(message)] = message
+        by_stamp[stamp_to_ns(message.header.stamp)] = message
     known = np.array(sorted(by_stamp))
     frames = []
     for stamp in stamps:
         if stamp in by_stamp:
-            frames.append(_frame_of_odometry(by_stamp[stamp], dim))
+            frames.append(frame_of(by_stamp[stamp], dim))
             continue
         index = int(np.searchsorted(known, stamp, side='right')) - 1
         if index < 0:
-            frames.append(stationary_frame(dim) if config.reference().is_stationary
-                          else config.reference().sample(stamp / NS_PER_S))
+            frames.append(reference.sample(stamp / NS_PER_S))
             continue
-        base = _frame_of_odometry(by_stamp[int(known[index])], dim)
+        base = frame_of(by_stamp[int(known[index])], dim)
         frames.append(advance(base, (stamp - int(known[index])) / NS_PER_S))
     return frames, 'recorded'
 
@@ -198,8 +189,8 @@ def trajectory_from_topics(topics, config):
     poses = {}
     for i in range(1, n + 1):
         for _, message in topics.get(f'/robot_{i}/pose', []):
-            p = message.pose.position
-            poses.setdefault(_stamp(message), {})[i - 1] = [p.x, p.y, p.z][:dim]
+            poses.setdefault(stamp_to_ns(message.header.stamp), {})[i - 1] = \
+                position_of(message, dim)
     stamps = sorted(stamp for stamp, seen in poses.items() if len(seen) == n)
     if len(stamps) < 2:
         raise BagError('fewer than two moments with the poses of all robots recorded')
@@ -208,8 +199,7 @@ def trajectory_from_topics(topics, config):
     for i in range(1, n + 1):
         commands = {}
         for _, message in topics.get(f'/robot_{i}/cmd_vel', []):
-            v = message.twist.linear
-            commands[_stamp(message)] = [v.x, v.y, v.z][:dim]
+            commands[stamp_to_ns(message.header.stamp)] = velocity_of(message, dim)
         if not commands:
             continue
         known = np.array(sorted(commands))

@@ -1,19 +1,13 @@
-"""Conversions between ROS messages and the numpy arrays of the core (no math beyond copying)."""
+"""Build ROS messages from the numpy arrays of the core (reading them is ``fields``)."""
 
 from builtin_interfaces.msg import Time
-from formation_ros.core.frames import frame_from_pose, frame_to_pose
+from formation_ros.core.frames import frame_to_pose
+from formation_ros.fields import NS_PER_S
 from geometry_msgs.msg import Pose, PoseArray, PoseStamped, TwistStamped
 from nav_msgs.msg import Odometry
-import numpy as np
 
 WORLD_FRAME = 'world'
 FORMATION_FRAME = 'formation'
-NS_PER_S = 1_000_000_000
-
-
-def stamp_to_ns(stamp):
-    """Convert a builtin_interfaces/Time to integer nanoseconds."""
-    return int(stamp.sec) * NS_PER_S + int(stamp.nanosec)
 
 
 def ns_to_stamp(ns):
@@ -59,24 +53,6 @@ def twist_stamped(velocity, stamp_ns, dim):
     return msg
 
 
-def position_of(msg, dim):
-    """Return the position of a PoseStamped as (dim,)."""
-    p = msg.pose.position
-    return np.array([p.x, p.y, p.z][:dim])
-
-
-def points_of(msg, dim):
-    """Return the positions of a PoseArray as (K, dim)."""
-    points = np.array([[p.position.x, p.position.y, p.position.z] for p in msg.poses])
-    return points.reshape(-1, 3)[:, :dim]
-
-
-def velocity_of(msg, dim):
-    """Return the linear velocity of a TwistStamped as (dim,)."""
-    v = msg.twist.linear
-    return np.array([v.x, v.y, v.z][:dim])
-
-
 def reference_odometry(frame, stamp_ns, dim):
     """Build the nav_msgs/Odometry of a reference sample (``core.frames.frame_to_pose``)."""
     position, quat, linear, angular = frame_to_pose(frame, dim)
@@ -89,24 +65,3 @@ def reference_odometry(frame, stamp_ns, dim):
     twist.linear.x, twist.linear.y, twist.linear.z = (float(v) for v in linear)
     twist.angular.x, twist.angular.y, twist.angular.z = (float(v) for v in angular)
     return msg
-
-
-def frame_of(msg, dim):
-    """Return the FrameSample carried by a reference Odometry message."""
-    pose, twist = msg.pose.pose, msg.twist.twist
-    o = pose.orientation
-    return frame_from_pose(
-        stamp_to_ns(msg.header.stamp) / NS_PER_S,
-        [pose.position.x, pose.position.y, pose.position.z], [o.x, o.y, o.z, o.w],
-        [twist.linear.x, twist.linear.y, twist.linear.z],
-        [twist.angular.x, twist.angular.y, twist.angular.z], dim)
-
-
-def odometry_is_finite(msg):
-    """Tell whether every number of a reference message is finite and its quaternion non-zero."""
-    pose, twist = msg.pose.pose, msg.twist.twist
-    o = pose.orientation
-    values = [pose.position.x, pose.position.y, pose.position.z, o.x, o.y, o.z, o.w,
-              twist.linear.x, twist.linear.y, twist.linear.z,
-              twist.angular.x, twist.angular.y, twist.angular.z]
-    return bool(np.all(np.isfinite(values))) and (o.x ** 2 + o.y ** 2 + o.z ** 2 + o.w ** 2) > 0

@@ -23,7 +23,7 @@ import os
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros import messages, qos
+from formation_ros import fields, messages, qos
 from formation_ros.core.frames import desired_positions, to_frame_velocity
 from formation_ros.core.metrics import closest_pair_distance, compute_metrics
 from formation_ros.markers import formation_markers
@@ -61,6 +61,7 @@ class PlantNode(Node):
         self.n, self.dim = config.num_robots, config.dim
         self.radii = config.sensing_radii
         self.q = config.start.copy()
+        self.tree = cKDTree(self.q)
         self.step_ns = int(round(1e9 / values['plant.rate']))
         self.t_ns = 0
         self.steps = 0
@@ -126,8 +127,8 @@ class PlantNode(Node):
         for i, msg in enumerate(self.commands):
             if msg is None:
                 continue
-            age = self.t_ns - messages.stamp_to_ns(msg.header.stamp)
-            velocity = messages.velocity_of(msg, self.dim)
+            age = self.t_ns - fields.stamp_to_ns(msg.header.stamp)
+            velocity = fields.velocity_of(msg, self.dim)
             if not np.all(np.isfinite(velocity)):
                 self.counts['bad_command_steps'] += 1
                 self.once.start(f'bad-{i}', f'robot {i + 1} sent a non-finite command; using '
@@ -146,7 +147,7 @@ class PlantNode(Node):
 
     def _check_bound(self, index, msg, velocity):
         """Count a new command whose bounded part u_hat (eq. 14) exceeds c * M1."""
-        stamp = messages.stamp_to_ns(msg.header.stamp)
+        stamp = fields.stamp_to_ns(msg.header.stamp)
         if self.checked[index] == stamp:
             return
         self.checked[index] = stamp
@@ -156,7 +157,7 @@ class PlantNode(Node):
             q = self.states.get(stamp)
             if q is None:
                 return
-            frame = self.reference.sample(stamp / messages.NS_PER_S)
+            frame = self.reference.sample(stamp / fields.NS_PER_S)
             u_hat = to_frame_velocity(velocity[None, :], q[index][None, :], frame)[0]
         excess = float(np.max(np.abs(u_hat))) - self.law.u_bound
         if excess > self.bound_tolerance:
@@ -167,8 +168,7 @@ class PlantNode(Node):
                 f"({self.counts['bound_violations']} so far)", throttle_duration_sec=1.0)
 
     def _check_collisions(self):
-        tree = cKDTree(self.q)
-        pairs = {tuple(p) for p in tree.query_pairs(self.collision_distance)}
+        pairs = {tuple(p) for p in self.tree.query_pairs(self.collision_distance)}
         for i, j in pairs - self.colliding:
             self.counts['collisions'] += 1
             self.get_logger().error(
@@ -182,8 +182,7 @@ class PlantNode(Node):
         self.states[stamp] = self.q.copy()
         while len(self.states) > STATE_BUFFER:
             self.states.popitem(last=False)
-        tree = cKDTree(self.q)
-        seen = tree.query_ball_point(self.q, r=self.radii)
+        seen = self.tree.query_ball_point(self.q, r=self.radii)
         for i in range(self.n):
             others = [j for j in seen[i]
                       if j != i and np.sum((self.q[j] - self.q[i]) ** 2) < self.radii[i] ** 2]
@@ -199,6 +198,7 @@ class PlantNode(Node):
         if self.steps % self.publish_every == 0:
             self.history.append((self.t_ns, self.q.copy(), u.copy()))
         self.q = self.q + (self.step_ns / 1e9) * u
+        self.tree = cKDTree(self.q)
         self.t_ns += self.step_ns
         self.steps += 1
         self._check_collisions()
@@ -248,7 +248,7 @@ class PlantNode(Node):
             self._publish_state()
 
     def _lockstep_tick(self):
-        answered = all(msg is not None and messages.stamp_to_ns(msg.header.stamp) == self.t_ns
+        answered = all(msg is not None and fields.stamp_to_ns(msg.header.stamp) == self.t_ns
                        for msg in self.commands)
         ahead = (self.t_ns / 1e9) > self.realtime_factor * (time.monotonic() - self.started_wall)
         if answered and not ahead:
@@ -288,7 +288,7 @@ class PlantNode(Node):
     def on_markers(self):
         """Publish the RViz picture: robots, sensing and repulsion zones, formation, paths."""
         self.paths.append(self.q.copy())
-        frame = self.reference.sample(self.t_ns / messages.NS_PER_S)
+        frame = self.reference.sample(self.t_ns / fields.NS_PER_S)
         desired = desired_positions(self.config.vertices, frame)
         self.marker_pub.publish(formation_markers(self.q, self.radii, self.law.repulsion_radius,
                                                   desired, np.array(self.paths), self.t_ns))

@@ -13,7 +13,7 @@ the simulated clock. The topic is transient local: a late robot gets the latest 
 """
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros import messages, qos
+from formation_ros import fields, messages, qos
 from formation_ros.nodes.common import declare_and_validate, diagnostics, DIAGNOSTICS_PERIOD, run
 from nav_msgs.msg import Odometry
 from rclpy.clock import Clock, ClockType
@@ -58,7 +58,7 @@ class ReferenceNode(Node):
         if self.lockstep and stamp == self.last_stamp:
             return
         self.last_stamp = stamp
-        frame = self.reference.sample((stamp - self.epoch_ns) / messages.NS_PER_S)
+        frame = self.reference.sample((stamp - self.epoch_ns) / fields.NS_PER_S)
         self.pub.publish(messages.reference_odometry(frame, stamp, self.dim))
         self.published += 1
 
@@ -66,7 +66,7 @@ class ReferenceNode(Node):
         """Publish the reference node's status: kind, time, samples published."""
         values = {'kind': self.reference.kind, 'samples published': self.published,
                   'time [s]': ('none yet' if self.last_stamp is None
-                               else (self.last_stamp - self.epoch_ns) / messages.NS_PER_S)}
+                               else (self.last_stamp - self.epoch_ns) / fields.NS_PER_S)}
         level, message = ('ok', 'publishing') if self.published else ('warn', 'no sample yet')
         self.diagnostics_pub.publish(diagnostics(self.get_clock().now().to_msg(),
                                                  'formation_ros/reference', level, message,

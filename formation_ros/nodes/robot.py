@@ -16,7 +16,7 @@ how old it is (and, in lockstep, which state it answers).
 from collections import deque
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros import messages, qos
+from formation_ros import fields, messages, qos
 from formation_ros.core.frames import advance
 from formation_ros.core.law import robot_command
 from formation_ros.nodes.common import (declare_and_validate, diagnostics, DIAGNOSTICS_PERIOD,
@@ -107,26 +107,26 @@ class RobotNode(Node):
 
     def on_reference(self, msg):
         """Store a reference sample (a few are kept to match state stamps in lockstep)."""
-        if self._accept('reference', messages.odometry_is_finite(msg)):
+        if self._accept('reference', fields.odometry_is_finite(msg)):
             self.references.append(msg)
             self.received_ns['reference'] = self._now_ns()
 
     def _reference_for(self, stamp_ns, exact):
         """Return the reference frame at ``stamp_ns``: that sample, else the newest carried on."""
         for msg in reversed(self.references):
-            if messages.stamp_to_ns(msg.header.stamp) == stamp_ns:
-                return messages.frame_of(msg, self.dim)
+            if fields.stamp_to_ns(msg.header.stamp) == stamp_ns:
+                return fields.frame_of(msg, self.dim)
         if exact or not self.references:
             return None
-        newest = messages.frame_of(self.references[-1], self.dim)
-        return advance(newest, stamp_ns / messages.NS_PER_S - newest.t)
+        newest = fields.frame_of(self.references[-1], self.dim)
+        return advance(newest, stamp_ns / fields.NS_PER_S - newest.t)
 
     def _command(self, stamp_ns, exact):
         frame = self._reference_for(stamp_ns, exact)
         if frame is None:
             return None
-        neighbours = messages.points_of(self.neighbors, self.dim)
-        own = messages.position_of(self.pose, self.dim)
+        neighbours = fields.points_of(self.neighbors, self.dim)
+        own = fields.position_of(self.pose, self.dim)
         self.last = robot_command(own, self.vertex, neighbours, self.sensing_radius, self.law,
                                   frame)
         return self.last.u
@@ -142,13 +142,13 @@ class RobotNode(Node):
         if self.waiting and not self._ready():
             return
         if stale:
-            stamp = messages.stamp_to_ns(self.pose.header.stamp)
+            stamp = fields.stamp_to_ns(self.pose.header.stamp)
             self.cmd_pub.publish(messages.twist_stamped(np.zeros(self.dim), stamp, self.dim))
             self.once.start('stale', f"no new {', '.join(stale)} for "
                                      f'{self.timeout_ns / 1e9:g} s: publishing zero')
             return
         self.once.end('stale', 'inputs fresh again: controlling')
-        stamp = messages.stamp_to_ns(self.pose.header.stamp)
+        stamp = fields.stamp_to_ns(self.pose.header.stamp)
         self.cmd_pub.publish(messages.twist_stamped(self._command(stamp, False), stamp,
                                                     self.dim))
 
@@ -171,8 +171,8 @@ class RobotNode(Node):
             return
         if self.waiting and not self._ready():
             return
-        stamp = messages.stamp_to_ns(self.pose.header.stamp)
-        if messages.stamp_to_ns(self.neighbors.header.stamp) != stamp:
+        stamp = fields.stamp_to_ns(self.pose.header.stamp)
+        if fields.stamp_to_ns(self.neighbors.header.stamp) != stamp:
             return
         command = self._command(stamp, True)
         if command is None:
@@ -187,8 +187,8 @@ class RobotNode(Node):
                                       else (now - self.received_ns[name]) / 1e9)
                   for name in INPUTS}
         if self.neighbors is not None and self.pose is not None:
-            gaps = np.linalg.norm(messages.points_of(self.neighbors, self.dim)
-                                  - messages.position_of(self.pose, self.dim), axis=1)
+            gaps = np.linalg.norm(fields.points_of(self.neighbors, self.dim)
+                                  - fields.position_of(self.pose, self.dim), axis=1)
             values['neighbours heard'] = len(gaps)
             values['neighbours within R_i'] = int(np.count_nonzero(gaps < self.sensing_radius))
             values['neighbours within b'] = int(np.count_nonzero(gaps < self.law.repulsion_radius))

@@ -5,7 +5,7 @@ import math
 import os
 
 from conftest import CONFIG, exe
-from formation_ros import messages, qos
+from formation_ros import fields, messages, qos
 from formation_ros.core.law import robot_command
 from formation_ros.core.params import load_config
 from formation_ros.trajectory import Trajectory
@@ -37,13 +37,13 @@ def test_robot_publishes_the_core_command_and_survives_bad_poses(processes, inst
 
     def answered():
         publish(messages.pose_stamped(own, STAMP_NS, 2))
-        return any(messages.stamp_to_ns(m.header.stamp) == STAMP_NS for m in heard)
+        return any(fields.stamp_to_ns(m.header.stamp) == STAMP_NS for m in heard)
 
     assert probe.spin_until(answered, 30), processes.log('robot_1')
     expected = robot_command(own, config.vertices[0], neighbours, config.sensing_radii[0],
                              config.law()).u
-    command = [m for m in heard if messages.stamp_to_ns(m.header.stamp) == STAMP_NS][-1]
-    assert np.max(np.abs(messages.velocity_of(command, 2) - expected)) < 1e-12
+    command = [m for m in heard if fields.stamp_to_ns(m.header.stamp) == STAMP_NS][-1]
+    assert np.max(np.abs(fields.velocity_of(command, 2) - expected)) < 1e-12
     assert np.any(expected != robot_command(own, config.vertices[0], neighbours[1:2],
                                             config.sensing_radii[0], config.law()).u)
     for _ in range(5):
@@ -51,7 +51,7 @@ def test_robot_publishes_the_core_command_and_survives_bad_poses(processes, inst
         probe.spin_until(lambda: False, 0.05)
     count = len(heard)
     probe.spin_until(lambda: len(heard) > count + 5, 5)
-    assert all(messages.stamp_to_ns(m.header.stamp) == STAMP_NS for m in heard[count:])
+    assert all(fields.stamp_to_ns(m.header.stamp) == STAMP_NS for m in heard[count:])
     assert robot.poll() is None
     assert processes.log('robot_1').count('non-finite') == 1
 
@@ -64,7 +64,7 @@ def test_plant_treats_a_non_finite_command_as_zero(processes, install, probe, tm
     command_pub = probe.create_publisher(TwistStamped, '/robot_1/cmd_vel', qos.COMMAND)
     clock = []
     probe.create_subscription(PoseStamped, '/robot_1/pose',
-                              lambda m: clock.append(messages.stamp_to_ns(m.header.stamp)),
+                              lambda m: clock.append(fields.stamp_to_ns(m.header.stamp)),
                               qos.STATE)
 
     def send():
