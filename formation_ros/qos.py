@@ -13,6 +13,10 @@ Quality of service of every formation topic, in one place.
 * Diagnostics (``/diagnostics``): reliable, keep last 10, volatile, as diagnostic tools expect.
 * Markers (``/formation/markers``): reliable, keep last 1, transient local, so RViz started
   later still shows the latest picture.
+
+The recorder subscribes with the publishers' reliability and durability but a deep history
+(:func:`recording`): a sample that waits a moment for a busy recorder is stored, not
+overwritten by the next one.
 """
 
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
@@ -29,3 +33,12 @@ STATE = _profile(1, ReliabilityPolicy.BEST_EFFORT, DurabilityPolicy.VOLATILE)
 CLOCK = _profile(1, ReliabilityPolicy.RELIABLE, DurabilityPolicy.VOLATILE)
 DIAGNOSTICS = _profile(10, ReliabilityPolicy.RELIABLE, DurabilityPolicy.VOLATILE)
 MARKERS = _profile(1, ReliabilityPolicy.RELIABLE, DurabilityPolicy.TRANSIENT_LOCAL)
+
+
+RECORDING_DEPTH = 1000
+
+
+def recording(profile):
+    """Return ``profile`` with the recorder's deep history (same reliability and durability)."""
+    return _profile(max(profile.depth, RECORDING_DEPTH), profile.reliability,
+                    profile.durability)

@@ -11,6 +11,7 @@ from formation_ros.core.metrics import compute_metrics
 from formation_ros.core.params import load_config
 from formation_ros.sim import simulate
 from formation_ros.trajectory import Trajectory
+from geometry_msgs.msg import PoseArray, PoseStamped
 import numpy as np
 from rosgraph_msgs.msg import Clock as ClockMsg
 from test_system import LAUNCHER, wait_exit
@@ -47,6 +48,11 @@ def test_recorded_run_reads_back_and_agrees_with_the_plant(processes, install, p
     assert {f'formation_ros/robot_{i}' for i in range(1, 5)} <= statuses
     from_bag = json.loads((out / 'metrics.json').read_text())
     plant = Trajectory.load(str(out / 'trajectory.npz'))
+    stepped = set(np.round(plant.t * 1e9).astype(np.int64).tolist())
+    for i in range(1, 5):
+        recorded = {m.header.stamp.sec * 10 ** 9 + m.header.stamp.nanosec
+                    for _, m in topics[f'/robot_{i}/pose']}
+        assert stepped <= recorded, sorted(stepped - recorded)[:10]
     printed = compute_metrics(plant.t, plant.q, plant.u, plant.u_hat, plant.q_desired, bound)
     assert from_bag['source'] == 'rosbag2'
     assert from_bag['min_pair_distance'] == printed['min_pair_distance']
@@ -105,3 +111,24 @@ def test_recorder_refuses_an_existing_bag(processes, install, tmp_path):
     assert process.wait(30) == 2
     assert 'refusing to overwrite' in processes.log('record')
     assert (bag / 'metadata.yaml').read_text() == 'not yours\n'
+
+
+def test_recorder_records_commands_only_once_the_states_reach_it(processes, install, probe,
+                                                                 tmp_path):
+    process = processes.start('record', [exe(install, 'record'), '--ros-args', '--params-file',
+                                         SQUARE, '-p', f'record.path:={tmp_path / "bag"}'])
+    assert probe.spin_until(lambda: probe.count_subscribers('/robot_1/pose') == 1, 30), \
+        processes.log('record')
+    probe.spin_until(lambda: False, 1.0)
+    assert probe.count_subscribers('/robot_1/cmd_vel') == 0
+    pose = probe.create_publisher(PoseStamped, '/robot_1/pose', qos.STATE)
+    assert probe.spin_until(lambda: probe.count_subscribers('/robot_1/cmd_vel') == 0
+                            and pose.get_subscription_count() == 1, 10)
+    probe.spin_until(lambda: False, 0.5)
+    assert probe.count_subscribers('/robot_1/cmd_vel') == 0
+    probe.create_publisher(PoseArray, '/robot_1/neighbors', qos.STATE)
+    assert probe.spin_until(lambda: probe.count_subscribers('/robot_1/cmd_vel') == 1, 10), \
+        processes.log('record')
+    assert probe.count_subscribers('/robot_2/cmd_vel') == 0
+    assert 'recorded once their pose and neighbours are' in processes.log('record')
+    assert processes.stop(process) == 0
