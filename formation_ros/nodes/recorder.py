@@ -93,7 +93,8 @@ class RecorderNode(Node):
         self.timer = self.create_timer(FLUSH_PERIOD, self.flush, clock=steady)
         self.match_timer = self.create_timer(MATCH_PERIOD, self.subscribe_commands,
                                              clock=steady)
-        self.get_logger().info(f'recording {len(topics)} topics to {self.path}')
+        self.get_logger().info(f'recording {len(topics)} topics and the parameters '
+                               f'(/formation/params) to {self.path}')
 
     def _subscribe(self, topic):
         name, msg_class, _, profile = topic
