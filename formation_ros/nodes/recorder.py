@@ -81,11 +81,11 @@ class RecorderNode(Node):
         self.once = OnceLog(self.get_logger())
         self.subscriptions_by_topic = {}
         topics = formation_topics(config.num_robots, values['record.markers'])
-        self.commands = {topic[0]: topic for topic in topics
-                         if topic[0].endswith('/cmd_vel')}
+        self.commands_to_subscribe = {topic[0]: topic for topic in topics
+                                      if topic[0].endswith('/cmd_vel')}
         for topic in topics:
             self.bag.add_topic(topic[0], topic[2], _bag_qos(topic[3]))
-            if topic[0] not in self.commands:
+            if topic[0] not in self.commands_to_subscribe:
                 self._subscribe(topic)
         self.bag.write_params({k: v for k, v in values.items() if k not in RECORD_ONLY},
                               self.get_clock().now().nanoseconds)
@@ -105,11 +105,11 @@ class RecorderNode(Node):
     def subscribe_commands(self):
         """Subscribe to robot i's cmd_vel once its pose and neighbours reach this recorder."""
         waiting = []
-        for name in list(self.commands):
+        for name in list(self.commands_to_subscribe):
             robot = name[:-len('/cmd_vel')]
             if all(self.subscriptions_by_topic[f'{robot}/{state}'].get_publisher_count() > 0
                    for state in ('pose', 'neighbors')):
-                self._subscribe(self.commands.pop(name))
+                self._subscribe(self.commands_to_subscribe.pop(name))
             else:
                 waiting.append(robot)
         if waiting:
