@@ -5,7 +5,7 @@ import os
 import signal
 
 from conftest import CONFIG, exe, write_params
-from formation_ros import qos
+from formation_ros import fields, qos
 from formation_ros.bag import read_messages
 from formation_ros.core.metrics import compute_metrics
 from formation_ros.core.params import load_config
@@ -50,8 +50,7 @@ def test_recorded_run_reads_back_and_agrees_with_the_plant(processes, install, p
     plant = Trajectory.load(str(out / 'trajectory.npz'))
     stepped = set(np.round(plant.t * 1e9).astype(np.int64).tolist())
     for i in range(1, 5):
-        recorded = {m.header.stamp.sec * 10 ** 9 + m.header.stamp.nanosec
-                    for _, m in topics[f'/robot_{i}/pose']}
+        recorded = {fields.stamp_to_ns(m.header.stamp) for _, m in topics[f'/robot_{i}/pose']}
         assert stepped <= recorded, sorted(stepped - recorded)[:10]
     printed = compute_metrics(plant.t, plant.q, plant.u, plant.u_hat, plant.q_desired, bound)
     assert from_bag['source'] == 'rosbag2'
@@ -78,7 +77,7 @@ def test_lockstep_bag_reproduces_formation_sim(processes, install, probe, tmp_pa
     poses = {}
     for i in range(config.num_robots):
         for _, message in topics[f'/robot_{i + 1}/pose']:
-            stamp = message.header.stamp.sec * 10 ** 9 + message.header.stamp.nanosec
+            stamp = fields.stamp_to_ns(message.header.stamp)
             poses.setdefault(stamp, {})[i] = (message.pose.position.x, message.pose.position.y)
     stamps = sorted(s for s, seen in poses.items() if len(seen) == config.num_robots)
     assert len(stamps) > 100
