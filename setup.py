@@ -23,8 +23,8 @@ setup(
     license='Apache-2.0',
     entry_points={
         'console_scripts': [
-            'formation_sim = formation_ros.sim:main',
-            'formation_report = formation_ros.report:main',
+            'formation_sim = formation_ros.tools.sim:main',
+            'formation_report = formation_ros.tools.report:main',
             'robot = formation_ros.nodes.robot:main',
             'plant = formation_ros.nodes.plant:main',
             'reference = formation_ros.nodes.reference:main',

@@ -5,12 +5,12 @@ import os
 import subprocess
 import sys
 
-from formation_ros.bag import (BagError, BagWriter, PARAMS_TOPIC, params_yaml, read_messages,
+from formation_ros.tools.bag import (BagError, BagWriter, PARAMS_TOPIC, params_yaml, read_messages,
                                TYPESTORE)
 from formation_ros.core.frames import frame_to_pose
 from formation_ros.core.params import load_config, load_params_file, parse_params_text, validate
-from formation_ros.report import main as report_main
-from formation_ros.sim import run_metrics, simulate
+from formation_ros.tools.report import main as report_main
+from formation_ros.tools.sim import run_metrics, simulate
 import numpy as np
 import pytest
 import yaml
@@ -183,7 +183,7 @@ def test_report_on_bag_without_parameters_says_why(tmp_path):
     config = load_config(os.path.join(CONFIG, 'square_4.yaml'))
     trajectory = simulate(config, duration=0.2, dt=0.01, sample_dt=0.05)
     write_run_as_bag(str(tmp_path / 'bag'), config, trajectory, with_params=False)
-    result = subprocess.run([sys.executable, '-m', 'formation_ros.report', str(tmp_path / 'bag'),
+    result = subprocess.run([sys.executable, '-m', 'formation_ros.tools.report', str(tmp_path / 'bag'),
                              '--out', str(tmp_path / 'out')], capture_output=True, text=True,
                             timeout=120)
     assert result.returncode == 2

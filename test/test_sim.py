@@ -8,9 +8,9 @@ import sys
 from formation_ros.core.law import log_potential
 from formation_ros.core.metrics import formation_errors
 from formation_ros.core.params import load_config, load_params_file, validate
-from formation_ros.plots import FIGURES
-from formation_ros.sim import run_metrics, simulate
-from formation_ros.trajectory import Trajectory
+from formation_ros.tools.plots import FIGURES
+from formation_ros.tools.sim import run_metrics, simulate
+from formation_ros.core.trajectory import Trajectory
 import numpy as np
 import pytest
 
@@ -86,7 +86,7 @@ def test_fixed_step_approaches_continuous_time():
 
 
 def run_cli(*args):
-    return subprocess.run([sys.executable, '-m', 'formation_ros.sim', *args],
+    return subprocess.run([sys.executable, '-m', 'formation_ros.tools.sim', *args],
                           capture_output=True, text=True, cwd=ROOT, timeout=300)
 
 

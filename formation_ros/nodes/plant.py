@@ -23,14 +23,14 @@ import os
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros import fields, messages, qos
+from formation_ros.ros import fields, messages, qos
 from formation_ros.core.frames import desired_positions, to_frame_velocity
 from formation_ros.core.metrics import closest_pair_distance, compute_metrics
-from formation_ros.markers import formation_markers
+from formation_ros.ros.markers import formation_markers
 from formation_ros.nodes.common import (declare_and_validate, diagnostics, DIAGNOSTICS_PERIOD,
                                         OnceLog, run)
-from formation_ros.report import PLANT_STATS
-from formation_ros.trajectory import Trajectory
+from formation_ros.tools.report import PLANT_STATS
+from formation_ros.core.trajectory import Trajectory
 from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
 import numpy as np
 from rclpy.clock import Clock, ClockType

@@ -18,8 +18,8 @@ parameters on /formation/params and in params.yaml, for ``formation_report``::
 import os
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros import qos
-from formation_ros.bag import BagError, BagWriter, qos_of
+from formation_ros.ros import qos
+from formation_ros.tools.bag import BagError, BagWriter, qos_of
 from formation_ros.core.params import ParamError
 from formation_ros.nodes.common import declare_and_validate, OnceLog, run
 from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped

@@ -13,7 +13,7 @@ the simulated clock. The topic is transient local: a late robot gets the latest 
 """
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros import fields, messages, qos
+from formation_ros.ros import fields, messages, qos
 from formation_ros.nodes.common import declare_and_validate, diagnostics, DIAGNOSTICS_PERIOD, run
 from nav_msgs.msg import Odometry
 from rclpy.clock import Clock, ClockType

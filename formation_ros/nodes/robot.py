@@ -16,7 +16,7 @@ how old it is (and, in lockstep, which state it answers).
 from collections import deque
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros import fields, messages, qos
+from formation_ros.ros import fields, messages, qos
 from formation_ros.core.frames import advance
 from formation_ros.core.law import robot_command
 from formation_ros.nodes.common import (declare_and_validate, diagnostics, DIAGNOSTICS_PERIOD,

@@ -6,7 +6,7 @@ Namespaces: ``robots`` (spheres), ``sensing`` (discs in 2D, balls in 3D, radius 
 Every marker is in frame 'world'; the arrays come from the plant.
 """
 
-from formation_ros.messages import ns_to_stamp, WORLD_FRAME
+from formation_ros.ros.messages import ns_to_stamp, WORLD_FRAME
 from geometry_msgs.msg import Point
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray

@@ -16,11 +16,11 @@ import json
 import os
 import sys
 
-from formation_ros.bag import (bag_params_text, BagError, PARAMS_FILE, PARAMS_TOPIC,
+from formation_ros.tools.bag import (bag_params_text, BagError, PARAMS_FILE, PARAMS_TOPIC,
                                plant_status, read_messages, trajectory_from_topics)
 from formation_ros.core.params import load_config, ParamError, parse_params_text, validate
-from formation_ros.sim import format_summary, run_metrics
-from formation_ros.trajectory import Trajectory
+from formation_ros.tools.sim import format_summary, run_metrics
+from formation_ros.core.trajectory import Trajectory
 
 PLANT_STATS = 'plant_stats.json'
 
@@ -94,7 +94,7 @@ def write_report(trajectory, config, out_dir, extra=None, plots=True):
         json.dump(metrics, stream, indent=2)
         stream.write('\n')
     if plots:
-        from formation_ros import plots as figures
+        from formation_ros.tools import plots as figures
         figures.write_figures(trajectory, config.law(), metrics, out_dir)
     return metrics
 

@@ -15,8 +15,8 @@ import os
 import shutil
 
 from formation_ros.core.frames import advance
-from formation_ros.fields import frame_of, NS_PER_S, position_of, stamp_to_ns, velocity_of
-from formation_ros.trajectory import Trajectory
+from formation_ros.ros.fields import frame_of, NS_PER_S, position_of, stamp_to_ns, velocity_of
+from formation_ros.core.trajectory import Trajectory
 import numpy as np
 from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, QosReliability
 from rosbags.interfaces import QosTime

@@ -18,7 +18,7 @@ from formation_ros.core.frames import desired_positions
 from formation_ros.core.law import team_command
 from formation_ros.core.metrics import compute_metrics
 from formation_ros.core.params import load_config, load_params_file, ParamError, validate
-from formation_ros.trajectory import Trajectory
+from formation_ros.core.trajectory import Trajectory
 import numpy as np
 from scipy.integrate import solve_ivp
 
@@ -213,7 +213,7 @@ def main(argv=None):
         json.dump(metrics, stream, indent=2)
         stream.write('\n')
     if not args.no_plots:
-        from formation_ros import plots
+        from formation_ros.tools import plots
         plots.write_figures(trajectory, config.law(), metrics, args.out)
     print(f'formation_sim: {integrator}, {duration:g} s simulated in {progress.elapsed:.1f} s')
     print(format_summary(metrics, args.out))

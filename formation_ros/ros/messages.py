@@ -2,7 +2,7 @@
 
 from builtin_interfaces.msg import Time
 from formation_ros.core.frames import frame_to_pose
-from formation_ros.fields import NS_PER_S
+from formation_ros.ros.fields import NS_PER_S
 from geometry_msgs.msg import Pose, PoseArray, PoseStamped, TwistStamped
 from nav_msgs.msg import Odometry
 
