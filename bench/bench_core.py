@@ -17,7 +17,7 @@ import time
 
 from formation_ros.core.law import team_command
 from formation_ros.core.params import validate
-from formation_ros.sim import simulate
+from formation_ros.tools.sim import simulate
 import numpy as np
 
 

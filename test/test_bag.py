@@ -5,10 +5,12 @@ import os
 import subprocess
 import sys
 
-from formation_ros.tools.bag import (BagError, BagWriter, PARAMS_TOPIC, params_yaml, read_messages,
-                               TYPESTORE)
 from formation_ros.core.frames import frame_to_pose
-from formation_ros.core.params import load_config, load_params_file, parse_params_text, validate
+from formation_ros.core.params import load_config, validate
+from formation_ros.core.params_file import dump_params_text, load_params_file, parse_params_text
+from formation_ros.ros.bag_writer import BagError, BagWriter, TYPESTORE
+from formation_ros.ros.topics import PARAMS as PARAMS_TOPIC
+from formation_ros.tools.bag import read_messages
 from formation_ros.tools.report import main as report_main
 from formation_ros.tools.sim import run_metrics, simulate
 import numpy as np
@@ -162,7 +164,7 @@ def test_bag_stores_its_parameters(tmp_path):
 
 def test_params_yaml_round_trip():
     raw = load_params_file(os.path.join(CONFIG, 'paper_section5.yaml'))
-    assert parse_params_text(params_yaml(raw), 'text') == raw
+    assert parse_params_text(dump_params_text(raw), 'text') == raw
 
 
 def test_refuses_to_overwrite(tmp_path):
@@ -183,9 +185,9 @@ def test_report_on_bag_without_parameters_says_why(tmp_path):
     config = load_config(os.path.join(CONFIG, 'square_4.yaml'))
     trajectory = simulate(config, duration=0.2, dt=0.01, sample_dt=0.05)
     write_run_as_bag(str(tmp_path / 'bag'), config, trajectory, with_params=False)
-    result = subprocess.run([sys.executable, '-m', 'formation_ros.tools.report', str(tmp_path / 'bag'),
-                             '--out', str(tmp_path / 'out')], capture_output=True, text=True,
-                            timeout=120)
+    result = subprocess.run([sys.executable, '-m', 'formation_ros.tools.report',
+                             str(tmp_path / 'bag'), '--out', str(tmp_path / 'out')],
+                            capture_output=True, text=True, timeout=120)
     assert result.returncode == 2
     assert 'has no parameters' in result.stderr and 'Traceback' not in result.stderr
     assert not (tmp_path / 'out').exists()

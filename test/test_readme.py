@@ -2,7 +2,7 @@
 
 import os
 
-from formation_ros.core.params import SCHEMA
+from formation_ros.core.declarations import DECLARATIONS as SCHEMA
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 

@@ -7,10 +7,11 @@ import sys
 
 from formation_ros.core.law import log_potential
 from formation_ros.core.metrics import formation_errors
-from formation_ros.core.params import load_config, load_params_file, validate
+from formation_ros.core.params import load_config, validate
+from formation_ros.core.params_file import load_params_file
+from formation_ros.core.trajectory import Trajectory
 from formation_ros.tools.plots import FIGURES
 from formation_ros.tools.sim import run_metrics, simulate
-from formation_ros.core.trajectory import Trajectory
 import numpy as np
 import pytest
 

@@ -16,99 +16,91 @@ parameters on /formation/params and in params.yaml, for ``formation_report``::
 """
 
 import os
+from typing import Any, Dict, List, Optional, Tuple
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros.ros import qos
-from formation_ros.tools.bag import BagError, BagWriter, qos_of
-from formation_ros.core.params import ParamError
-from formation_ros.nodes.common import declare_and_validate, OnceLog, run
+from formation_ros.core.declarations import Exe, ParamError, RECORDER_ONLY
+from formation_ros.ros import qos, topics
+from formation_ros.ros.bag_writer import BagError, BagWriter, qos_of
+from formation_ros.ros.once import OnceLog
+from formation_ros.ros.parameters import declare_parameters
+from formation_ros.ros.runner import run
 from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
 from nav_msgs.msg import Odometry
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
+from rclpy.qos import QoSProfile
 from rosgraph_msgs.msg import Clock as ClockMsg
 from visualization_msgs.msg import MarkerArray
 
 FLUSH_PERIOD = 0.2
 MATCH_PERIOD = 0.02
-RECORD_ONLY = ('record.path', 'record.overwrite', 'record.markers')
+MESSAGE_CLASSES = {
+    'geometry_msgs/msg/PoseStamped': PoseStamped,
+    'geometry_msgs/msg/PoseArray': PoseArray,
+    'geometry_msgs/msg/TwistStamped': TwistStamped,
+    'nav_msgs/msg/Odometry': Odometry,
+    'rosgraph_msgs/msg/Clock': ClockMsg,
+    'diagnostic_msgs/msg/DiagnosticArray': DiagnosticArray,
+    'visualization_msgs/msg/MarkerArray': MarkerArray,
+}
 
 
-def _bag_qos(profile):
+def _bag_qos(profile: QoSProfile) -> Any:
     return qos_of(reliable=profile.reliability == qos.COMMAND.reliability,
                   transient_local=profile.durability == qos.REFERENCE.durability,
                   depth=profile.depth)
 
 
-def robot_topics(i):
-    """Return [(topic, message class, ROS type name, QoS profile)] of robot i (1-based)."""
-    return [
-        (f'/robot_{i}/pose', PoseStamped, 'geometry_msgs/msg/PoseStamped', qos.STATE),
-        (f'/robot_{i}/neighbors', PoseArray, 'geometry_msgs/msg/PoseArray', qos.STATE),
-        (f'/robot_{i}/cmd_vel', TwistStamped, 'geometry_msgs/msg/TwistStamped', qos.COMMAND),
-    ]
-
-
-def formation_topics(num_robots, markers):
-    """Return [(topic, message class, ROS type name, QoS profile)] the recorder subscribes to."""
-    topics = [topic for i in range(1, num_robots + 1) for topic in robot_topics(i)]
-    topics += [
-        ('/formation/reference', Odometry, 'nav_msgs/msg/Odometry', qos.REFERENCE),
-        ('/clock', ClockMsg, 'rosgraph_msgs/msg/Clock', qos.CLOCK),
-        ('/diagnostics', DiagnosticArray, 'diagnostic_msgs/msg/DiagnosticArray',
-         qos.DIAGNOSTICS),
-    ]
-    if markers:
-        topics.append(('/formation/markers', MarkerArray, 'visualization_msgs/msg/MarkerArray',
-                       qos.MARKERS))
-    return topics
-
-
 class RecorderNode(Node):
     """Buffers serialized messages in callbacks; a timer writes them to the bag."""
 
-    def __init__(self, **kwargs):
+    def __init__(self) -> None:
         """Declare and check parameters, open the bag, subscribe to every formation topic."""
-        super().__init__('record', **kwargs)
-        config = declare_and_validate(self, 'record')
-        values = config.values
-        self.path = os.path.abspath(values['record.path'])
+        super().__init__('record')
+        config = declare_parameters(self, Exe.RECORD)
+        settings = config.recorder
+        assert settings is not None
+        self.path = os.path.abspath(settings.path)
         try:
-            self.bag = BagWriter(self.path, overwrite=values['record.overwrite'])
+            self.bag = BagWriter(self.path, overwrite=settings.overwrite)
         except BagError as exc:
             raise ParamError([('record.path', str(exc))]) from None
-        self.pending = []
+        self.pending: List[Tuple[str, int, bytes]] = []
         self.once = OnceLog(self.get_logger())
-        self.subscriptions_by_topic = {}
-        topics = formation_topics(config.num_robots, values['record.markers'])
-        self.commands_to_subscribe = {topic[0]: topic for topic in topics
-                                      if topic[0].endswith('/cmd_vel')}
-        for topic in topics:
-            self.bag.add_topic(topic[0], topic[2], _bag_qos(topic[3]))
-            if topic[0] not in self.commands_to_subscribe:
+        self.subscriptions_by_topic: Dict[str, Any] = {}
+        recorded = topics.recorded_topics(config.num_robots, settings.markers)
+        command_names = {topics.robot_topic(i, topics.CMD_VEL)
+                         for i in range(1, config.num_robots + 1)}
+        self.commands_to_subscribe = {topic.name: topic for topic in recorded
+                                      if topic.name in command_names}
+        for topic in recorded:
+            self.bag.add_topic(topic.name, topic.type_name, _bag_qos(qos.BY_KIND[topic.qos]))
+            if topic.name not in self.commands_to_subscribe:
                 self._subscribe(topic)
-        self.bag.write_params({k: v for k, v in values.items() if k not in RECORD_ONLY},
+        self.bag.write_params({k: v for k, v in config.values.items()
+                               if k not in RECORDER_ONLY},
                               self.get_clock().now().nanoseconds)
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         self.timer = self.create_timer(FLUSH_PERIOD, self.flush, clock=steady)
         self.match_timer = self.create_timer(MATCH_PERIOD, self.subscribe_commands,
                                              clock=steady)
-        self.get_logger().info(f'recording {len(topics)} topics and the parameters '
-                               f'(/formation/params) to {self.path}')
+        self.get_logger().info(f'recording {len(recorded)} topics and the parameters '
+                               f'({topics.PARAMS}) to {self.path}')
 
-    def _subscribe(self, topic):
-        name, msg_class, _, profile = topic
+    def _subscribe(self, topic: topics.Topic) -> None:
+        name = topic.name
         self.subscriptions_by_topic[name] = self.create_subscription(
-            msg_class, name, lambda data: self.on_message(name, data), qos.recording(profile),
-            raw=True)
+            MESSAGE_CLASSES[topic.type_name], name, lambda data: self.on_message(name, data),
+            qos.recording(qos.BY_KIND[topic.qos]), raw=True)
 
-    def subscribe_commands(self):
+    def subscribe_commands(self) -> None:
         """Subscribe to robot i's cmd_vel once its pose and neighbours reach this recorder."""
         waiting = []
         for name in list(self.commands_to_subscribe):
-            robot = name[:-len('/cmd_vel')]
+            robot = name[:-len(topics.CMD_VEL) - 1]
             if all(self.subscriptions_by_topic[f'{robot}/{state}'].get_publisher_count() > 0
-                   for state in ('pose', 'neighbors')):
+                   for state in (topics.POSE, topics.NEIGHBOURS)):
                 self._subscribe(self.commands_to_subscribe.pop(name))
             else:
                 waiting.append(robot)
@@ -122,17 +114,17 @@ class RecorderNode(Node):
                                   'recording every cmd_vel')
         self.match_timer.cancel()
 
-    def on_message(self, topic, data):
+    def on_message(self, topic: str, data: bytes) -> None:
         """Keep a serialized message with its receive time until the next flush."""
         self.pending.append((topic, self.get_clock().now().nanoseconds, data))
 
-    def flush(self):
+    def flush(self) -> None:
         """Write the buffered messages to the bag."""
         pending, self.pending = self.pending, []
         for topic, stamp, data in pending:
             self.bag.write(topic, stamp, data)
 
-    def finish(self):
+    def finish(self) -> None:
         """Write what is left and finish the bag (metadata.yaml)."""
         self.flush()
         self.bag.close()
@@ -142,6 +134,6 @@ class RecorderNode(Node):
                                f'{self.path}')
 
 
-def main(args=None):
+def main(args: Optional[List[str]] = None) -> int:
     """Entry point of ``ros2 run formation_ros record``."""
     return run(RecorderNode, args, name='record')

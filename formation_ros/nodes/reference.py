@@ -12,9 +12,14 @@ e.g. while it waits for the robots. In lockstep it publishes one sample for ever
 the simulated clock. The topic is transient local: a late robot gets the latest sample.
 """
 
+from typing import List, Optional
+
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros.ros import fields, messages, qos
-from formation_ros.nodes.common import declare_and_validate, diagnostics, DIAGNOSTICS_PERIOD, run
+from formation_ros.core.declarations import Exe
+from formation_ros.ros import fields, messages, qos, topics
+from formation_ros.ros.diagnostics import diagnostics, PERIOD
+from formation_ros.ros.parameters import declare_parameters
+from formation_ros.ros.runner import run
 from nav_msgs.msg import Odometry
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
@@ -25,34 +30,36 @@ LOCKSTEP_POLL = 0.001
 class ReferenceNode(Node):
     """Publishes q_od(t), J(t), qdot_od(t) and the frame's angular velocity."""
 
-    def __init__(self, **kwargs):
+    def __init__(self) -> None:
         """Declare and check parameters, then start publishing."""
-        super().__init__('reference', **kwargs)
-        config = declare_and_validate(self, 'reference')
+        super().__init__('reference')
+        config = declare_parameters(self, Exe.REFERENCE)
+        settings = config.reference_node
+        assert settings is not None
         self.dim = config.dim
         self.reference = config.reference()
-        self.lockstep = config.values['plant.lockstep']
+        self.lockstep = config.lockstep
         self.sim_time = self.get_parameter('use_sim_time').value
         self.epoch_ns = 0 if self.sim_time else self.get_clock().now().nanoseconds
-        self.last_stamp = None
-        self.pub = self.create_publisher(Odometry, '/formation/reference', qos.REFERENCE)
+        self.last_stamp: Optional[int] = None
+        self.pub = self.create_publisher(Odometry, topics.REFERENCE, qos.REFERENCE)
         self.published = 0
-        self.diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics',
+        self.diagnostics_pub = self.create_publisher(DiagnosticArray, topics.DIAGNOSTICS,
                                                      qos.DIAGNOSTICS)
         self.diagnostics_timer = self.create_timer(
-            DIAGNOSTICS_PERIOD, self.on_diagnostics, clock=Clock(clock_type=ClockType.STEADY_TIME))
-        period = LOCKSTEP_POLL if self.lockstep else 1.0 / config.values['reference.rate']
+            PERIOD, self.on_diagnostics, clock=Clock(clock_type=ClockType.STEADY_TIME))
+        period = LOCKSTEP_POLL if self.lockstep else 1.0 / settings.rate
         self.timer = self.create_timer(period, self.on_timer,
                                        clock=Clock(clock_type=ClockType.STEADY_TIME))
         self.get_logger().info(
             f'reference: {self.reference.kind} in {self.dim}D, '
-            + ('lockstep' if self.lockstep else f"{config.values['reference.rate']:g} Hz")
+            + ('lockstep' if self.lockstep else f'{settings.rate:g} Hz')
             + (', simulated time' if self.sim_time else ', wall-clock time from start'))
         if self.lockstep and not self.sim_time:
             self.get_logger().warning('lockstep without use_sim_time: samples will not match '
                                       'the plant state stamps')
 
-    def on_timer(self):
+    def on_timer(self) -> None:
         """Publish the sample of the current time (in lockstep: only when the clock moved)."""
         stamp = self.get_clock().now().nanoseconds
         if self.lockstep and stamp == self.last_stamp:
@@ -62,17 +69,16 @@ class ReferenceNode(Node):
         self.pub.publish(messages.reference_odometry(frame, stamp, self.dim))
         self.published += 1
 
-    def on_diagnostics(self):
+    def on_diagnostics(self) -> None:
         """Publish the reference node's status: kind, time, samples published."""
         values = {'kind': self.reference.kind, 'samples published': self.published,
                   'time [s]': ('none yet' if self.last_stamp is None
                                else (self.last_stamp - self.epoch_ns) / fields.NS_PER_S)}
         level, message = ('ok', 'publishing') if self.published else ('warn', 'no sample yet')
-        self.diagnostics_pub.publish(diagnostics(self.get_clock().now().to_msg(),
-                                                 'formation_ros/reference', level, message,
+        self.diagnostics_pub.publish(diagnostics('formation_ros/reference', level, message,
                                                  values))
 
 
-def main(args=None):
+def main(args: Optional[List[str]] = None) -> int:
     """Entry point of ``ros2 run formation_ros reference``."""
     return run(ReferenceNode, args, name='reference')

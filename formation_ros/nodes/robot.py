@@ -1,10 +1,10 @@
 r"""
 Robot node (executable ``robot``): one robot's bounded formation controller.
 
-It knows its own position (``pose``), the robots its range sensor sees (``neighbors``) and the
-desired formation frame (``/formation/reference``), and publishes ``cmd_vel`` with linear =
-u_i of eqs. (14), (25), computed by ``core.law.robot_command``. Run one per robot, each in its
-namespace::
+It knows its own position (``pose``), the robots its range sensor sees (its neighbours, on
+``neighbors``) and the desired formation frame (``/formation/reference``), and publishes
+``cmd_vel`` with linear = u_i of eqs. (14), (25), computed by ``core.law.robot_command``. Run
+one per robot, each in its namespace::
 
     ros2 run formation_ros robot --ros-args -r __ns:=/robot_1 -p robot_id:=1 \\
         --params-file config/paper_section5.yaml
@@ -14,13 +14,17 @@ how old it is (and, in lockstep, which state it answers).
 """
 
 from collections import deque
+from typing import List, Optional
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros.ros import fields, messages, qos
-from formation_ros.core.frames import advance
-from formation_ros.core.law import robot_command
-from formation_ros.nodes.common import (declare_and_validate, diagnostics, DIAGNOSTICS_PERIOD,
-                                        OnceLog, run)
+from formation_ros.core.declarations import Exe
+from formation_ros.core.frames import advance, FrameSample
+from formation_ros.core.law import Command, robot_command
+from formation_ros.ros import fields, messages, qos, topics
+from formation_ros.ros.diagnostics import diagnostics, PERIOD
+from formation_ros.ros.once import OnceLog
+from formation_ros.ros.parameters import declare_parameters
+from formation_ros.ros.runner import run
 from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
 from nav_msgs.msg import Odometry
 import numpy as np
@@ -29,7 +33,7 @@ from rclpy.node import Node
 
 LOCKSTEP_POLL = 0.001
 REFERENCE_BUFFER = 64
-INPUTS = ('pose', 'neighbors', 'reference')
+INPUTS = ('pose', 'neighbour', 'reference')
 
 
 class RobotNode(Node):
@@ -38,50 +42,50 @@ class RobotNode(Node):
     def __init__(self, **kwargs):
         """Declare and check parameters, then set up topics and the control timer."""
         super().__init__('robot', **kwargs)
-        config = declare_and_validate(self, 'robot')
-        values = config.values
+        config = declare_parameters(self, Exe.ROBOT)
+        settings = config.robot
+        assert settings is not None
         self.dim = config.dim
-        self.index = values['robot_id'] - 1
+        self.index = settings.robot_id - 1
         self.vertex = config.vertices[self.index]
         self.sensing_radius = float(config.sensing_radii[self.index])
         self.law = config.law()
-        self.lockstep = values['plant.lockstep']
-        self.timeout_ns = int(values['input_timeout'] * 1e9)
+        self.lockstep = config.lockstep
+        self.timeout_ns = int(settings.input_timeout * fields.NS_PER_S)
         self.once = OnceLog(self.get_logger())
         self.steady = Clock(clock_type=ClockType.STEADY_TIME)
 
-        self.pose = None
-        self.neighbors = None
-        self.references = deque(maxlen=REFERENCE_BUFFER)
+        self.pose: Optional[PoseStamped] = None
+        self.neighbours: Optional[PoseArray] = None
+        self.references: deque = deque(maxlen=REFERENCE_BUFFER)
         self.received_ns = dict.fromkeys(INPUTS)
         self.pose_count = 0
         self.answered_count = 0
         self.rejected = dict.fromkeys(INPUTS, 0)
-        self.last = None
+        self.last: Optional[Command] = None
         self.waiting = True
-        self.wait_subscribers = values['wait_for_subscribers']
+        self.wait_subscribers = settings.wait_for_subscribers
 
-        self.create_subscription(PoseStamped, 'pose', self.on_pose, qos.STATE)
-        self.create_subscription(PoseArray, 'neighbors', self.on_neighbors, qos.STATE)
-        self.create_subscription(Odometry, '/formation/reference', self.on_reference,
-                                 qos.REFERENCE)
-        self.cmd_pub = self.create_publisher(TwistStamped, 'cmd_vel', qos.COMMAND)
-        self.diagnostics_pub = self.create_publisher(DiagnosticArray, '/diagnostics',
+        self.create_subscription(PoseStamped, topics.POSE, self.on_pose, qos.STATE)
+        self.create_subscription(PoseArray, topics.NEIGHBOURS, self.on_neighbours, qos.STATE)
+        self.create_subscription(Odometry, topics.REFERENCE, self.on_reference, qos.REFERENCE)
+        self.cmd_pub = self.create_publisher(TwistStamped, topics.CMD_VEL, qos.COMMAND)
+        self.diagnostics_pub = self.create_publisher(DiagnosticArray, topics.DIAGNOSTICS,
                                                      qos.DIAGNOSTICS)
-        self.diagnostics_timer = self.create_timer(DIAGNOSTICS_PERIOD, self.on_diagnostics,
+        self.diagnostics_timer = self.create_timer(PERIOD, self.on_diagnostics,
                                                    clock=self.steady)
-        period = LOCKSTEP_POLL if self.lockstep else 1.0 / values['control_rate']
+        period = LOCKSTEP_POLL if self.lockstep else 1.0 / settings.control_rate
         self.timer = self.create_timer(period, self.on_timer, clock=self.steady)
         self.get_logger().info(
             f'robot {self.index + 1}/{config.num_robots}: vertex {np.round(self.vertex, 4)}, '
             f'R_i = {self.sensing_radius:g} m, b = {config.repulsion_radius:g} m, '
             f'bound c*M1 = {self.law.u_bound:.4g} m/s, '
-            + ('lockstep' if self.lockstep else f"{values['control_rate']:g} Hz"))
+            + ('lockstep' if self.lockstep else f'{settings.control_rate:g} Hz'))
 
-    def _now_ns(self):
+    def _now_ns(self) -> int:
         return self.steady.now().nanoseconds
 
-    def _accept(self, name, finite):
+    def _accept(self, name: str, finite: bool) -> bool:
         if finite:
             return True
         self.rejected[name] += 1
@@ -89,7 +93,7 @@ class RobotNode(Node):
                                        '(logged once; diagnostics count them)', 'error')
         return False
 
-    def on_pose(self, msg):
+    def on_pose(self, msg: PoseStamped) -> None:
         """Store the latest own pose."""
         p = msg.pose.position
         if self._accept('pose', np.all(np.isfinite([p.x, p.y, p.z]))):
@@ -97,21 +101,21 @@ class RobotNode(Node):
             self.pose_count += 1
             self.received_ns['pose'] = self._now_ns()
 
-    def on_neighbors(self, msg):
+    def on_neighbours(self, msg: PoseArray) -> None:
         """Store the latest sensed neighbour positions."""
         finite = all(np.isfinite([p.position.x, p.position.y, p.position.z]).all()
                      for p in msg.poses)
-        if self._accept('neighbors', finite):
-            self.neighbors = msg
-            self.received_ns['neighbors'] = self._now_ns()
+        if self._accept('neighbour', finite):
+            self.neighbours = msg
+            self.received_ns['neighbour'] = self._now_ns()
 
-    def on_reference(self, msg):
+    def on_reference(self, msg: Odometry) -> None:
         """Store a reference sample (a few are kept to match state stamps in lockstep)."""
         if self._accept('reference', fields.odometry_is_finite(msg)):
             self.references.append(msg)
             self.received_ns['reference'] = self._now_ns()
 
-    def _reference_for(self, stamp_ns, exact):
+    def _reference_for(self, stamp_ns: int, exact: bool) -> Optional[FrameSample]:
         """Return the reference frame at ``stamp_ns``: that sample, else the newest carried on."""
         for msg in reversed(self.references):
             if fields.stamp_to_ns(msg.header.stamp) == stamp_ns:
@@ -121,17 +125,17 @@ class RobotNode(Node):
         newest = fields.frame_of(self.references[-1], self.dim)
         return advance(newest, stamp_ns / fields.NS_PER_S - newest.t)
 
-    def _command(self, stamp_ns, exact):
+    def _command(self, stamp_ns: int, exact: bool) -> Optional[np.ndarray]:
         frame = self._reference_for(stamp_ns, exact)
         if frame is None:
             return None
-        neighbours = fields.points_of(self.neighbors, self.dim)
+        neighbours = fields.points_of(self.neighbours, self.dim)
         own = fields.position_of(self.pose, self.dim)
         self.last = robot_command(own, self.vertex, neighbours, self.sensing_radius, self.law,
                                   frame)
         return self.last.u
 
-    def on_timer(self):
+    def on_timer(self) -> None:
         """Compute and publish the command (or zero when inputs are stale)."""
         if self.lockstep:
             self._lockstep_answer()
@@ -152,7 +156,7 @@ class RobotNode(Node):
         self.cmd_pub.publish(messages.twist_stamped(self._command(stamp, False), stamp,
                                                     self.dim))
 
-    def _ready(self):
+    def _ready(self) -> bool:
         """Start-up: every input heard once and cmd_vel has its subscribers (plant, recorder)."""
         never = [name for name in INPUTS if self.received_ns[name] is None]
         listeners = self.cmd_pub.get_subscription_count()
@@ -165,14 +169,14 @@ class RobotNode(Node):
         self.waiting = False
         return True
 
-    def _lockstep_answer(self):
+    def _lockstep_answer(self) -> None:
         """Answer each state the plant sends, once, with the reference sample of its stamp."""
-        if self.pose is None or self.neighbors is None or self.pose_count == self.answered_count:
+        if self.pose is None or self.neighbours is None or self.pose_count == self.answered_count:
             return
         if self.waiting and not self._ready():
             return
         stamp = fields.stamp_to_ns(self.pose.header.stamp)
-        if fields.stamp_to_ns(self.neighbors.header.stamp) != stamp:
+        if fields.stamp_to_ns(self.neighbours.header.stamp) != stamp:
             return
         command = self._command(stamp, True)
         if command is None:
@@ -180,14 +184,14 @@ class RobotNode(Node):
         self.cmd_pub.publish(messages.twist_stamped(command, stamp, self.dim))
         self.answered_count = self.pose_count
 
-    def on_diagnostics(self):
+    def on_diagnostics(self) -> None:
         """Publish this robot's status: input ages, neighbours in range, command size."""
         now = self._now_ns()
-        values = {f'{name} age [s]': ('never' if self.received_ns[name] is None
-                                      else (now - self.received_ns[name]) / 1e9)
+        values = {f'{name} message age [s]': ('never' if self.received_ns[name] is None
+                                              else (now - self.received_ns[name]) / 1e9)
                   for name in INPUTS}
-        if self.neighbors is not None and self.pose is not None:
-            gaps = np.linalg.norm(fields.points_of(self.neighbors, self.dim)
+        if self.neighbours is not None and self.pose is not None:
+            gaps = np.linalg.norm(fields.points_of(self.neighbours, self.dim)
                                   - fields.position_of(self.pose, self.dim), axis=1)
             values['neighbours heard'] = len(gaps)
             values['neighbours within R_i'] = int(np.count_nonzero(gaps < self.sensing_radius))
@@ -204,11 +208,10 @@ class RobotNode(Node):
             level, message = 'warn', 'publishing zero: inputs stale'
         else:
             level, message = 'ok', 'lockstep' if self.lockstep else 'controlling'
-        self.diagnostics_pub.publish(diagnostics(
-            self.get_clock().now().to_msg(), f'formation_ros/robot_{self.index + 1}', level,
-            message, values))
+        self.diagnostics_pub.publish(diagnostics(f'formation_ros/robot_{self.index + 1}', level,
+                                                 message, values))
 
 
-def main(args=None):
+def main(args: Optional[List[str]] = None) -> int:
     """Entry point of ``ros2 run formation_ros robot``."""
     return run(RobotNode, args, name='robot')

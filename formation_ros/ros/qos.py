@@ -19,6 +19,7 @@ The recorder subscribes with the publishers' reliability and durability but a de
 overwritten by the next one.
 """
 
+from formation_ros.ros.topics import QosKind
 from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
 
 
@@ -33,12 +34,14 @@ STATE = _profile(1, ReliabilityPolicy.BEST_EFFORT, DurabilityPolicy.VOLATILE)
 CLOCK = _profile(1, ReliabilityPolicy.RELIABLE, DurabilityPolicy.VOLATILE)
 DIAGNOSTICS = _profile(10, ReliabilityPolicy.RELIABLE, DurabilityPolicy.VOLATILE)
 MARKERS = _profile(1, ReliabilityPolicy.RELIABLE, DurabilityPolicy.TRANSIENT_LOCAL)
+BY_KIND = {QosKind.COMMAND: COMMAND, QosKind.REFERENCE: REFERENCE, QosKind.STATE: STATE,
+           QosKind.CLOCK: CLOCK, QosKind.DIAGNOSTICS: DIAGNOSTICS, QosKind.MARKERS: MARKERS}
 
 
 RECORDING_DEPTH = 1000
 
 
-def recording(profile):
+def recording(profile: QoSProfile) -> QoSProfile:
     """Return ``profile`` with the recorder's deep history (same reliability and durability)."""
     return _profile(max(profile.depth, RECORDING_DEPTH), profile.reliability,
                     profile.durability)

@@ -15,45 +15,52 @@ import argparse
 import json
 import os
 import sys
+from typing import Any, Dict, Optional, Tuple
 
-from formation_ros.tools.bag import (bag_params_text, BagError, PARAMS_FILE, PARAMS_TOPIC,
-                               plant_status, read_messages, trajectory_from_topics)
-from formation_ros.core.params import load_config, ParamError, parse_params_text, validate
-from formation_ros.tools.sim import format_summary, run_metrics
+from formation_ros.core.declarations import ParamError
+from formation_ros.core.params import FormationConfig, load_config, validate
+from formation_ros.core.params_file import parse_params_text
+from formation_ros.core.plant import PLANT_STATS_FILE
 from formation_ros.core.trajectory import Trajectory
+from formation_ros.ros import topics as names
+from formation_ros.ros.bag_writer import BagError, PARAMS_FILE
+from formation_ros.tools.bag import (bag_params_text, plant_status, read_messages,
+                                     trajectory_from_topics)
+from formation_ros.tools.sim import format_summary, run_metrics
 
-PLANT_STATS = 'plant_stats.json'
+Loaded = Tuple[Trajectory, FormationConfig, Dict[str, Any]]
 
 
 class ReportError(Exception):
     """The input cannot be reported on; the message says why."""
 
 
-def load_bag(path):
+def load_bag(path: str) -> Loaded:
     """Return (Trajectory, FormationConfig, extra metrics) of a recorded bag."""
     try:
-        topics, counts = read_messages(path)
+        recorded, counts = read_messages(path)
     except (BagError, OSError, ValueError) as exc:
         raise ReportError(f'{path}: cannot read the bag: {exc}') from None
-    text = bag_params_text(path, topics)
+    text = bag_params_text(path, recorded)
     if text is None:
-        raise ReportError(f'{path}: the bag has no parameters (no {PARAMS_TOPIC} message and no '
+        raise ReportError(f'{path}: the bag has no parameters (no {names.PARAMS} message and '
+                          'no '
                           f'{PARAMS_FILE}); without the formation and the bound it cannot be '
                           'interpreted. Record with the record node (it stores them) or put '
                           f'the parameters file there as {PARAMS_FILE}.')
     try:
         config = validate(parse_params_text(text, f'{path} parameters'))
-        trajectory, info = trajectory_from_topics(topics, config)
+        trajectory, info = trajectory_from_topics(recorded, config)
     except (ParamError, BagError) as exc:
         raise ReportError(f'{path}: {exc}') from None
     extra = {'source': 'rosbag2', 'integrator': 'recorded run (rosbag2)',
              'messages': int(sum(counts.values()))}
     extra.update(info)
-    extra.update(plant_status(topics))
+    extra.update(plant_status(recorded))
     return trajectory, config, extra
 
 
-def load_run(path):
+def load_run(path: str) -> Loaded:
     """Return (Trajectory, FormationConfig, extra metrics) of a bag or a run directory."""
     if not os.path.isdir(path):
         raise ReportError(f'{path}: not a directory')
@@ -76,14 +83,15 @@ def load_run(path):
                           f'{trajectory.q.shape[2]}D but params.yaml says {config.num_robots} '
                           f'in {config.dim}D')
     extra = {}
-    stats = os.path.join(path, PLANT_STATS)
+    stats = os.path.join(path, PLANT_STATS_FILE)
     if os.path.exists(stats):
         with open(stats, encoding='utf-8') as stream:
             extra = json.load(stream)
     return trajectory, config, extra
 
 
-def write_report(trajectory, config, out_dir, extra=None, plots=True):
+def write_report(trajectory: Trajectory, config: FormationConfig, out_dir: str,
+                 extra: Optional[Dict[str, Any]] = None, plots: bool = True) -> dict:
     """Write metrics.json (and the figures) to ``out_dir``; return the metrics."""
     extra = dict(extra or {})
     integrator = extra.pop('integrator', 'recorded run')
@@ -99,7 +107,7 @@ def write_report(trajectory, config, out_dir, extra=None, plots=True):
     return metrics
 
 
-def main(argv=None):
+def main(argv: Optional[list] = None) -> int:
     """Entry point of ``formation_report``; returns the exit code."""
     parser = argparse.ArgumentParser(
         prog='formation_report',

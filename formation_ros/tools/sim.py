@@ -13,11 +13,16 @@ import os
 import shutil
 import sys
 import time
+from typing import Optional, TextIO
 
+from formation_ros.core.declarations import DEFAULT_COLLISION_DISTANCE, Exe, ParamError
 from formation_ros.core.frames import desired_positions
 from formation_ros.core.law import team_command
 from formation_ros.core.metrics import compute_metrics
-from formation_ros.core.params import load_config, load_params_file, ParamError, validate
+from formation_ros.core.params import (FormationConfig, load_config,
+                                       validate_for_every_executable)
+from formation_ros.core.params_file import load_params_file
+from formation_ros.core.plant import Commands, NS_PER_S, PlantModel
 from formation_ros.core.trajectory import Trajectory
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -30,7 +35,7 @@ DEFAULT_SAMPLE_DT = 0.01
 class Progress:
     """Prints how far a long run is, at most every 10 % of simulated time, once past 2 s wall."""
 
-    def __init__(self, duration, stream=sys.stderr, quiet=False):
+    def __init__(self, duration: float, stream: TextIO = sys.stderr, quiet: bool = False):
         """Track a run of ``duration`` simulated seconds."""
         self.duration = duration
         self.stream = stream
@@ -38,7 +43,7 @@ class Progress:
         self.start = time.monotonic()
         self.next_mark = 0.1
 
-    def update(self, t):
+    def update(self, t: float) -> None:
         """Report simulated time t if a new 10 % mark was passed and the run is slow enough."""
         fraction = t / self.duration
         if self.quiet or fraction < self.next_mark:
@@ -51,12 +56,12 @@ class Progress:
                   file=self.stream, flush=True)
 
     @property
-    def elapsed(self):
+    def elapsed(self) -> float:
         """Wall-clock seconds since the start."""
         return time.monotonic() - self.start
 
 
-def sample_times(duration, sample_dt):
+def sample_times(duration: float, sample_dt: float) -> np.ndarray:
     """Sample times 0, sample_dt, ..., duration (the end always included): (T,)."""
     count = int(math.floor(duration / sample_dt + 1e-9))
     times = np.arange(count + 1) * sample_dt
@@ -78,7 +83,9 @@ def _assemble(times, states, config, law, reference):
                       q_desired=np.array(desired), q_od=np.array(centres))
 
 
-def simulate(config, duration=None, dt=None, sample_dt=DEFAULT_SAMPLE_DT, progress=None):
+def simulate(config: FormationConfig, duration: Optional[float] = None,
+             dt: Optional[float] = None, sample_dt: float = DEFAULT_SAMPLE_DT,
+             progress: Optional[Progress] = None) -> Trajectory:
     """
     Run the closed loop from ``config.start`` and return a :class:`Trajectory`.
 
@@ -87,51 +94,74 @@ def simulate(config, duration=None, dt=None, sample_dt=DEFAULT_SAMPLE_DT, progre
     ``dt`` it is rounded to a whole number of steps, at least one).
     """
     duration = config.duration if duration is None else float(duration)
+    progress = progress or Progress(duration, quiet=True)
+    if dt is not None:
+        return simulate_fixed_step(config, duration, dt, sample_dt, progress)
     law = config.law()
     reference = config.reference()
-    progress = progress or Progress(duration, quiet=True)
     n, dim = config.num_robots, config.dim
+    assert config.start is not None
 
-    if dt is None:
-        def rhs(t, y):
-            progress.update(t)
-            q = y.reshape(n, dim)
-            frame = reference.sample(t)
-            return team_command(q, config.vertices, config.sensing_radii, law, frame).u.ravel()
-
-        times = sample_times(duration, sample_dt)
-        solution = solve_ivp(rhs, (0.0, duration), config.start.ravel(), method='RK45',
-                             t_eval=times, rtol=RTOL, atol=ATOL)
-        if not solution.success:
-            raise RuntimeError(f'RK45 failed: {solution.message}')
-        states = solution.y.T.reshape(-1, n, dim)
-        return _assemble(solution.t, states, config, law, reference)
-
-    steps = int(round(duration / dt))
-    stride = max(1, int(round(sample_dt / dt)))
-    q = config.start.copy()
-    times, states = [], []
-    for k in range(steps + 1):
-        t = k * dt
-        if k % stride == 0 or k == steps:
-            times.append(t)
-            states.append(q)
-        if k == steps:
-            break
+    def rhs(t: float, y: np.ndarray) -> np.ndarray:
         progress.update(t)
         frame = reference.sample(t)
-        q = q + dt * team_command(q, config.vertices, config.sensing_radii, law, frame).u
-    return _assemble(times, states, config, law, reference)
+        return team_command(y.reshape(n, dim), config.vertices, config.sensing_radii, law,
+                            frame).u.ravel()
+
+    times = sample_times(duration, sample_dt)
+    solution = solve_ivp(rhs, (0.0, duration), config.start.ravel(), method='RK45',
+                         t_eval=times, rtol=RTOL, atol=ATOL)
+    if not solution.success:
+        raise RuntimeError(f'RK45 failed: {solution.message}')
+    states = solution.y.T.reshape(-1, n, dim)
+    return _assemble(solution.t, states, config, law, reference)
 
 
-def run_metrics(trajectory, config, integrator):
+def simulate_fixed_step(config: FormationConfig, duration: float, dt: float,
+                        sample_dt: float, progress: Progress) -> Trajectory:
+    """
+    Step the plant model (``core.plant``) with the law's commands, as the plant node does.
+
+    Every robot answers every state at once (a lockstep run without the network): the model
+    admits the commands, audits the bound and integrates with zero-order hold over ``dt``.
+    """
+    law = config.law()
+    reference = config.reference()
+    step_ns = int(round(dt * NS_PER_S))
+    model = PlantModel(config.start, config.sensing_radii, step_ns, law, reference,
+                       input_timeout_ns=step_ns, collision_distance=DEFAULT_COLLISION_DISTANCE)
+    commands = Commands.empty(config.num_robots, config.dim)
+    steps = int(round(duration / dt))
+    stride = max(1, int(round(sample_dt / dt)))
+    times, states, applied, frames = [], [], [], []
+    for k in range(steps + 1):
+        frame = reference.sample(model.t)
+        commands.store_all(team_command(model.q, config.vertices, config.sensing_radii, law,
+                                        frame).u, model.t_ns)
+        if k == steps:
+            times.append(model.t)
+            states.append(model.q)
+            applied.append(model.admit(commands).u)
+            frames.append(frame)
+            break
+        progress.update(model.t)
+        report = model.advance(commands)
+        if k % stride == 0:
+            times.append(report.t_ns / NS_PER_S)
+            states.append(report.q)
+            applied.append(report.admission.u)
+            frames.append(frame)
+    return Trajectory.from_frames(times, states, applied, frames, config.vertices)
+
+
+def run_metrics(trajectory: Trajectory, config: FormationConfig, integrator: str) -> dict:
     """metrics.json content for a simulated trajectory."""
     extra = {'reference_kind': config.reference_kind, 'integrator': integrator}
     return compute_metrics(trajectory.t, trajectory.q, trajectory.u, trajectory.u_hat,
                            trajectory.q_desired, config.law().u_bound, extra)
 
 
-def format_summary(metrics, out_dir=None):
+def format_summary(metrics: dict, out_dir: Optional[str] = None) -> str:
     """Human-readable summary lines of a metrics dictionary."""
     settle = metrics['settle_time']
     settle_text = f'{settle:.2f} s' if settle is not None else 'not settled by the end'
@@ -151,7 +181,7 @@ def format_summary(metrics, out_dir=None):
     return '\n'.join(lines)
 
 
-def build_parser():
+def build_parser() -> argparse.ArgumentParser:
     """Command-line interface of formation_sim."""
     parser = argparse.ArgumentParser(
         prog='formation_sim',
@@ -162,9 +192,8 @@ def build_parser():
     parser.add_argument('--out', help='output directory (created if missing); required unless '
                                       '--check')
     parser.add_argument('--check', action='store_true',
-                        help='only validate the parameters for the simulator and every node, '
-                             "print 'NUM_ROBOTS WALL_MS' (robots, and milliseconds the run "
-                             'takes at plant.realtime_factor) and exit (0 valid, 2 not)')
+                        help='only validate the parameters as the simulator and every node '
+                             'read them, say so and exit (0 valid, 2 not)')
     parser.add_argument('--duration', type=float, help='simulated seconds (default: duration '
                                                        'in the parameters file)')
     parser.add_argument('--dt', type=float, help='fixed step with zero-order hold, s (default: '
@@ -176,7 +205,7 @@ def build_parser():
     return parser
 
 
-def main(argv=None):
+def main(argv: Optional[list] = None) -> int:
     """Entry point of ``formation_sim``; returns the exit code."""
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -187,18 +216,16 @@ def main(argv=None):
     if not args.check and not args.out:
         parser.error('--out is required (or --check)')
     try:
-        config = load_config(args.params)
         if args.check:
-            raw = load_params_file(args.params)
-            plant = validate(raw, 'plant')
-            validate(raw, 'reference')
-            validate({**raw, 'robot_id': 1}, 'robot')
+            config = validate_for_every_executable(load_params_file(args.params))[Exe.SIM]
+        else:
+            config = load_config(args.params)
     except ParamError as exc:
         print(f'formation_sim: invalid parameters in {args.params}:\n{exc}', file=sys.stderr)
         return 2
     if args.check:
-        wall = config.duration / plant.values['plant.realtime_factor']
-        print(config.num_robots, int(round(1000.0 * wall)))
+        print(f'{config.num_robots} robots in {config.dim}D: {args.params} is valid for '
+              'formation_sim, plant, reference and robot')
         return 0
     duration = config.duration if args.duration is None else args.duration
     os.makedirs(args.out, exist_ok=True)

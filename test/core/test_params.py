@@ -4,8 +4,9 @@ import math
 import os
 import re
 
-from formation_ros.core.params import (load_config, load_params_file, ParamError, REQUIRED,
-                                       SCHEMA, validate)
+from formation_ros.core.declarations import DECLARATIONS as SCHEMA, ParamError, REQUIRED
+from formation_ros.core.params import load_config, validate
+from formation_ros.core.params_file import load_params_file
 import numpy as np
 import pytest
 import yaml
@@ -54,7 +55,8 @@ def test_scientific_notation_is_a_double(tmp_path):
 
 BAD_CASES = [
     ('controller.gain', {'controller.gain': 2}, 'write 2.0'),
-    ('controller.gain', {'controller.gain': -1.0}, '>= 1e-12'),
+    ('controller.gain', {'controller.gain': -1.0}, 'must be > 0, got -1.0'),
+    ('controller.gain', {'controller.gain': 0.0}, 'must be > 0, got 0.0'),
     ('controller.gain', {'controller.gain': 'fast'}, 'finite double'),
     ('controller.gain', {'controller.gain': math.nan}, 'finite double'),
     ('num_robots', {'num_robots': 'ten'}, 'integer'),
@@ -85,7 +87,8 @@ BAD_CASES = [
     ('reference.origin', {'reference.origin': [0.0, 0.0, 0.0]}, 'dim = 2'),
     ('reference.speed', {'reference.kind': 'circle', 'reference.speed': 0.0}, '> 0'),
     ('sensing_radius', {'sensing_radius': None}, 'is required'),
-    ('duration', {'duration': 0.0}, '>= 1e-09'),
+    ('duration', {'duration': 0.0}, 'must be > 0'),
+    ('jump.order', {'jump.order': 51}, 'must be <= 50'),
 ]
 
 
@@ -145,7 +148,7 @@ def test_schema_defaults_have_their_declared_types():
     kinds = {'int': int, 'double': float, 'string': str, 'bool': bool, 'double_array': list}
     for param in SCHEMA:
         if param.default is not None and param.default is not REQUIRED:
-            assert isinstance(param.default, kinds[param.kind]), param.name
+            assert isinstance(param.default, kinds[param.kind.value]), param.name
 
 
 def test_section5_file_is_plain_yaml_for_ros():

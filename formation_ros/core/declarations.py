@@ -1,0 +1,345 @@
+"""
+One declaration per parameter: name, type, allowed range, description, who reads it.
+
+This is the only list of parameters. ``core.params`` checks values against it and builds the
+typed settings; the ROS adapter declares each node's parameters from it (with the same
+descriptions and ranges); the README's table is checked against it. Adding a parameter means
+adding its :class:`Param` here and using it in ``core.params``.
+
+A range bound is inclusive or exclusive and says so in messages: ``> 0`` for a strictly
+positive value, ``>= 2`` for an inclusive one.
+"""
+
+from dataclasses import dataclass
+import difflib
+import enum
+import math
+from typing import Iterable, Mapping, Optional, Tuple
+
+DEFAULT_COLLISION_DISTANCE = 1e-3
+
+
+class Kind(enum.Enum):
+    """ROS 2 parameter type of a declaration."""
+
+    INT = 'int'
+    DOUBLE = 'double'
+    STRING = 'string'
+    BOOL = 'bool'
+    DOUBLE_ARRAY = 'double_array'
+
+
+class Exe(enum.Enum):
+    """The executables that read parameters."""
+
+    SIM = 'formation_sim'
+    ROBOT = 'robot'
+    PLANT = 'plant'
+    REFERENCE = 'reference'
+    RECORD = 'record'
+
+
+class PsiKind(str, enum.Enum):
+    """Bounded function psi of eq. (14): ``controller.psi``."""
+
+    ARCTAN = 'arctan'
+    TANH = 'tanh'
+
+
+class JumpKind(str, enum.Enum):
+    """Jump function of Lemma 1: ``jump.kind``."""
+
+    POLY = 'poly'
+    SMOOTH = 'smooth'
+
+
+class ReferenceKind(str, enum.Enum):
+    """Desired formation trajectory: ``reference.kind``."""
+
+    FIXED = 'fixed'
+    LINE = 'line'
+    CIRCLE = 'circle'
+    FIGURE_EIGHT = 'figure_eight'
+    HELIX = 'helix'
+
+
+@dataclass(frozen=True)
+class Bound:
+    """One end of a numeric range: ``value``, inclusive (``>=``/``<=``) or not (``>``/``<``)."""
+
+    value: float
+    inclusive: bool = True
+
+
+def at_least(value: float) -> Bound:
+    """Return the inclusive bound ``>= value`` (or ``<= value`` as an upper end)."""
+    return Bound(value, True)
+
+
+def above(value: float) -> Bound:
+    """Return the exclusive bound ``> value`` (or ``< value`` as an upper end)."""
+    return Bound(value, False)
+
+
+class Required:
+    """Marker default: the parameter must be given."""
+
+    def __repr__(self) -> str:
+        """Show as REQUIRED."""
+        return 'REQUIRED'
+
+
+REQUIRED = Required()
+ALL = frozenset(Exe)
+START = frozenset({Exe.SIM, Exe.PLANT, Exe.RECORD})
+PLANT = frozenset({Exe.PLANT, Exe.RECORD})
+ROBOT = frozenset({Exe.ROBOT, Exe.RECORD})
+
+
+@dataclass(frozen=True)
+class Param:
+    """
+    One parameter.
+
+    default: its value when absent; ``None`` for an optional parameter without a value (it is
+    then declared on a node only when it applies, see ``ros.parameters``); :data:`REQUIRED`.
+    low / high: range of the value (of each element for arrays); choices: allowed strings
+    (from an enum); users: the executables that read it.
+    """
+
+    name: str
+    kind: Kind
+    default: object
+    description: str
+    low: Optional[Bound] = None
+    high: Optional[Bound] = None
+    choices: Tuple[str, ...] = ()
+    users: frozenset = ALL
+
+    def range_text(self) -> str:
+        """Describe the allowed values, e.g. ``> 0``, ``2 to 3``, ``arctan, tanh``."""
+        if self.choices:
+            return ', '.join(self.choices)
+        parts = []
+        if self.low is not None:
+            parts.append(f"{'>=' if self.low.inclusive else '>'} {self.low.value:g}")
+        if self.high is not None:
+            parts.append(f"{'<=' if self.high.inclusive else '<'} {self.high.value:g}")
+        return ', '.join(parts)
+
+
+def _choices(kind: type) -> Tuple[str, ...]:
+    return tuple(member.value for member in kind)
+
+
+DECLARATIONS = (
+    Param('num_robots', Kind.INT, REQUIRED, 'Number of robots N (robots are numbered 1..N).',
+          low=at_least(2), high=at_least(100000)),
+    Param('dim', Kind.INT, 2, 'Dimension n of the workspace: 2 or 3.', low=at_least(2),
+          high=at_least(3)),
+    Param('sensing_radius', Kind.DOUBLE, REQUIRED, 'Sensing radius R_i of every robot, m.',
+          low=above(0.0)),
+    Param('sensing_radii', Kind.DOUBLE_ARRAY, None,
+          'Optional sensing radius per robot (num_robots values, m); overrides sensing_radius.',
+          low=above(0.0)),
+    Param('repulsion_radius', Kind.DOUBLE, REQUIRED,
+          'Repulsion radius b_ij of eq. (11), m; at most every R_i and the closest vertex pair.',
+          low=above(0.0)),
+    Param('controller.gain', Kind.DOUBLE, 2.0, 'Gain c of eq. (14), m/s.', low=above(0.0)),
+    Param('controller.kappa', Kind.DOUBLE, 1.0,
+          'Weight kappa of the collision term, eqs. (8), (13).', low=above(0.0)),
+    Param('controller.psi', Kind.STRING, PsiKind.ARCTAN.value,
+          'Bounded function psi of eq. (14).', choices=_choices(PsiKind)),
+    Param('jump.kind', Kind.STRING, JumpKind.POLY.value,
+          "Jump function of Lemma 1: 'poly' (g = y^p) or 'smooth' (g = exp(-1/y)).",
+          choices=_choices(JumpKind)),
+    Param('jump.order', Kind.INT, 2, "Order p of g(y) = y^p (kind 'poly').", low=at_least(1),
+          high=at_least(50)),
+    Param('formation.vertices', Kind.DOUBLE_ARRAY, REQUIRED,
+          "Flat list of num_robots x dim values: robot i's place in the formation frame, m."),
+    Param('start.positions', Kind.DOUBLE_ARRAY, None,
+          'Flat list of num_robots x dim start positions, m (or use start.random_*).',
+          users=START),
+    Param('start.random_radius', Kind.DOUBLE, None,
+          'Random start: radius of the disc (ball in 3D) about the origin, m.', low=above(0.0),
+          users=START),
+    Param('start.min_separation', Kind.DOUBLE, None,
+          'Random start: smallest distance between two robots, m.', low=above(0.0),
+          users=START),
+    Param('start.seed', Kind.INT, 0, 'Random start: seed of the random generator.',
+          low=at_least(0), high=at_least(2 ** 31 - 1), users=START),
+    Param('reference.kind', Kind.STRING, ReferenceKind.FIXED.value,
+          'Desired formation trajectory q_od(t).', choices=_choices(ReferenceKind)),
+    Param('reference.origin', Kind.DOUBLE_ARRAY, None,
+          'dim values: fixed point, start of a line, centre of a circle/figure eight/helix, m '
+          '(default: the origin).'),
+    Param('reference.velocity', Kind.DOUBLE_ARRAY, None,
+          "dim values: velocity of a 'line', m/s (default: zero)."),
+    Param('reference.radius', Kind.DOUBLE, 1.0, 'Radius of circle, figure eight and helix, m.',
+          low=above(0.0)),
+    Param('reference.speed', Kind.DOUBLE, 0.5,
+          'Path speed of circle and helix (mean speed of the figure eight), m/s.',
+          low=at_least(0.0)),
+    Param('reference.pitch', Kind.DOUBLE, 1.0, 'Helix rise per turn along +z, m.'),
+    Param('reference.rate', Kind.DOUBLE, 50.0,
+          'Publication rate of /formation/reference, Hz (wall clock).', low=above(0.0),
+          high=at_least(10000.0), users=frozenset({Exe.REFERENCE, Exe.RECORD})),
+    Param('duration', Kind.DOUBLE, 20.0, 'Length of a run, s.', low=above(0.0)),
+    Param('robot_id', Kind.INT, REQUIRED, 'This robot: 1..num_robots (robot node only).',
+          low=at_least(1), users=frozenset({Exe.ROBOT})),
+    Param('control_rate', Kind.DOUBLE, 50.0, 'Rate of the control timer, Hz (wall clock).',
+          low=above(0.0), high=at_least(10000.0), users=ROBOT),
+    Param('input_timeout', Kind.DOUBLE, 0.5,
+          'A robot publishes zero when no new pose, neighbours or reference arrived for this '
+          'long, s (wall clock; not in lockstep).', low=above(0.0), users=ROBOT),
+    Param('wait_for_subscribers', Kind.INT, 1,
+          'A robot sends its first command only once cmd_vel has this many subscribers (the '
+          'plant; 2 when a recorder listens too).', low=at_least(0), high=at_least(1000),
+          users=ROBOT),
+    Param('plant.rate', Kind.DOUBLE, 100.0,
+          'Integration rate of the plant, Hz of simulated time: step dt = 1 / rate.',
+          low=above(0.0), high=at_least(100000.0), users=PLANT),
+    Param('plant.input_timeout', Kind.DOUBLE, 0.5,
+          'A command whose state stamp is older than this counts as zero, s (simulated time).',
+          low=above(0.0), users=PLANT),
+    Param('plant.publish_rate', Kind.DOUBLE, 50.0,
+          'Rate of /robot_<i>/pose and /robot_<i>/neighbors, Hz of simulated time (at most '
+          'plant.rate; every step in lockstep).', low=above(0.0), high=at_least(100000.0),
+          users=PLANT),
+    Param('plant.realtime_factor', Kind.DOUBLE, 1.0,
+          'Simulated seconds per wall-clock second (an upper bound in lockstep).',
+          low=above(0.0), high=at_least(1000.0), users=PLANT),
+    Param('plant.lockstep', Kind.BOOL, False,
+          'Deterministic mode: the plant steps only when every robot answered the latest state.',
+          users=frozenset({Exe.PLANT, Exe.ROBOT, Exe.REFERENCE, Exe.RECORD})),
+    Param('plant.collision_distance', Kind.DOUBLE, DEFAULT_COLLISION_DISTANCE,
+          'Two robots closer than this are logged as a collision, m.', low=at_least(0.0),
+          users=PLANT),
+    Param('plant.wait_for_robots', Kind.BOOL, True,
+          'Hold the clock at 0 (resending the start state) until every robot has sent a '
+          'command, so that all robots start together.', users=PLANT),
+    Param('plant.wait_for_subscribers', Kind.INT, 1,
+          'While waiting for the robots, also wait until every robot_<i>/pose topic has this '
+          'many subscribers (2 when a recorder listens too).', low=at_least(0),
+          high=at_least(1000), users=PLANT),
+    Param('plant.marker_rate', Kind.DOUBLE, 5.0,
+          'Rate of /formation/markers for RViz, Hz (wall clock); 0 publishes none.',
+          low=at_least(0.0), high=at_least(100.0), users=PLANT),
+    Param('plant.output_dir', Kind.STRING, '',
+          'If set, the plant writes trajectory.npz and plant_stats.json there when it stops.',
+          users=PLANT),
+    Param('record.path', Kind.STRING, REQUIRED,
+          'Directory of the rosbag2 (MCAP) the recorder writes; must not exist yet.',
+          users=frozenset({Exe.RECORD})),
+    Param('record.overwrite', Kind.BOOL, False,
+          'Let the recorder replace an existing bag directory at record.path.',
+          users=frozenset({Exe.RECORD})),
+    Param('record.markers', Kind.BOOL, False, 'Also record /formation/markers.',
+          users=frozenset({Exe.RECORD})),
+)
+BY_NAME = {param.name: param for param in DECLARATIONS}
+ROS_OWN = ('use_sim_time', 'start_type_description_service', 'qos_overrides.')
+RECORDER_ONLY = ('record.path', 'record.overwrite', 'record.markers')
+
+
+class ParamError(ValueError):
+    """One or more invalid parameters; ``str()`` names each parameter and what is allowed."""
+
+    def __init__(self, problems: Iterable[Tuple[str, str]]):
+        """Keep the list of (parameter name, message) pairs."""
+        self.problems = list(problems)
+        super().__init__('\n'.join(f"parameter '{name}': {msg}" for name, msg in self.problems))
+
+
+def used_by(exe: Exe) -> Tuple[Param, ...]:
+    """Return the declarations that ``exe`` reads, in declaration order."""
+    return tuple(param for param in DECLARATIONS if exe in param.users)
+
+
+def is_known(name: str) -> bool:
+    """Tell whether ``name`` is a formation parameter or one that rclpy itself declares."""
+    return name in BY_NAME or name.startswith(ROS_OWN)
+
+
+def did_you_mean(name: str) -> str:
+    """Return " (did you mean 'x'?)" with the closest known name, or '' when none is close."""
+    close = difflib.get_close_matches(name, list(BY_NAME), n=1)
+    return f" (did you mean '{close[0]}'?)" if close else ''
+
+
+def _is_int(value: object) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
+def type_problem(param: Param, value: object) -> Optional[str]:
+    """Return what is wrong with the type of ``value`` for ``param``, or None."""
+    if param.kind is Kind.INT:
+        return None if _is_int(value) else f'must be an integer, got {value!r}'
+    if param.kind is Kind.DOUBLE:
+        if _is_int(value):
+            return f'must be a double: write {value}.0, not {value} (ROS 2 parameters are typed)'
+        ok = isinstance(value, float) and math.isfinite(value)
+        return None if ok else f'must be a finite double, got {value!r}'
+    if param.kind is Kind.STRING:
+        return None if isinstance(value, str) else f'must be a string, got {value!r}'
+    if param.kind is Kind.BOOL:
+        return None if isinstance(value, bool) else f'must be true or false, got {value!r}'
+    if not isinstance(value, (list, tuple)) or not value:
+        return f'must be a non-empty list of doubles, got {value!r}'
+    for item in value:
+        if _is_int(item):
+            return (f'must be a list of doubles: write {item}.0, not {item} '
+                    '(ROS 2 parameters are typed)')
+        if not (isinstance(item, float) and math.isfinite(item)):
+            return f'must be a list of finite doubles, got element {item!r}'
+    return None
+
+
+def _outside(value: float, bound: Bound, lower: bool) -> bool:
+    if lower:
+        return value < bound.value if bound.inclusive else value <= bound.value
+    return value > bound.value if bound.inclusive else value >= bound.value
+
+
+def range_problem(param: Param, value: object) -> Optional[str]:
+    """Return what is wrong with the (well-typed) ``value`` for ``param``'s range, or None."""
+    if param.choices:
+        ok = value in param.choices
+        return None if ok else f"must be one of {', '.join(param.choices)}; got {value!r}"
+    if param.kind not in (Kind.INT, Kind.DOUBLE, Kind.DOUBLE_ARRAY):
+        return None
+    items = value if param.kind is Kind.DOUBLE_ARRAY else [value]
+    for item in items:  # type: ignore[union-attr]
+        for bound, lower in ((param.low, True), (param.high, False)):
+            if bound is not None and _outside(item, bound, lower):
+                sign = ('>' if lower else '<') + ('=' if bound.inclusive else '')
+                return f'must be {sign} {bound.value:g}, got {item!r}'
+    return None
+
+
+def check_values(raw: Mapping[str, object], exe: Exe) -> dict:
+    """
+    Check names, types and ranges; return {name: value} with the static defaults filled in.
+
+    raw: flat {dotted name: value}, as given. Only the parameters ``exe`` reads are checked and
+    returned; unknown names are errors. Raises :class:`ParamError` listing every problem.
+    """
+    problems = [(name, f'unknown parameter{did_you_mean(name)}') for name in raw
+                if not is_known(name)]
+    values = {}
+    for param in used_by(exe):
+        value = raw.get(param.name)
+        if value is None:
+            if param.default is REQUIRED:
+                problems.append((param.name, f'is required: {param.description}'))
+            elif param.default is not None:
+                values[param.name] = param.default
+            continue
+        problem = type_problem(param, value) or range_problem(param, value)
+        if problem:
+            problems.append((param.name, problem))
+        else:
+            values[param.name] = list(value) if param.kind is Kind.DOUBLE_ARRAY else value
+    if problems:
+        raise ParamError(problems)
+    return values

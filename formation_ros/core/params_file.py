@@ -1,0 +1,110 @@
+"""
+Read and write ROS 2 parameters files (YAML): the one place that knows their layout.
+
+One standard file drives the simulator and every node::
+
+    /**:
+      ros__parameters:
+        num_robots: 10
+        controller:
+          gain: 2.0
+
+Nested keys are dotted names in ROS (``controller.gain``). The reader follows ROS's YAML
+dialect where PyYAML (YAML 1.1) does not: ``1e-3`` is a double, as ``--params-file`` reads it.
+:func:`dump_params_text` writes the inverse, so text written here reads back to the same
+values (bags store their parameters this way).
+"""
+
+import os
+import re
+from typing import Any, Dict, Mapping, Union
+
+from formation_ros.core.declarations import ParamError
+import yaml
+
+_FLOAT_PATTERN = re.compile(
+    r'^(?:[-+]?[0-9][0-9_]*\.[0-9_]*(?:[eE][-+]?[0-9]+)?'
+    r'|[-+]?[0-9][0-9_]*[eE][-+]?[0-9]+'
+    r'|[-+]?\.[0-9_]+(?:[eE][-+]?[0-9]+)?'
+    r'|[-+]?\.(?:inf|Inf|INF)'
+    r'|\.(?:nan|NaN|NAN))$')
+
+
+class _Loader(yaml.SafeLoader):
+    """Safe YAML loader that also reads ``1e-3`` as a float."""
+
+
+_Loader.yaml_implicit_resolvers = {
+    key: [(tag, regexp) for tag, regexp in resolvers if tag != 'tag:yaml.org,2002:float']
+    for key, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items()
+}
+_Loader.add_implicit_resolver('tag:yaml.org,2002:float', _FLOAT_PATTERN,
+                              list('-+0123456789.'))
+
+
+def flatten(tree: Mapping[str, Any], prefix: str = '') -> Dict[str, Any]:
+    """Nested dict -> {dotted name: value}; ``{'a': {'b': 1}}`` -> ``{'a.b': 1}``."""
+    flat: Dict[str, Any] = {}
+    for key, value in tree.items():
+        name = f'{prefix}{key}'
+        if isinstance(value, dict):
+            flat.update(flatten(value, name + '.'))
+        else:
+            flat[name] = value
+    return flat
+
+
+def nest(values: Mapping[str, Any]) -> Dict[str, Any]:
+    """Inverse of :func:`flatten`: {dotted name: value} -> nested dict (None values dropped)."""
+    tree: Dict[str, Any] = {}
+    for name, value in sorted(values.items()):
+        if value is None:
+            continue
+        node = tree
+        parts = name.split('.')
+        for part in parts[:-1]:
+            node = node.setdefault(part, {})
+        node[parts[-1]] = list(value) if isinstance(value, (list, tuple)) else value
+    return tree
+
+
+def load_params_file(path: Union[str, os.PathLike]) -> Dict[str, Any]:
+    """
+    Read a ROS 2 parameters YAML file and return the flat ``/**`` parameters.
+
+    Raises ParamError (naming the file) when the file is missing or unreadable, is empty or not
+    YAML, or has no ``/**: ros__parameters:`` section.
+    """
+    try:
+        with open(path, encoding='utf-8') as stream:
+            text = stream.read()
+    except FileNotFoundError:
+        raise ParamError([(str(path), 'file not found')]) from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ParamError([(str(path), f'cannot read it: {exc}')]) from None
+    return parse_params_text(text, str(path))
+
+
+def parse_params_text(text: str, source: str) -> Dict[str, Any]:
+    """Parse ROS 2 parameters YAML text (``source`` names it in errors); return flat values."""
+    try:
+        document = yaml.load(text, Loader=_Loader)
+    except yaml.YAMLError as exc:
+        reason = str(exc).replace('\n', ' ')
+        raise ParamError([(source, f'cannot read it as YAML: {reason}')]) from None
+    section = document.get('/**') if isinstance(document, dict) else None
+    if not isinstance(section, dict) or not isinstance(section.get('ros__parameters'), dict):
+        raise ParamError([(source, "expected a ROS 2 parameters file with a top-level '/**:' "
+                                   "section holding 'ros__parameters:'")])
+    return flatten(section['ros__parameters'])
+
+
+def dump_params_text(values: Mapping[str, Any]) -> str:
+    """Return the ROS 2 parameters YAML (``/**: ros__parameters:``) of flat dotted values."""
+    return yaml.safe_dump({'/**': {'ros__parameters': nest(values)}}, sort_keys=True)
+
+
+def write_params_file(path: Union[str, os.PathLike], values: Mapping[str, Any]) -> None:
+    """Write flat dotted values as a ROS 2 parameters file at ``path``."""
+    with open(path, 'w', encoding='utf-8') as stream:
+        stream.write(dump_params_text(values))

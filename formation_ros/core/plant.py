@@ -1,0 +1,321 @@
+"""
+The robots' bodies and sensors, without ROS: one model for ``formation_sim --dt`` and the plant.
+
+Bodies are single integrators, q_i' = u_i (eq. 1), stepped with zero-order hold: the command
+admitted for a robot is held over the step, ``q(t + dt) = q(t) + dt u``. Time is kept in integer
+nanoseconds, as message stamps are, so the simulator and the plant node step through exactly the
+same instants.
+
+Each step the model
+
+* admits commands (:meth:`PlantModel.admit`): for each robot the latest command counts if there
+  is one (else ``MISSING``), it is finite (else ``NON_FINITE``) and its state stamp is at most
+  ``input_timeout`` old (else ``STALE``); a command that does not count is replaced by zero;
+* audits the bound (:meth:`PlantModel.advance`): a new command whose bounded part u_hat of
+  eq. (14) (recovered through eq. (25) for a moving reference) has a component above c M1 is
+  counted and reported, not clipped;
+* integrates and checks collisions: a pair closer than ``collision_distance`` is counted once
+  when it comes closer;
+* senses (:meth:`PlantModel.neighbours`): what each robot's range sensor sees, the other robots
+  strictly within its R_i, from one k-d tree per step.
+
+Positions are rows: ``q`` has shape (N, dim), in m; commands (N, dim) in m/s.
+"""
+
+from collections import OrderedDict
+from dataclasses import dataclass, field
+import enum
+from typing import Dict, List, Optional, Tuple
+
+from formation_ros.core.frames import to_frame_velocity
+from formation_ros.core.law import LawParams
+from formation_ros.core.reference import Reference
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.spatial import cKDTree
+
+NS_PER_S = 1_000_000_000
+BOUND_TOLERANCE_FIXED = 1e-9
+BOUND_TOLERANCE_MOVING = 1e-3
+MAX_STATES_KEPT = 512
+MAX_START_TRIES = 20000
+PLANT_STATS_FILE = 'plant_stats.json'
+
+
+class CommandStatus(enum.IntEnum):
+    """What the plant made of a robot's latest command for one step."""
+
+    APPLIED = 0
+    MISSING = 1
+    STALE = 2
+    NON_FINITE = 3
+
+
+@dataclass
+class Commands:
+    """
+    The latest command of every robot, as received: what the plant node stores from cmd_vel.
+
+    u: (N, dim) m/s; stamp_ns: (N,) the stamp of the state each command answers, ns;
+    present: (N,) whether robot i has sent a command at all.
+    """
+
+    u: NDArray[np.float64]
+    stamp_ns: NDArray[np.int64]
+    present: NDArray[np.bool_]
+
+    @classmethod
+    def empty(cls, num_robots: int, dim: int) -> 'Commands':
+        """No command from anyone yet."""
+        return cls(np.zeros((num_robots, dim)), np.zeros(num_robots, dtype=np.int64),
+                   np.zeros(num_robots, dtype=bool))
+
+    def store(self, index: int, velocity: ArrayLike, stamp_ns: int) -> None:
+        """Keep robot ``index``'s (0-based) newest command."""
+        self.u[index] = velocity
+        self.stamp_ns[index] = stamp_ns
+        self.present[index] = True
+
+    def store_all(self, u: ArrayLike, stamp_ns: int) -> None:
+        """Keep one command per robot, all answering the state stamped ``stamp_ns``."""
+        self.u[:] = u
+        self.stamp_ns[:] = stamp_ns
+        self.present[:] = True
+
+
+@dataclass(frozen=True)
+class Admission:
+    """Commands held over one step (N, dim), and each robot's :class:`CommandStatus` (N,)."""
+
+    u: NDArray[np.float64]
+    status: NDArray[np.int8]
+
+
+@dataclass(frozen=True)
+class StepReport:
+    """
+    One step: the state it started from and what happened.
+
+    t_ns, q: time and positions (N, dim) before the step; admission: the commands held over it;
+    violations: (robot index, largest |u_hat| component in m/s) of new commands above the
+    bound; collisions: (i, j, distance in m) of pairs that came closer than the collision
+    distance during the step (indices 0-based, i < j).
+    """
+
+    t_ns: int
+    q: NDArray[np.float64]
+    admission: Admission
+    violations: List[Tuple[int, float]]
+    collisions: List[Tuple[int, int, float]]
+
+
+@dataclass
+class PlantCounts:
+    """What the model counted so far; per-robot arrays are (N,) and indexed from 0."""
+
+    steps: int = 0
+    collisions: int = 0
+    bound_violations: int = 0
+    status_steps: NDArray[np.int64] = field(default_factory=lambda: np.zeros((4, 0), np.int64))
+
+    def steps_with(self, status: CommandStatus) -> int:
+        """Robot-steps whose command had ``status`` (e.g. STALE), summed over robots."""
+        return int(self.status_steps[status].sum())
+
+    def totals(self) -> Dict[str, int]:
+        """Return the counters by name (the keys of ``plant_stats.json``)."""
+        return {'steps': self.steps, 'collisions': self.collisions,
+                'bound_violations': self.bound_violations,
+                'stale_command_steps': self.steps_with(CommandStatus.STALE),
+                'bad_command_steps': self.steps_with(CommandStatus.NON_FINITE),
+                'missing_command_steps': self.steps_with(CommandStatus.MISSING)}
+
+
+@dataclass(frozen=True)
+class StartSpec:
+    """
+    Where the robots start: explicit positions (N, dim), or random in a disc/ball.
+
+    With ``positions`` None: ``num_robots`` points uniform in the disc (ball in 3D) of
+    ``random_radius`` m about the origin, pairwise at least ``min_separation`` m apart, from
+    the random generator seeded with ``seed``.
+    """
+
+    num_robots: int
+    dim: int
+    positions: Optional[NDArray[np.float64]] = None
+    random_radius: float = 0.0
+    min_separation: float = 0.0
+    seed: int = 0
+
+
+def random_start(n: int, dim: int, radius: float, min_separation: float,
+                 seed: int) -> Optional[NDArray[np.float64]]:
+    """
+    Uniform random positions in the disc/ball of ``radius`` about 0, pairwise >= separation.
+
+    Returns (n, dim), or None when the points do not fit after many tries.
+    """
+    rng = np.random.default_rng(seed)
+    placed = np.empty((n, dim))
+    count = 0
+    tries = 0
+    while count < n:
+        tries += 1
+        if tries > MAX_START_TRIES * n:
+            return None
+        direction = rng.normal(size=dim)
+        direction /= np.linalg.norm(direction)
+        candidate = direction * radius * rng.random() ** (1.0 / dim)
+        if count and np.min(np.sum((placed[:count] - candidate) ** 2, axis=1)) \
+                < min_separation ** 2:
+            continue
+        placed[count] = candidate
+        count += 1
+    return placed
+
+
+def start_positions(spec: StartSpec) -> Optional[NDArray[np.float64]]:
+    """Return the start positions (N, dim) of ``spec``; None if random ones do not fit."""
+    if spec.positions is not None:
+        return np.array(spec.positions, dtype=float)
+    return random_start(spec.num_robots, spec.dim, spec.random_radius, spec.min_separation,
+                        spec.seed)
+
+
+def sensed_pairs(tree: cKDTree, q: NDArray[np.float64],
+                 radii: NDArray[np.float64]) -> Tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """
+    Who senses whom: arrays (observer, seen) of every ordered pair with ||q_o - q_s|| < R_o.
+
+    tree: k-d tree of ``q`` (N, dim); radii: (N,) R_i in m. Sorted by observer.
+    """
+    pairs = tree.query_pairs(r=float(np.max(radii)), output_type='ndarray').reshape(-1, 2)
+    diff = q[pairs[:, 0]] - q[pairs[:, 1]]
+    d2 = np.einsum('kd,kd->k', diff, diff)
+    first = pairs[d2 < radii[pairs[:, 0]] ** 2]
+    second = pairs[d2 < radii[pairs[:, 1]] ** 2][:, ::-1]
+    both = np.concatenate([first, second])
+    order = np.lexsort((both[:, 1], both[:, 0]))
+    return both[order, 0], both[order, 1]
+
+
+class PlantModel:
+    """
+    Every robot's body and range sensor, stepped with zero-order hold.
+
+    start: (N, dim) positions, m; sensing_radii: (N,) R_i, m; step_ns: dt in ns; law: the
+    control law constants (for the bound c M1); reference: the desired trajectory (to recover
+    u_hat when auditing the bound); input_timeout_ns: the oldest state stamp a command may
+    answer; collision_distance: m.
+    """
+
+    def __init__(self, start: ArrayLike, sensing_radii: ArrayLike, step_ns: int,
+                 law: LawParams, reference: Reference, input_timeout_ns: int,
+                 collision_distance: float):
+        """Place the robots at ``start`` at time 0."""
+        self.q = np.array(start, dtype=float)
+        self.radii = np.array(sensing_radii, dtype=float)
+        self.num_robots, self.dim = self.q.shape
+        if step_ns <= 0:
+            raise ValueError(f'step_ns must be > 0, got {step_ns}')
+        self.step_ns = int(step_ns)
+        self.law = law
+        self.reference = reference
+        self.input_timeout_ns = int(input_timeout_ns)
+        self.collision_distance = float(collision_distance)
+        self.bound_tolerance = (BOUND_TOLERANCE_FIXED if reference.is_stationary
+                                else BOUND_TOLERANCE_MOVING)
+        self.t_ns = 0
+        self.tree = cKDTree(self.q)
+        self.counts = PlantCounts(status_steps=np.zeros((len(CommandStatus), self.num_robots),
+                                                        dtype=np.int64))
+        self._states: 'OrderedDict[int, NDArray[np.float64]]' = OrderedDict([(0, self.q)])
+        self._states_kept = min(MAX_STATES_KEPT, 2 + self.input_timeout_ns // self.step_ns)
+        self._audited = np.full(self.num_robots, -1, dtype=np.int64)
+        self._colliding = self._close_pairs()
+
+    @property
+    def t(self) -> float:
+        """Return the simulated time, s."""
+        return self.t_ns / NS_PER_S
+
+    @property
+    def dt(self) -> float:
+        """Return the step, s."""
+        return self.step_ns / NS_PER_S
+
+    def admit(self, commands: Commands) -> Admission:
+        """Return the commands that count for the coming step (zero where one does not)."""
+        status = np.full(self.num_robots, CommandStatus.APPLIED, dtype=np.int8)
+        finite = np.all(np.isfinite(commands.u), axis=1)
+        stale = self.t_ns - commands.stamp_ns > self.input_timeout_ns
+        status[stale] = CommandStatus.STALE
+        status[~finite] = CommandStatus.NON_FINITE
+        status[~commands.present] = CommandStatus.MISSING
+        applied = status == CommandStatus.APPLIED
+        u = np.where(applied[:, None], commands.u, 0.0)
+        return Admission(u=u, status=status)
+
+    def advance(self, commands: Commands) -> StepReport:
+        """Admit the commands, audit the bound, step q' = u over dt, check collisions."""
+        admission = self.admit(commands)
+        violations = self._audit(commands, admission.status == CommandStatus.APPLIED)
+        t_ns, q = self.t_ns, self.q
+        self.q = q + self.dt * admission.u
+        self.t_ns += self.step_ns
+        self.tree = cKDTree(self.q)
+        self._states[self.t_ns] = self.q
+        while len(self._states) > self._states_kept:
+            self._states.popitem(last=False)
+        counts = self.counts
+        counts.steps += 1
+        np.add.at(counts.status_steps, (admission.status, np.arange(self.num_robots)), 1)
+        counts.bound_violations += len(violations)
+        collisions = self._new_collisions()
+        counts.collisions += len(collisions)
+        return StepReport(t_ns, q, admission, violations, collisions)
+
+    def neighbours(self) -> List[NDArray[np.intp]]:
+        """Robot i's range sensor: indices of the other robots strictly within R_i, each sorted."""
+        observer, seen = sensed_pairs(self.tree, self.q, self.radii)
+        splits = np.searchsorted(observer, np.arange(1, self.num_robots))
+        return np.split(seen, splits)
+
+    def closest_pair_distance(self) -> float:
+        """Smallest distance between two robots now, m (inf for a single robot)."""
+        if self.num_robots < 2:
+            return float('inf')
+        distance, _ = self.tree.query(self.q, k=2)
+        return float(np.min(distance[:, 1]))
+
+    def _close_pairs(self) -> set:
+        return {tuple(pair) for pair in
+                self.tree.query_pairs(self.collision_distance, output_type='ndarray').tolist()}
+
+    def _new_collisions(self) -> List[Tuple[int, int, float]]:
+        pairs = self._close_pairs()
+        new = sorted(pairs - self._colliding)
+        self._colliding = pairs
+        return [(i, j, float(np.linalg.norm(self.q[i] - self.q[j]))) for i, j in new]
+
+    def _audit(self, commands: Commands, applied: NDArray[np.bool_]) -> List[Tuple[int, float]]:
+        """Check each applied command not audited before against c M1; return violations."""
+        fresh = applied & (commands.stamp_ns != self._audited)
+        if not np.any(fresh):
+            return []
+        self._audited[fresh] = commands.stamp_ns[fresh]
+        largest = np.full(self.num_robots, -np.inf)
+        if self.reference.is_stationary:
+            largest[fresh] = np.max(np.abs(commands.u[fresh]), axis=1)
+        else:
+            for stamp in np.unique(commands.stamp_ns[fresh]):
+                state = self._states.get(int(stamp))
+                if state is None:
+                    continue
+                rows = fresh & (commands.stamp_ns == stamp)
+                frame = self.reference.sample(int(stamp) / NS_PER_S)
+                u_hat = to_frame_velocity(commands.u[rows], state[rows], frame)
+                largest[rows] = np.max(np.abs(u_hat), axis=1)
+        over = np.flatnonzero(largest - self.law.u_bound > self.bound_tolerance)
+        return [(int(i), float(largest[i])) for i in over]

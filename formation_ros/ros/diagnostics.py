@@ -1,0 +1,41 @@
+"""
+Status of each node on ``/diagnostics``: one time base, one key style.
+
+Every node publishes one DiagnosticStatus named ``formation_ros/<node>`` once a second
+(:data:`PERIOD`, steady clock). Header stamps are system (wall-clock) time in every node,
+whichever clock the node itself runs on, so statuses from nodes with and without
+``use_sim_time`` can be compared. Keys are lower-case words with the unit in brackets
+(``simulated time [s]``, ``stale command steps``); counts have no unit.
+"""
+
+from typing import Any, Mapping
+
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from rclpy.clock import Clock, ClockType
+
+PERIOD = 1.0
+LEVELS = {'ok': DiagnosticStatus.OK, 'warn': DiagnosticStatus.WARN,
+          'error': DiagnosticStatus.ERROR}
+HARDWARE_ID = 'formation_ros'
+_WALL = Clock(clock_type=ClockType.SYSTEM_TIME)
+
+
+def format_value(value: Any) -> str:
+    """Floats with 6 significant digits, everything else with ``str``."""
+    return f'{value:.6g}' if isinstance(value, float) else str(value)
+
+
+def diagnostics(name: str, level: str, message: str,
+                values: Mapping[str, Any]) -> DiagnosticArray:
+    """
+    Build a DiagnosticArray with one status, stamped with the system time now.
+
+    name: e.g. 'formation_ros/plant'; level: 'ok', 'warn' or 'error'; values: {key: value}.
+    """
+    status = DiagnosticStatus(level=LEVELS[level], name=name, message=message,
+                              hardware_id=HARDWARE_ID)
+    status.values = [KeyValue(key=key, value=format_value(value))
+                     for key, value in values.items()]
+    array = DiagnosticArray(status=[status])
+    array.header.stamp = _WALL.now().to_msg()
+    return array

@@ -1,0 +1,103 @@
+"""
+Declare a node's parameters from the declarations and validate them with the core's checks.
+
+Each parameter the executable reads is declared once, read-only, typed, with its description
+and range. Optional parameters without a value (``start.positions`` when the start is random,
+``sensing_radii`` when every robot has ``sensing_radius``) are declared only when given, and
+``reference.origin`` / ``reference.velocity`` with their zero defaults, so ``ros2 param dump``
+and ``ros2 param get`` answer for every declared parameter.
+"""
+
+import sys
+from typing import Any, Dict, Optional
+
+from formation_ros.core.declarations import (Bound, did_you_mean, Exe, is_known, Kind, Param,
+                                             ParamError, used_by)
+from formation_ros.core.params import FormationConfig, validate
+from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
+from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+
+TYPES = {
+    Kind.INT: Parameter.Type.INTEGER,
+    Kind.DOUBLE: Parameter.Type.DOUBLE,
+    Kind.STRING: Parameter.Type.STRING,
+    Kind.BOOL: Parameter.Type.BOOL,
+    Kind.DOUBLE_ARRAY: Parameter.Type.DOUBLE_ARRAY,
+}
+FLOAT_MAX = sys.float_info.max
+INT_MAX = 2 ** 63 - 1
+DEFAULT_ZERO_VECTORS = ('reference.origin', 'reference.velocity')
+
+
+def _end(bound: Optional[Bound], fallback: float) -> float:
+    return fallback if bound is None else bound.value
+
+
+def descriptor_for(param: Param) -> ParameterDescriptor:
+    """Build the descriptor of a declaration: type, description with range, read-only."""
+    text = param.description
+    allowed = param.range_text()
+    if allowed:
+        text += f' Allowed: {allowed}.'
+    descriptor = ParameterDescriptor(name=param.name, type=TYPES[param.kind].value,
+                                     description=text, read_only=True, dynamic_typing=False)
+    if param.low is None and param.high is None:
+        return descriptor
+    if param.kind is Kind.DOUBLE:
+        descriptor.floating_point_range = [FloatingPointRange(
+            from_value=float(_end(param.low, -FLOAT_MAX)),
+            to_value=float(_end(param.high, FLOAT_MAX)), step=0.0)]
+    elif param.kind is Kind.INT:
+        descriptor.integer_range = [IntegerRange(
+            from_value=int(_end(param.low, -INT_MAX)), to_value=int(_end(param.high, INT_MAX)),
+            step=0)]
+    return descriptor
+
+
+def _given(node: Node, exe: Exe) -> Dict[str, Any]:
+    """Return what the command line and parameters files give for ``exe``'s parameters."""
+    given, problems = {}, []
+    for param in used_by(exe):
+        try:
+            probe = node.declare_parameter(param.name, TYPES[param.kind],
+                                           ParameterDescriptor(dynamic_typing=False))
+        except (InvalidParameterTypeException, InvalidParameterValueException) as exc:
+            problems.append((param.name, str(exc).split(': ' + param.name)[0]))
+            continue
+        node.undeclare_parameter(param.name)
+        if probe.value is not None:
+            value = probe.value
+            given[param.name] = list(value) if param.kind is Kind.DOUBLE_ARRAY else value
+    if problems:
+        raise ParamError(problems)
+    return given
+
+
+def _warn_unknown(node: Node) -> None:
+    overrides = getattr(node, '_parameter_overrides', {}) or {}
+    for name in overrides:
+        if not is_known(name):
+            node.get_logger().warning(f"ignoring unknown parameter '{name}'{did_you_mean(name)}")
+
+
+def declare_parameters(node: Node, exe: Exe) -> FormationConfig:
+    """
+    Declare and validate the parameters of ``exe`` on ``node``; return its configuration.
+
+    Raises :class:`ParamError` naming every bad parameter (wrong type, out of range,
+    inconsistent). A parameter given that no formation executable knows is logged as a
+    warning with the closest known name (it may be meant for another tool).
+    """
+    _warn_unknown(node)
+    config = validate(_given(node, exe), exe)
+    effective = dict(config.values)
+    for name in DEFAULT_ZERO_VECTORS:
+        effective.setdefault(name, [0.0] * config.dim)
+    for param in used_by(exe):
+        value = effective.get(param.name)
+        if value is not None:
+            node.declare_parameter(param.name, value, descriptor_for(param),
+                                   ignore_override=True)
+    return config

@@ -1,0 +1,73 @@
+"""
+Every topic name of the formation, in one place, and what the recorder records.
+
+Robot topics are relative (``pose``, ``neighbors``, ``cmd_vel``): a robot node started in
+namespace ``/robot_<i>`` resolves them to ``/robot_<i>/pose`` and so on, and the plant, which
+serves every robot, uses :func:`robot_topic`. The formation-wide topics are absolute.
+"""
+
+from dataclasses import dataclass
+import enum
+from typing import List
+
+POSE = 'pose'
+NEIGHBOURS = 'neighbors'
+CMD_VEL = 'cmd_vel'
+REFERENCE = '/formation/reference'
+CLOCK = '/clock'
+DIAGNOSTICS = '/diagnostics'
+MARKERS = '/formation/markers'
+PARAMS = '/formation/params'
+
+
+class QosKind(enum.Enum):
+    """Which profile of ``ros.qos`` a topic uses."""
+
+    STATE = 'state'
+    COMMAND = 'command'
+    REFERENCE = 'reference'
+    CLOCK = 'clock'
+    DIAGNOSTICS = 'diagnostics'
+    MARKERS = 'markers'
+
+
+@dataclass(frozen=True)
+class Topic:
+    """A topic of the formation: absolute name, ROS type name, QoS kind."""
+
+    name: str
+    type_name: str
+    qos: QosKind
+
+
+def robot_namespace(robot_id: int) -> str:
+    """Return the namespace of robot ``robot_id`` (1-based): ``/robot_<i>``."""
+    return f'/robot_{robot_id}'
+
+
+def robot_topic(robot_id: int, name: str) -> str:
+    """Return the absolute name of a robot topic: (3, CMD_VEL) gives ``/robot_3/cmd_vel``."""
+    return f'{robot_namespace(robot_id)}/{name}'
+
+
+def robot_topics(robot_id: int) -> List[Topic]:
+    """Return the three topics of robot ``robot_id``: pose, neighbours, command."""
+    return [
+        Topic(robot_topic(robot_id, POSE), 'geometry_msgs/msg/PoseStamped', QosKind.STATE),
+        Topic(robot_topic(robot_id, NEIGHBOURS), 'geometry_msgs/msg/PoseArray', QosKind.STATE),
+        Topic(robot_topic(robot_id, CMD_VEL), 'geometry_msgs/msg/TwistStamped',
+              QosKind.COMMAND),
+    ]
+
+
+def recorded_topics(num_robots: int, markers: bool) -> List[Topic]:
+    """Return every topic a recording of the formation holds (``/formation/params`` aside)."""
+    topics = [topic for i in range(1, num_robots + 1) for topic in robot_topics(i)]
+    topics += [
+        Topic(REFERENCE, 'nav_msgs/msg/Odometry', QosKind.REFERENCE),
+        Topic(CLOCK, 'rosgraph_msgs/msg/Clock', QosKind.CLOCK),
+        Topic(DIAGNOSTICS, 'diagnostic_msgs/msg/DiagnosticArray', QosKind.DIAGNOSTICS),
+    ]
+    if markers:
+        topics.append(Topic(MARKERS, 'visualization_msgs/msg/MarkerArray', QosKind.MARKERS))
+    return topics
