@@ -5,9 +5,11 @@
 
 import ast
 import glob
+import importlib.util
 import os
 from pathlib import Path
 import sys
+import types
 import xml.etree.ElementTree as ElementTree
 
 import pytest
@@ -110,3 +112,141 @@ def test_setup_py_and_package_xml_agree(setup_data):
     root = package_xml()
     assert setup_data['metadata']['name'] == root.findtext('name') == PACKAGE
     assert setup_data['metadata']['version'] == root.findtext('version')
+
+
+def test_setup_py_installs_the_launch_files(setup_data):
+    installed = dict(setup_data['data_files']).get(f'share/{PACKAGE}/launch', [])
+    assert 'launch/formation.launch.py' in installed, setup_data['data_files']
+
+
+class Recorded:
+    """Stands in for a launch action: keeps the arguments it was created with."""
+
+    def __init__(self, *args, **kwargs):
+        """Keep ``args`` and ``kwargs``."""
+        self.args = args
+        self.kwargs = kwargs
+
+
+class Shutdown(Recorded):
+    """Stands in for launch.actions.Shutdown."""
+
+
+class LaunchConfiguration:
+    """Stands in for launch.substitutions.LaunchConfiguration: reads the context's value."""
+
+    def __init__(self, variable_name, *, default=None):
+        """Name the launch argument."""
+        self.variable_name = variable_name
+
+    def perform(self, context):
+        """Return the argument's value in ``context`` (a dict here)."""
+        return context[self.variable_name]
+
+
+@pytest.fixture
+def launch_file(monkeypatch):
+    """
+    Load launch/formation.launch.py with launch and launch_ros replaced by recorders.
+
+    The ROS launch packages are not on PyPI; these stand-ins take the same arguments and keep
+    them, so the test sees the nodes the file asks for. The package's share directory is the
+    source tree (it has the same config/ folder).
+    """
+    modules = {
+        'launch': {'LaunchDescription': Recorded},
+        'launch.actions': {'DeclareLaunchArgument': Recorded, 'OpaqueFunction': Recorded,
+                           'Shutdown': Shutdown},
+        'launch.substitutions': {'LaunchConfiguration': LaunchConfiguration},
+        'launch_ros': {},
+        'launch_ros.actions': {'Node': Recorded},
+        'ament_index_python': {},
+        'ament_index_python.packages': {
+            'get_package_share_directory': {PACKAGE: ROOT}.__getitem__},
+    }
+    for name, attributes in modules.items():
+        module = types.ModuleType(name)
+        module.__dict__.update(attributes)
+        monkeypatch.setitem(sys.modules, name, module)
+    path = os.path.join(ROOT, 'launch', 'formation.launch.py')
+    spec = importlib.util.spec_from_file_location('formation_launch', path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def launched_nodes(launch_file, **arguments):
+    """Return the Node stand-ins the launch file starts for the given launch arguments."""
+    description = launch_file.generate_launch_description()
+    (actions,) = description.args
+    declared = {action.args[0]: action.kwargs['default_value'] for action in actions
+                if 'default_value' in action.kwargs}
+    context = {**declared, **arguments}
+    (opaque,) = [action for action in actions if 'function' in action.kwargs]
+    return opaque.kwargs['function'](context)
+
+
+def node_parameters(node):
+    """Return a node's parameters file and its parameter overrides merged in order."""
+    params_file, *overrides = node.kwargs['parameters']
+    merged = {}
+    for override in overrides:
+        merged.update(override)
+    return params_file, merged
+
+
+def test_launch_file_declares_its_arguments_and_defaults_to_section5(launch_file):
+    description = launch_file.generate_launch_description()
+    declared = {action.args[0]: action.kwargs['default_value']
+                for action in description.args[0] if action.args}
+    assert declared == {
+        'params_file': os.path.join(ROOT, 'config', 'paper_section5.yaml'),
+        'record': '', 'output_dir': ''}
+
+
+@pytest.mark.parametrize('record', ['', '/tmp/formation_bag'])
+def test_launch_file_starts_the_system_of_the_shell_launcher(launch_file, setup_data, record):
+    from formation_ros.core.params import SCHEMA
+    schema = {param.name: param for param in SCHEMA}
+    scripts = {entry.split('=')[0].strip()
+               for entry in setup_data['entry_points']['console_scripts']}
+    params = os.path.join(ROOT, 'config', 'square_4.yaml')
+    nodes = launched_nodes(launch_file, params_file=params, record=record,
+                           output_dir='/tmp/formation_out')
+
+    executables = sorted(node.kwargs['executable'] for node in nodes)
+    assert executables == sorted(['plant', 'reference'] + ['robot'] * 4
+                                 + (['record'] if record else []))
+    assert set(executables) <= scripts
+    robots = {}
+    for node in nodes:
+        executable = node.kwargs['executable']
+        assert node.kwargs['package'] == PACKAGE
+        assert isinstance(node.kwargs['on_exit'], Shutdown), f'{executable} exits alone'
+        params_file, overrides = node_parameters(node)
+        assert params_file == params
+        assert overrides.pop('use_sim_time', False) == (executable == 'reference')
+        for name in overrides:
+            assert name in schema, f'{executable}: {name} is not a parameter of the schema'
+            assert executable in schema[name].users, f'{executable} does not read {name}'
+        if executable == 'robot':
+            robots[overrides['robot_id']] = (node.kwargs['namespace'], overrides)
+        else:
+            assert node.kwargs['namespace'] is None, executable
+
+    waits = 2 if record else 1
+    assert robots == {i: (f'robot_{i}', {'robot_id': i, 'wait_for_subscribers': waits})
+                      for i in range(1, 5)}
+    (plant,) = [node for node in nodes if node.kwargs['executable'] == 'plant']
+    assert node_parameters(plant)[1] == {
+        'plant.output_dir': '/tmp/formation_out',
+        **({'plant.wait_for_subscribers': 2} if record else {})}
+    if record:
+        (recorder,) = [node for node in nodes if node.kwargs['executable'] == 'record']
+        assert node_parameters(recorder)[1] == {'record.path': record}
+
+
+def test_launch_file_without_output_dir_sets_none(launch_file):
+    nodes = launched_nodes(launch_file, params_file=os.path.join(ROOT, 'config', 'square_4.yaml'))
+    (plant,) = [node for node in nodes if node.kwargs['executable'] == 'plant']
+    assert node_parameters(plant)[1] == {}
