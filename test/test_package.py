@@ -114,6 +114,18 @@ def test_setup_py_and_package_xml_agree(setup_data):
     assert setup_data['metadata']['version'] == root.findtext('version')
 
 
+@pytest.mark.filterwarnings('ignore:nodes.Node.traverse:DeprecationWarning')
+def test_changelog_is_read_by_catkin_and_its_last_release_is_the_package_version():
+    from catkin_pkg.changelog import get_changelog_from_path
+    changelog = get_changelog_from_path(os.path.join(ROOT, 'CHANGELOG.rst'), PACKAGE)
+    versions = [version for version, _, _ in changelog.foreach_version()]
+    assert versions and versions[0] == package_xml().findtext('version'), versions
+    with open(os.path.join(ROOT, 'CHANGELOG.rst')) as stream:
+        title = stream.read().splitlines()[:3]
+    assert title[1] == f'Changelog for package {PACKAGE}'
+    assert title[0] == title[2] == '^' * len(title[1])
+
+
 def test_setup_py_installs_the_launch_files(setup_data):
     installed = dict(setup_data['data_files']).get(f'share/{PACKAGE}/launch', [])
     assert 'launch/formation.launch.py' in installed, setup_data['data_files']
