@@ -18,6 +18,7 @@ def test_install_layout(install):
                                        'formation_ros'))
     configs = os.listdir(os.path.join(share, 'formation_ros', 'config'))
     assert 'paper_section5.yaml' in configs and 'square_4.yaml' in configs
+    assert os.path.isfile(os.path.join(share, 'formation_ros', 'launch', 'formation.launch.py'))
 
 
 def test_installed_executable_runs_from_install_space(install, ros_env, tmp_path):
