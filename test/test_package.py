@@ -218,8 +218,7 @@ def test_launch_file_declares_its_arguments_and_defaults_to_section5(launch_file
 
 @pytest.mark.parametrize('record', ['', '/tmp/formation_bag'])
 def test_launch_file_starts_the_system_of_the_shell_launcher(launch_file, setup_data, record):
-    from formation_ros.core.params import SCHEMA
-    schema = {param.name: param for param in SCHEMA}
+    from formation_ros.core.declarations import BY_NAME as schema, Exe
     scripts = {entry.split('=')[0].strip()
                for entry in setup_data['entry_points']['console_scripts']}
     params = os.path.join(ROOT, 'config', 'square_4.yaml')
@@ -240,7 +239,7 @@ def test_launch_file_starts_the_system_of_the_shell_launcher(launch_file, setup_
         assert overrides.pop('use_sim_time', False) == (executable == 'reference')
         for name in overrides:
             assert name in schema, f'{executable}: {name} is not a parameter of the schema'
-            assert executable in schema[name].users, f'{executable} does not read {name}'
+            assert Exe(executable) in schema[name].users, f'{executable} does not read {name}'
         if executable == 'robot':
             robots[overrides['robot_id']] = (node.kwargs['namespace'], overrides)
         else:
