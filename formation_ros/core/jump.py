@@ -23,7 +23,7 @@ from functools import lru_cache
 import math
 
 import numpy as np
-from scipy import integrate, special
+from scipy import special
 
 JUMP_KINDS = ('poly', 'smooth')
 
@@ -120,6 +120,7 @@ class SmoothJump:
         reads ``int exp(-w) k / ((1 - 2 sigma) P**2) dw`` with ``P = Phi(s) + w``, ``k = 1/L``:
         smooth, with no boundary layer however small s is. Nearer 1/2 it is taken directly.
         """
+        from scipy import integrate  # only the smooth kind integrates; robots need not load it
         k = inv_len
         phi_s = k / (s * (1.0 - s))
         if s < 0.3:

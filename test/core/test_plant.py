@@ -1,0 +1,144 @@
+"""The plant model (core/plant.py): zero-order hold, admission, bound audit, collisions, sensor."""
+
+import math
+import os
+
+from formation_ros.core.law import make_law, team_command
+from formation_ros.core.params import load_config
+from formation_ros.core.plant import (Commands, CommandStatus, PlantModel, random_start,
+                                      start_positions, StartSpec)
+from formation_ros.core.reference import Reference
+from formation_ros.tools.sim import simulate
+import numpy as np
+import pytest
+
+CONFIG = os.path.join(os.path.dirname(__file__), '..', '..', 'config')
+LAW = make_law(2.0, 1.0, 'arctan', 'poly', 2, 0.5)
+FIXED = Reference('fixed', 2)
+MS = 10_000_000
+
+
+def model(q, radii=1.0, timeout_ns=50 * MS, collision=1e-3, reference=FIXED):
+    q = np.asarray(q, dtype=float)
+    return PlantModel(q, np.full(len(q), radii), MS, LAW, reference, timeout_ns, collision)
+
+
+def test_zero_order_hold_step_and_time_in_nanoseconds():
+    start = np.array([[0.0, 0.0], [3.0, 0.0], [0.0, 3.0]])
+    plant = model(start)
+    commands = Commands.empty(3, 2)
+    u = np.array([[1.0, -2.0], [0.5, 0.0], [0.0, 0.25]])
+    commands.store_all(u, 0)
+    report = plant.advance(commands)
+    assert report.t_ns == 0 and np.array_equal(report.q, start)
+    assert plant.t_ns == MS and plant.t == pytest.approx(0.01)
+    assert np.array_equal(plant.q, start + 0.01 * u)
+    assert np.array_equal(start, [[0.0, 0.0], [3.0, 0.0], [0.0, 3.0]])
+    assert np.array_equal(u, [[1.0, -2.0], [0.5, 0.0], [0.0, 0.25]])
+
+
+def test_admission_names_why_a_command_does_not_count():
+    plant = model([[0.0, 0.0], [3.0, 0.0], [0.0, 3.0], [3.0, 3.0]], timeout_ns=20 * MS)
+    for _ in range(5):
+        plant.advance(Commands.empty(4, 2))
+    commands = Commands.empty(4, 2)
+    commands.store(0, [0.1, 0.2], plant.t_ns - 20 * MS)
+    commands.store(1, [0.1, 0.2], plant.t_ns - 20 * MS - 1)
+    commands.store(2, [math.nan, 0.2], plant.t_ns)
+    admission = plant.admit(commands)
+    assert admission.status.tolist() == [CommandStatus.APPLIED, CommandStatus.STALE,
+                                         CommandStatus.NON_FINITE, CommandStatus.MISSING]
+    assert admission.u.tolist() == [[0.1, 0.2], [0.0, 0.0], [0.0, 0.0], [0.0, 0.0]]
+    plant.advance(commands)
+    totals = plant.counts.totals()
+    assert totals['stale_command_steps'] == 1 and totals['bad_command_steps'] == 1
+    assert totals['missing_command_steps'] == 5 * 4 + 1 and totals['steps'] == 6
+
+
+def test_a_collision_is_counted_once_per_approach():
+    plant = model([[0.0, 0.0], [0.01, 0.0], [5.0, 5.0]], collision=0.005)
+    commands = Commands.empty(3, 2)
+    commands.store_all([[0.2, 0.0], [-0.2, 0.0], [0.0, 0.0]], 0)
+    reports = []
+    for _ in range(4):
+        commands.stamp_ns[:] = plant.t_ns
+        reports.append(plant.advance(commands))
+    assert [len(r.collisions) for r in reports] == [0, 1, 0, 0]
+    (i, j, distance), = reports[1].collisions
+    assert (i, j) == (0, 1) and distance == pytest.approx(0.002)
+    assert plant.counts.collisions == 1
+
+
+def test_bound_audit_counts_each_new_command_once():
+    plant = model([[0.0, 0.0], [3.0, 0.0]])
+    commands = Commands.empty(2, 2)
+    commands.store_all([[LAW.u_bound + 0.1, 0.0], [0.0, -LAW.u_bound]], 0)
+    first = plant.advance(commands)
+    again = plant.advance(commands)
+    assert [robot for robot, _ in first.violations] == [0]
+    assert first.violations[0][1] == pytest.approx(LAW.u_bound + 0.1)
+    assert again.violations == [] and plant.counts.bound_violations == 1
+
+
+def test_bound_audit_of_a_moving_reference_uses_the_formation_frame():
+    circle = Reference('circle', 2, radius=2.0, speed=1.0)
+    q = np.array([[2.0, 0.3], [-1.0, -1.0]])
+    plant = model(q, reference=circle, timeout_ns=10 * MS)
+    config_vertices = np.array([[0.3, 0.0], [-0.3, 0.0]])
+    frame = circle.sample(0.0)
+    command = team_command(q, config_vertices, np.full(2, 1.0), LAW, frame)
+    assert np.max(np.abs(command.u)) > LAW.u_bound or np.max(np.abs(command.u_hat)) < LAW.u_bound
+    commands = Commands.empty(2, 2)
+    commands.store_all(command.u, 0)
+    assert plant.advance(commands).violations == []
+    commands.store_all(command.u + [[0.0, 0.0], [10.0, 0.0]], plant.t_ns)
+    assert [robot for robot, _ in plant.advance(commands).violations] == [1]
+
+
+def test_range_sensor_sees_the_others_strictly_within_each_radius():
+    rng = np.random.default_rng(4)
+    q = rng.uniform(-3.0, 3.0, size=(60, 2))
+    radii = rng.uniform(0.3, 1.5, size=60)
+    q[0], q[1] = [0.0, 0.0], [radii[0], 0.0]
+    plant = PlantModel(q, radii, MS, LAW, FIXED, MS, 1e-3)
+    seen = plant.neighbours()
+    assert len(seen) == 60
+    for i in range(60):
+        expected = [j for j in range(60)
+                    if j != i and np.sum((q[j] - q[i]) ** 2) < radii[i] ** 2]
+        assert seen[i].tolist() == expected, i
+    assert 1 not in seen[0].tolist()
+
+
+def test_closest_pair_distance():
+    plant = model([[0.0, 0.0], [3.0, 4.0], [0.0, 2.0]])
+    assert plant.closest_pair_distance() == pytest.approx(2.0)
+
+
+def test_start_positions_random_and_explicit():
+    points = random_start(30, 3, 2.0, 0.3, seed=5)
+    assert points.shape == (30, 3) and np.all(np.linalg.norm(points, axis=1) <= 2.0)
+    gaps = np.linalg.norm(points[:, None] - points[None], axis=2)
+    assert np.min(gaps[np.triu_indices(30, 1)]) >= 0.3
+    assert np.array_equal(points, start_positions(StartSpec(30, 3, None, 2.0, 0.3, 5)))
+    assert random_start(50, 2, 0.1, 0.1, seed=0) is None
+    given = np.arange(6.0).reshape(3, 2)
+    assert np.array_equal(start_positions(StartSpec(3, 2, given)), given)
+
+
+@pytest.mark.parametrize('name', ['square_4.yaml', 'circle_2d.yaml'])
+def test_formation_sim_fixed_step_is_the_plant_model_answered_every_step(name):
+    """formation_sim --dt: the law answers each state of the model, stamped with its time."""
+    config = load_config(os.path.join(CONFIG, name))
+    law, reference = config.law(), config.reference()
+    trajectory = simulate(config, duration=0.5, dt=0.01, sample_dt=0.01)
+    plant = PlantModel(config.start, config.sensing_radii, MS, law, reference, MS, 1e-3)
+    commands = Commands.empty(config.num_robots, config.dim)
+    for k in range(50):
+        assert np.array_equal(plant.q, trajectory.q[k])
+        commands.store_all(team_command(plant.q, config.vertices, config.sensing_radii, law,
+                                        reference.sample(plant.t)).u, plant.t_ns)
+        assert np.array_equal(trajectory.u[k], commands.u)
+        report = plant.advance(commands)
+        assert (report.admission.status == CommandStatus.APPLIED).all()
+    assert np.array_equal(plant.q, trajectory.q[50])
