@@ -7,11 +7,11 @@ Rows of J are the frame's axes written in world coordinates. With positions stor
 
 Frames:
 
-* 2D (Section 6, ERRATA 6): ``J = [[cos th, sin th], [-sin th, cos th]]`` with
+* 2D (Section 6; docs/equations.md, slip 6): ``J = [[cos th, sin th], [-sin th, cos th]]`` with
   ``th = atan2(y', x')``; ``Jdot = th' [[-sin, cos], [-cos, -sin]]`` with
   ``th' = (x' y'' - y' x'') / v**2``.
 * 3D Frenet (helix): rows t, n, b; ``Jdot = -[w]x J`` with the Darboux vector
-  ``w = v (tau, 0, k)`` (ERRATA 6).
+  ``w = v (tau, 0, k)`` (docs/equations.md, slip 6).
 * 3D planar (line, circle, figure eight; beyond the paper): ``b`` is the fixed plane normal,
   ``n = b x t``. This is the Frenet triad wherever the path turns counter-clockwise about the
   normal, and unlike the Frenet triad it stays defined and continuous where the curvature is zero
@@ -69,10 +69,10 @@ def to_frame_vectors(v, frame):
 
 def from_frame_velocity(u_hat, q, frame):
     """
-    Eq. (25) with ERRATA 5: ``u = qdot_od + J^{-1} (u_hat - Jdot (q - q_od))``.
+    World velocities from formation-frame commands: eq. (25), docs/equations.md, slip 5.
 
-    u_hat: (N, dim) commands in the formation frame; q: (N, dim) world positions.
-    Returns (N, dim) world velocities in m/s.
+    ``u = qdot_od + J^{-1} (u_hat - Jdot (q - q_od))``. u_hat: (N, dim) commands in the formation
+    frame; q: (N, dim) world positions. Returns (N, dim) world velocities in m/s.
     """
     u_hat = np.asarray(u_hat, dtype=float)
     if frame is None:
@@ -110,7 +110,7 @@ def skew(w):
 
 def frame_2d(qdot, qddot):
     """
-    J and Jdot in 2D from the reference velocity and acceleration (ERRATA 6).
+    J and Jdot in 2D from the reference velocity and acceleration (docs/equations.md, slip 6).
 
     Returns (J, Jdot), each (2, 2). A reference at rest has J = I, Jdot = 0.
     """
@@ -149,7 +149,7 @@ def frame_planar_3d(qdot, qddot, normal):
 
 def frame_frenet_3d(qdot, qddot, qdddot):
     """
-    Frenet J and Jdot = -[w]x J, w = v (tau, 0, k) (Section 6, ERRATA 6).
+    Frenet J and Jdot = -[w]x J, w = v (tau, 0, k) (Section 6; docs/equations.md, slip 6).
 
     Needs a curvature bounded away from zero (the helix). Returns (J, Jdot), each (3, 3).
     """

@@ -3,13 +3,14 @@ Jump functions of Lemma 1 (eqs. 5-7) and the collision terms built from them (eq
 
 A jump function ``h(x, a, b)`` is 0 for ``x <= a``, 1 for ``x >= b``, smooth in between.
 The controller only ever needs it at ``a = 0``, ``b = b_ij**2 / 2`` and ``x = ||q_ij||**2 / 2``
-(eq. 11 read as in ERRATA 1), but the functions here take any ``0 <= a < b``.
+(eq. 11 read as in docs/equations.md, slip 1), but the functions here take any ``0 <= a < b``.
 
 Two kinds of ``g`` (eq. 7) are implemented:
 
 * ``PolyJump(p)``: ``g(y) = y**p`` for an integer ``p >= 1``. Then ``h`` is the regularized
-  incomplete beta function ``I_t(p + 1, p + 1)`` with ``t = (x - a) / (b - a)`` (ERRATA 4), written
-  here as the finite binomial sum ``t**(p+1) * S(t)`` so that ``h'/h`` stays exact as ``t -> 0``.
+  incomplete beta function ``I_t(p + 1, p + 1)`` with ``t = (x - a) / (b - a)``
+  (docs/equations.md, slip 4), written here as the finite binomial sum ``t**(p+1) * S(t)`` so
+  that ``h'/h`` stays exact as ``t -> 0``.
 * ``SmoothJump()``: ``g(y) = exp(-1/y)`` (Corollary 1). ``h`` needs an integral, evaluated by
   adaptive quadrature (``scipy.integrate.quad``, relative tolerance 1e-13) in a scaled form that
   cannot underflow; ``h'`` is closed form.
@@ -34,7 +35,7 @@ def _check_interval(a, b):
 
 
 class PolyJump:
-    """p times differentiable jump function with ``g(y) = y**p`` (Lemma 1, ERRATA 4)."""
+    """Jump function of Lemma 1 with ``g(y) = y**p`` (docs/equations.md, slip 4)."""
 
     kind = 'poly'
 
@@ -67,7 +68,7 @@ class PolyJump:
         return t ** (self.order + 1) * self._sum_s(t)
 
     def dh(self, x, a, b):
-        """Closed-form derivative dh/dx (ERRATA 4), in 1/m**2; zero outside (a, b)."""
+        """Closed-form dh/dx (docs/equations.md, slip 4), in 1/m**2; zero outside (a, b)."""
         _check_interval(a, b)
         x = np.asarray(x, dtype=float)
         p = self.order

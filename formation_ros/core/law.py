@@ -73,7 +73,7 @@ def psi(omega, law):
 
 
 def beta(distance_sq, law):
-    """Return beta_ij of eq. (11) (ERRATA 1) from squared distances ||q_ij||**2, any shape."""
+    """Return beta_ij of eq. (11) (docs/equations.md, slip 1) from ||q_ij||**2, any shape."""
     b = law.repulsion_radius
     return law.jump.h(0.5 * np.asarray(distance_sq, dtype=float), 0.0, 0.5 * b * b)
 
@@ -82,9 +82,9 @@ def repulsion_terms(q_ij, law):
     """
     Return betabar'_ij * q_ij for rows of relative positions q_ij = q_i - q_j.
 
-    q_ij: (K, dim) in m. Returns (K, dim) in 1/m. betabar' = h'/h (eq. 13, ERRATA 3) is zero for
-    ||q_ij|| >= b. A row with q_ij exactly zero (two robots at one point) has no direction and
-    contributes zero; the callers report such a collision.
+    q_ij: (K, dim) in m. Returns (K, dim) in 1/m. betabar' = h'/h (eq. 13; docs/equations.md,
+    slip 3) is zero for ||q_ij|| >= b. A row with q_ij exactly zero (two robots at one point) has
+    no direction and contributes zero; the callers report such a collision.
     """
     q_ij = np.asarray(q_ij, dtype=float)
     d2 = np.einsum('kd,kd->k', q_ij, q_ij)

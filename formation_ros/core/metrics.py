@@ -50,7 +50,7 @@ def dis_min_series(q):
 
 
 def dis_all(points):
-    """Return the 'mean-product' distance of Section 5 (ERRATA 7): geometric mean of ||q_ij||."""
+    """Return dis_all of Section 5, the geometric mean of ||q_ij|| (docs/equations.md, slip 7)."""
     with np.errstate(divide='ignore'):
         return float(np.exp(np.mean(np.log(pdist(np.asarray(points, dtype=float))))))
 

@@ -95,7 +95,7 @@ def test_vertical_line_has_a_frame():
 
 @pytest.mark.parametrize('kind,dim', CASES)
 def test_eq25_gives_qhat_dot_equal_u_hat(kind, dim):
-    """Differentiating eq. (21) along u of eq. (25) gives qhat' = u_hat (eq. 24, ERRATA 5)."""
+    """Eq. (21) along u of eq. (25) gives qhat' = u_hat (eq. 24; docs/equations.md, slip 5)."""
     reference = make(kind, dim)
     rng = np.random.default_rng(1)
     q = rng.normal(size=(4, dim)) * 3.0
