@@ -24,6 +24,7 @@ Frames:
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 STATIONARY = None
 SPEED_EPS = 1e-12
@@ -173,53 +174,29 @@ def _vee(skew_matrix):
     return np.array([skew_matrix[2, 1], skew_matrix[0, 2], skew_matrix[1, 0]])
 
 
-def _embed(matrix):
-    """Embed a 2x2 rotation (about z) in 3x3; return a 3x3 matrix unchanged."""
-    if matrix.shape == (3, 3):
-        return matrix
-    out = np.eye(3)
-    out[:2, :2] = matrix
-    return out
+def _rotation_and_angular_velocity(frame):
+    """
+    J as a 3x3 rotation and the frame's world angular velocity w, with ``Jdot = -J [w]x``.
 
-
-def _rotation_exp(vector):
-    """Return exp([v]x), the rotation by |v| rad about v (Rodrigues)."""
-    angle = float(np.linalg.norm(vector))
-    k = skew(vector)
-    if angle < 1e-12:
-        return np.eye(3) + k
-    return np.eye(3) + np.sin(angle) / angle * k + (1.0 - np.cos(angle)) / angle ** 2 * (k @ k)
+    A 2D frame is a rotation about z: J goes in the upper left block of the identity, and w has
+    only a z component.
+    """
+    dim = frame.J.shape[0]
+    jmat, jdot = np.eye(3), np.zeros((3, 3))
+    jmat[:dim, :dim] = frame.J
+    jdot[:dim, :dim] = frame.Jdot
+    return jmat, _vee(-jmat.T @ jdot)
 
 
 def quaternion_from_matrix(rotation):
     """Return the unit quaternion (x, y, z, w), w >= 0, of a 3x3 rotation matrix."""
-    r = np.asarray(rotation, dtype=float)
-    trace = np.trace(r)
-    if trace > 0.0:
-        s = 2.0 * np.sqrt(trace + 1.0)
-        quat = [(r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s,
-                0.25 * s]
-    else:
-        i = int(np.argmax(np.diag(r)))
-        j, k = (i + 1) % 3, (i + 2) % 3
-        s = 2.0 * np.sqrt(1.0 + r[i, i] - r[j, j] - r[k, k])
-        quat = [0.0, 0.0, 0.0, (r[k, j] - r[j, k]) / s]
-        quat[i] = 0.25 * s
-        quat[j] = (r[j, i] + r[i, j]) / s
-        quat[k] = (r[k, i] + r[i, k]) / s
-    quat = np.array(quat)
-    quat /= np.linalg.norm(quat)
+    quat = Rotation.from_matrix(np.asarray(rotation, dtype=float)).as_quat()
     return quat if quat[3] >= 0.0 else -quat
 
 
 def matrix_from_quaternion(quat):
-    """Return the rotation matrix (3, 3) of a quaternion (x, y, z, w), normalised first."""
-    x, y, z, w = np.asarray(quat, dtype=float) / np.linalg.norm(quat)
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
+    """Return the rotation matrix (3, 3) of a quaternion (x, y, z, w) != 0, normalised first."""
+    return Rotation.from_quat(np.asarray(quat, dtype=float)).as_matrix()
 
 
 def frame_to_pose(frame, dim):
@@ -232,14 +209,10 @@ def frame_to_pose(frame, dim):
     stationary frame at the origin. 2D frames are rotations about z, with z components zero.
     """
     frame = stationary_frame(dim) if frame is None else frame
-    jmat, jdot = _embed(frame.J), _embed(frame.Jdot)
-    if dim == 2:
-        jdot = np.zeros((3, 3))
-        jdot[:2, :2] = frame.Jdot
+    jmat, angular = _rotation_and_angular_velocity(frame)
     position, linear = np.zeros(3), np.zeros(3)
     position[:dim] = frame.q_od
     linear[:dim] = frame.qdot_od
-    angular = _vee(-jmat.T @ jdot)
     return position, quaternion_from_matrix(jmat.T), linear, angular
 
 
@@ -257,17 +230,15 @@ def advance(frame, dt):
     Carry a frame forward by dt seconds at constant velocity and angular velocity.
 
     Used to bring the latest reference sample to the time of a robot's state; exact for a line
-    and a fixed reference, first order in dt otherwise. Returns a new :class:`FrameSample`.
+    and a fixed reference, and for J of a circle or helix (constant angular velocity); q_od is
+    first order in dt otherwise. Returns a new :class:`FrameSample` (``frame`` itself for
+    ``dt == 0`` or ``None``).
     """
     if frame is None or dt == 0.0:
         return frame
     dim = frame.q_od.shape[0]
-    jmat, jdot = _embed(frame.J), _embed(frame.Jdot)
-    if dim == 2:
-        jdot = np.zeros((3, 3))
-        jdot[:2, :2] = frame.Jdot
-    omega = _vee(-jmat.T @ jdot)
-    moved = jmat @ _rotation_exp(-omega * dt)
+    jmat, omega = _rotation_and_angular_velocity(frame)
+    moved = jmat @ Rotation.from_rotvec(-omega * dt).as_matrix()
     moved_dot = -moved @ skew(omega)
     return FrameSample(frame.t + dt, frame.q_od + frame.qdot_od * dt, frame.qdot_od.copy(),
                        moved[:dim, :dim].copy(), moved_dot[:dim, :dim].copy())
