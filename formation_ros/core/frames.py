@@ -184,7 +184,8 @@ def _vee(skew_matrix: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.array([skew_matrix[2, 1], skew_matrix[0, 2], skew_matrix[1, 0]])
 
 
-def _rotation_and_angular_velocity(frame: FrameSample) -> JAndJdot:
+def _rotation_and_angular_velocity(
+        frame: FrameSample) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """
     J as a 3x3 rotation and the frame's world angular velocity w, with ``Jdot = -J [w]x``.
 
