@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import difflib
 import enum
 import math
-from typing import Iterable, Mapping, Optional, Tuple
+from typing import Any, Dict, FrozenSet, Iterable, Mapping, Optional, Tuple, Type
 
 DEFAULT_COLLISION_DISTANCE = 1e-3
 
@@ -114,7 +114,7 @@ class Param:
     low: Optional[Bound] = None
     high: Optional[Bound] = None
     choices: Tuple[str, ...] = ()
-    users: frozenset = ALL
+    users: FrozenSet[Exe] = ALL
 
     def range_text(self) -> str:
         """Describe the allowed values, e.g. ``> 0``, ``2 to 3``, ``arctan, tanh``."""
@@ -128,8 +128,8 @@ class Param:
         return ', '.join(parts)
 
 
-def _choices(kind: type) -> Tuple[str, ...]:
-    return tuple(member.value for member in kind)
+def _choices(kind: Type[enum.Enum]) -> Tuple[str, ...]:
+    return tuple(str(member.value) for member in kind)
 
 
 DECLARATIONS = (
@@ -308,8 +308,8 @@ def range_problem(param: Param, value: object) -> Optional[str]:
         return None if ok else f"must be one of {', '.join(param.choices)}; got {value!r}"
     if param.kind not in (Kind.INT, Kind.DOUBLE, Kind.DOUBLE_ARRAY):
         return None
-    items = value if param.kind is Kind.DOUBLE_ARRAY else [value]
-    for item in items:  # type: ignore[union-attr]
+    items: Any = value if param.kind is Kind.DOUBLE_ARRAY else [value]
+    for item in items:
         for bound, lower in ((param.low, True), (param.high, False)):
             if bound is not None and _outside(item, bound, lower):
                 sign = ('>' if lower else '<') + ('=' if bound.inclusive else '')
@@ -317,7 +317,7 @@ def range_problem(param: Param, value: object) -> Optional[str]:
     return None
 
 
-def check_values(raw: Mapping[str, object], exe: Exe) -> dict:
+def check_values(raw: Mapping[str, Any], exe: Exe) -> Dict[str, Any]:
     """
     Check names, types and ranges; return {name: value} with the static defaults filled in.
 
@@ -326,7 +326,7 @@ def check_values(raw: Mapping[str, object], exe: Exe) -> dict:
     """
     problems = [(name, f'unknown parameter{did_you_mean(name)}') for name in raw
                 if not is_known(name)]
-    values = {}
+    values: Dict[str, Any] = {}
     for param in used_by(exe):
         value = raw.get(param.name)
         if value is None:

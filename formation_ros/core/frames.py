@@ -7,11 +7,11 @@ Rows of J are the frame's axes written in world coordinates. With positions stor
 
 Frames:
 
-* 2D (Section 6, ERRATA 6): ``J = [[cos th, sin th], [-sin th, cos th]]`` with
+* 2D (Section 6; docs/equations.md, slip 6): ``J = [[cos th, sin th], [-sin th, cos th]]`` with
   ``th = atan2(y', x')``; ``Jdot = th' [[-sin, cos], [-cos, -sin]]`` with
   ``th' = (x' y'' - y' x'') / v**2``.
 * 3D Frenet (helix): rows t, n, b; ``Jdot = -[w]x J`` with the Darboux vector
-  ``w = v (tau, 0, k)`` (ERRATA 6).
+  ``w = v (tau, 0, k)`` (docs/equations.md, slip 6).
 * 3D planar (line, circle, figure eight; beyond the paper): ``b`` is the fixed plane normal,
   ``n = b x t``. This is the Frenet triad wherever the path turns counter-clockwise about the
   normal, and unlike the Frenet triad it stays defined and continuous where the curvature is zero
@@ -22,11 +22,17 @@ Frames:
 """
 
 from dataclasses import dataclass
+from typing import Optional, overload
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.spatial.transform import Rotation
 
 STATIONARY = None
 SPEED_EPS = 1e-12
+
+JAndJdot = tuple[NDArray[np.float64], NDArray[np.float64]]
+Pose = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
 
 
 @dataclass(frozen=True)
@@ -39,19 +45,19 @@ class FrameSample:
     """
 
     t: float
-    q_od: np.ndarray
-    qdot_od: np.ndarray
-    J: np.ndarray
-    Jdot: np.ndarray
+    q_od: NDArray[np.float64]
+    qdot_od: NDArray[np.float64]
+    J: NDArray[np.float64]
+    Jdot: NDArray[np.float64]
 
 
-def stationary_frame(dim, origin=None, t=0.0):
+def stationary_frame(dim: int, origin: Optional[ArrayLike] = None, t: float = 0.0) -> FrameSample:
     """Frame of a fixed reference at ``origin`` (default 0): J = I, Jdot = 0."""
     q_od = np.zeros(dim) if origin is None else np.asarray(origin, dtype=float).copy()
     return FrameSample(float(t), q_od, np.zeros(dim), np.eye(dim), np.zeros((dim, dim)))
 
 
-def to_frame(q, frame):
+def to_frame(q: ArrayLike, frame: Optional[FrameSample]) -> NDArray[np.float64]:
     """Eq. (21): positions (N, dim) in the world frame -> formation frame (N, dim)."""
     q = np.asarray(q, dtype=float)
     if frame is None:
@@ -59,7 +65,7 @@ def to_frame(q, frame):
     return (q - frame.q_od) @ frame.J.T
 
 
-def to_frame_vectors(v, frame):
+def to_frame_vectors(v: ArrayLike, frame: Optional[FrameSample]) -> NDArray[np.float64]:
     """Rotate free vectors (N, dim), e.g. q_ij, into the formation frame (no translation)."""
     v = np.asarray(v, dtype=float)
     if frame is None:
@@ -67,12 +73,13 @@ def to_frame_vectors(v, frame):
     return v @ frame.J.T
 
 
-def from_frame_velocity(u_hat, q, frame):
+def from_frame_velocity(u_hat: ArrayLike, q: ArrayLike,
+                        frame: Optional[FrameSample]) -> NDArray[np.float64]:
     """
-    Eq. (25) with ERRATA 5: ``u = qdot_od + J^{-1} (u_hat - Jdot (q - q_od))``.
+    World velocities from formation-frame commands: eq. (25), docs/equations.md, slip 5.
 
-    u_hat: (N, dim) commands in the formation frame; q: (N, dim) world positions.
-    Returns (N, dim) world velocities in m/s.
+    ``u = qdot_od + J^{-1} (u_hat - Jdot (q - q_od))``. u_hat: (N, dim) commands in the formation
+    frame; q: (N, dim) world positions. Returns (N, dim) world velocities in m/s.
     """
     u_hat = np.asarray(u_hat, dtype=float)
     if frame is None:
@@ -81,7 +88,8 @@ def from_frame_velocity(u_hat, q, frame):
     return frame.qdot_od + (u_hat - offset @ frame.Jdot.T) @ frame.J
 
 
-def to_frame_velocity(u, q, frame):
+def to_frame_velocity(u: ArrayLike, q: ArrayLike,
+                      frame: Optional[FrameSample]) -> NDArray[np.float64]:
     """
     Invert eq. (25): ``u_hat = J (u - qdot_od) + Jdot (q - q_od)``.
 
@@ -95,7 +103,8 @@ def to_frame_velocity(u, q, frame):
     return (u - frame.qdot_od) @ frame.J.T + offset @ frame.Jdot.T
 
 
-def desired_positions(vertices, frame):
+def desired_positions(vertices: ArrayLike,
+                      frame: Optional[FrameSample]) -> NDArray[np.float64]:
     """Eq. (20) solved for q_id: ``q_id = q_od + J^{-1} qhat_id``; (N, dim) -> (N, dim)."""
     vertices = np.asarray(vertices, dtype=float)
     if frame is None:
@@ -103,17 +112,19 @@ def desired_positions(vertices, frame):
     return frame.q_od + vertices @ frame.J
 
 
-def skew(w):
+def skew(w: ArrayLike) -> NDArray[np.float64]:
     """Return the cross-product matrix [w]x of a 3-vector w (times v gives w x v)."""
+    w = np.asarray(w, dtype=float)
     return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
 
 
-def frame_2d(qdot, qddot):
+def frame_2d(qdot: ArrayLike, qddot: ArrayLike) -> JAndJdot:
     """
-    J and Jdot in 2D from the reference velocity and acceleration (ERRATA 6).
+    J and Jdot in 2D from the reference velocity and acceleration (docs/equations.md, slip 6).
 
     Returns (J, Jdot), each (2, 2). A reference at rest has J = I, Jdot = 0.
     """
+    qdot, qddot = np.asarray(qdot, dtype=float), np.asarray(qddot, dtype=float)
     vx, vy = float(qdot[0]), float(qdot[1])
     v2 = vx * vx + vy * vy
     if v2 <= SPEED_EPS ** 2:
@@ -126,19 +137,19 @@ def frame_2d(qdot, qddot):
     return jmat, jdot
 
 
-def frame_planar_3d(qdot, qddot, normal):
+def frame_planar_3d(qdot: ArrayLike, qddot: ArrayLike, normal: ArrayLike) -> JAndJdot:
     """
     J and Jdot in 3D for a path in a plane with unit ``normal`` (module docstring).
 
     For a straight line ``normal`` only fixes the roll of the frame: any unit vector not parallel
     to the line. Returns (J, Jdot), each (3, 3); a reference at rest has J = I, Jdot = 0.
     """
-    qdot = np.asarray(qdot, dtype=float)
+    qdot, qddot = np.asarray(qdot, dtype=float), np.asarray(qddot, dtype=float)
     speed = float(np.linalg.norm(qdot))
     if speed <= SPEED_EPS:
         return np.eye(3), np.zeros((3, 3))
     tangent = qdot / speed
-    n_raw = np.cross(normal, tangent)
+    n_raw = np.cross(np.asarray(normal, dtype=float), tangent)
     n_vec = n_raw / np.linalg.norm(n_raw)
     b_vec = np.cross(tangent, n_vec)
     jmat = np.vstack([tangent, n_vec, b_vec])
@@ -147,13 +158,13 @@ def frame_planar_3d(qdot, qddot, normal):
     return jmat, jdot
 
 
-def frame_frenet_3d(qdot, qddot, qdddot):
+def frame_frenet_3d(qdot: ArrayLike, qddot: ArrayLike, qdddot: ArrayLike) -> JAndJdot:
     """
-    Frenet J and Jdot = -[w]x J, w = v (tau, 0, k) (Section 6, ERRATA 6).
+    Frenet J and Jdot = -[w]x J, w = v (tau, 0, k) (Section 6; docs/equations.md, slip 6).
 
     Needs a curvature bounded away from zero (the helix). Returns (J, Jdot), each (3, 3).
     """
-    qdot = np.asarray(qdot, dtype=float)
+    qdot, qddot = np.asarray(qdot, dtype=float), np.asarray(qddot, dtype=float)
     speed = float(np.linalg.norm(qdot))
     cross = np.cross(qdot, qddot)
     cross_norm = float(np.linalg.norm(cross))
@@ -163,66 +174,44 @@ def frame_frenet_3d(qdot, qddot, qdddot):
     b_vec = cross / cross_norm
     n_vec = np.cross(b_vec, tangent)
     curvature = cross_norm / speed ** 3
-    torsion = float(np.dot(cross, qdddot)) / cross_norm ** 2
+    torsion = float(np.dot(cross, np.asarray(qdddot, dtype=float))) / cross_norm ** 2
     jmat = np.vstack([tangent, n_vec, b_vec])
     jdot = -skew(speed * np.array([torsion, 0.0, curvature])) @ jmat
     return jmat, jdot
 
 
-def _vee(skew_matrix):
+def _vee(skew_matrix: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.array([skew_matrix[2, 1], skew_matrix[0, 2], skew_matrix[1, 0]])
 
 
-def _embed(matrix):
-    """Embed a 2x2 rotation (about z) in 3x3; return a 3x3 matrix unchanged."""
-    if matrix.shape == (3, 3):
-        return matrix
-    out = np.eye(3)
-    out[:2, :2] = matrix
-    return out
+def _rotation_and_angular_velocity(
+        frame: FrameSample) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """
+    J as a 3x3 rotation and the frame's world angular velocity w, with ``Jdot = -J [w]x``.
+
+    A 2D frame is a rotation about z: J goes in the upper left block of the identity, and w has
+    only a z component.
+    """
+    dim = frame.J.shape[0]
+    jmat, jdot = np.eye(3), np.zeros((3, 3))
+    jmat[:dim, :dim] = frame.J
+    jdot[:dim, :dim] = frame.Jdot
+    return jmat, _vee(-jmat.T @ jdot)
 
 
-def _rotation_exp(vector):
-    """Return exp([v]x), the rotation by |v| rad about v (Rodrigues)."""
-    angle = float(np.linalg.norm(vector))
-    k = skew(vector)
-    if angle < 1e-12:
-        return np.eye(3) + k
-    return np.eye(3) + np.sin(angle) / angle * k + (1.0 - np.cos(angle)) / angle ** 2 * (k @ k)
-
-
-def quaternion_from_matrix(rotation):
+def quaternion_from_matrix(rotation: ArrayLike) -> NDArray[np.float64]:
     """Return the unit quaternion (x, y, z, w), w >= 0, of a 3x3 rotation matrix."""
-    r = np.asarray(rotation, dtype=float)
-    trace = np.trace(r)
-    if trace > 0.0:
-        s = 2.0 * np.sqrt(trace + 1.0)
-        quat = [(r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s,
-                0.25 * s]
-    else:
-        i = int(np.argmax(np.diag(r)))
-        j, k = (i + 1) % 3, (i + 2) % 3
-        s = 2.0 * np.sqrt(1.0 + r[i, i] - r[j, j] - r[k, k])
-        quat = [0.0, 0.0, 0.0, (r[k, j] - r[j, k]) / s]
-        quat[i] = 0.25 * s
-        quat[j] = (r[j, i] + r[i, j]) / s
-        quat[k] = (r[k, i] + r[i, k]) / s
-    quat = np.array(quat)
-    quat /= np.linalg.norm(quat)
+    quat: NDArray[np.float64] = Rotation.from_matrix(np.asarray(rotation, dtype=float)).as_quat()
     return quat if quat[3] >= 0.0 else -quat
 
 
-def matrix_from_quaternion(quat):
-    """Return the rotation matrix (3, 3) of a quaternion (x, y, z, w), normalised first."""
-    x, y, z, w = np.asarray(quat, dtype=float) / np.linalg.norm(quat)
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
+def matrix_from_quaternion(quat: ArrayLike) -> NDArray[np.float64]:
+    """Return the rotation matrix (3, 3) of a quaternion (x, y, z, w) != 0, normalised first."""
+    matrix: NDArray[np.float64] = Rotation.from_quat(np.asarray(quat, dtype=float)).as_matrix()
+    return matrix
 
 
-def frame_to_pose(frame, dim):
+def frame_to_pose(frame: Optional[FrameSample], dim: int) -> Pose:
     """
     Express a frame as an odometry-like pose.
 
@@ -232,42 +221,49 @@ def frame_to_pose(frame, dim):
     stationary frame at the origin. 2D frames are rotations about z, with z components zero.
     """
     frame = stationary_frame(dim) if frame is None else frame
-    jmat, jdot = _embed(frame.J), _embed(frame.Jdot)
-    if dim == 2:
-        jdot = np.zeros((3, 3))
-        jdot[:2, :2] = frame.Jdot
+    jmat, angular = _rotation_and_angular_velocity(frame)
     position, linear = np.zeros(3), np.zeros(3)
     position[:dim] = frame.q_od
     linear[:dim] = frame.qdot_od
-    angular = _vee(-jmat.T @ jdot)
     return position, quaternion_from_matrix(jmat.T), linear, angular
 
 
-def frame_from_pose(t, position, quaternion, linear, angular, dim):
-    """Inverse of :func:`frame_to_pose`: a :class:`FrameSample` of dimension ``dim``."""
+def frame_from_pose(t: float, position: ArrayLike, quaternion: ArrayLike, linear: ArrayLike,
+                    angular: ArrayLike, dim: int) -> FrameSample:
+    """
+    Inverse of :func:`frame_to_pose`: a :class:`FrameSample` of dimension ``dim``.
+
+    position, linear, angular: 3 values each (m, m/s, rad/s); quaternion: (x, y, z, w), not zero.
+    """
     jmat = matrix_from_quaternion(quaternion).T
-    jdot = -jmat @ skew(np.asarray(angular, dtype=float))
-    return FrameSample(float(t), np.array(position[:dim], dtype=float),
-                       np.array(linear[:dim], dtype=float), jmat[:dim, :dim].copy(),
+    jdot = -jmat @ skew(angular)
+    return FrameSample(float(t), np.array(np.asarray(position, dtype=float)[:dim]),
+                       np.array(np.asarray(linear, dtype=float)[:dim]), jmat[:dim, :dim].copy(),
                        jdot[:dim, :dim].copy())
 
 
-def advance(frame, dt):
+@overload
+def advance(frame: FrameSample, dt: float) -> FrameSample: ...
+
+
+@overload
+def advance(frame: None, dt: float) -> None: ...
+
+
+def advance(frame: Optional[FrameSample], dt: float) -> Optional[FrameSample]:
     """
     Carry a frame forward by dt seconds at constant velocity and angular velocity.
 
     Used to bring the latest reference sample to the time of a robot's state; exact for a line
-    and a fixed reference, first order in dt otherwise. Returns a new :class:`FrameSample`.
+    and a fixed reference, and for J of a circle or helix (constant angular velocity); q_od is
+    first order in dt otherwise. Returns a new :class:`FrameSample` (``frame`` itself for
+    ``dt == 0`` or ``None``).
     """
     if frame is None or dt == 0.0:
         return frame
     dim = frame.q_od.shape[0]
-    jmat, jdot = _embed(frame.J), _embed(frame.Jdot)
-    if dim == 2:
-        jdot = np.zeros((3, 3))
-        jdot[:2, :2] = frame.Jdot
-    omega = _vee(-jmat.T @ jdot)
-    moved = jmat @ _rotation_exp(-omega * dt)
+    jmat, omega = _rotation_and_angular_velocity(frame)
+    moved = jmat @ Rotation.from_rotvec(-omega * dt).as_matrix()
     moved_dot = -moved @ skew(omega)
     return FrameSample(frame.t + dt, frame.q_od + frame.qdot_od * dt, frame.qdot_od.copy(),
                        moved[:dim, :dim].copy(), moved_dot[:dim, :dim].copy())

@@ -3,13 +3,14 @@ Jump functions of Lemma 1 (eqs. 5-7) and the collision terms built from them (eq
 
 A jump function ``h(x, a, b)`` is 0 for ``x <= a``, 1 for ``x >= b``, smooth in between.
 The controller only ever needs it at ``a = 0``, ``b = b_ij**2 / 2`` and ``x = ||q_ij||**2 / 2``
-(eq. 11 read as in ERRATA 1), but the functions here take any ``0 <= a < b``.
+(eq. 11 read as in docs/equations.md, slip 1), but the functions here take any ``0 <= a < b``.
 
 Two kinds of ``g`` (eq. 7) are implemented:
 
 * ``PolyJump(p)``: ``g(y) = y**p`` for an integer ``p >= 1``. Then ``h`` is the regularized
-  incomplete beta function ``I_t(p + 1, p + 1)`` with ``t = (x - a) / (b - a)`` (ERRATA 4), written
-  here as the finite binomial sum ``t**(p+1) * S(t)`` so that ``h'/h`` stays exact as ``t -> 0``.
+  incomplete beta function ``I_t(p + 1, p + 1)`` with ``t = (x - a) / (b - a)``
+  (docs/equations.md, slip 4), written here as the finite binomial sum ``t**(p+1) * S(t)`` so
+  that ``h'/h`` stays exact as ``t -> 0``.
 * ``SmoothJump()``: ``g(y) = exp(-1/y)`` (Corollary 1). ``h`` needs an integral, evaluated by
   adaptive quadrature (``scipy.integrate.quad``, relative tolerance 1e-13) in a scaled form that
   cannot underflow; ``h'`` is closed form.
@@ -21,24 +22,47 @@ dimensionless; ``h'`` and ``h'/h`` are in 1/m**2.
 
 from functools import lru_cache
 import math
+from typing import Optional, Protocol
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 from scipy import special
 
 JUMP_KINDS = ('poly', 'smooth')
 
 
-def _check_interval(a, b):
+class JumpFunction(Protocol):
+    """What the control law needs of a jump function: ``h``, ``dh`` and ``ratio`` (eqs. 5, 13)."""
+
+    @property
+    def kind(self) -> str:
+        """Return 'poly' or 'smooth' (``jump.kind``)."""
+
+    @property
+    def order(self) -> Optional[int]:
+        """Return p of ``g(y) = y**p``; None for the smooth kind."""
+
+    def h(self, x: ArrayLike, a: float, b: float) -> NDArray[np.float64]:
+        """Evaluate the jump function of eq. (5) at x: shape of ``x``, values in [0, 1]."""
+
+    def dh(self, x: ArrayLike, a: float, b: float) -> NDArray[np.float64]:
+        """Evaluate dh/dx in 1/m**2, shape of ``x``."""
+
+    def ratio(self, x: ArrayLike, a: float, b: float) -> NDArray[np.float64]:
+        """Evaluate h'/h in 1/m**2, shape of ``x``; +inf for x <= a, 0 for x >= b."""
+
+
+def _check_interval(a: float, b: float) -> None:
     if not (0.0 <= a < b):
         raise ValueError(f'jump function needs 0 <= a < b, got a={a!r}, b={b!r}')
 
 
 class PolyJump:
-    """p times differentiable jump function with ``g(y) = y**p`` (Lemma 1, ERRATA 4)."""
+    """Jump function of Lemma 1 with ``g(y) = y**p`` (docs/equations.md, slip 4)."""
 
     kind = 'poly'
 
-    def __init__(self, order):
+    def __init__(self, order: int) -> None:
         """Build the jump function of order ``order`` (integer p >= 1)."""
         if isinstance(order, bool) or int(order) != order or order < 1:
             raise ValueError(f'jump order p must be an integer >= 1, got {order!r}')
@@ -51,23 +75,24 @@ class PolyJump:
         self._one_minus_t_powers = n - np.arange(p + 1, n + 1)
         self._inv_beta = 1.0 / special.beta(p + 1, p + 1)
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         """Return a short description."""
         return f'PolyJump(order={self.order})'
 
-    def _sum_s(self, t):
+    def _sum_s(self, t: NDArray[np.float64]) -> NDArray[np.float64]:
         t = t[..., None]
-        return np.sum(self._binomials * t ** self._t_powers
-                      * (1.0 - t) ** self._one_minus_t_powers, axis=-1)
+        total: NDArray[np.float64] = np.sum(
+            self._binomials * t ** self._t_powers * (1.0 - t) ** self._one_minus_t_powers, axis=-1)
+        return total
 
-    def h(self, x, a, b):
+    def h(self, x: ArrayLike, a: float, b: float) -> NDArray[np.float64]:
         """Evaluate the jump function of eq. (5) at x: shape of ``x``, values in [0, 1]."""
         _check_interval(a, b)
         t = np.clip((np.asarray(x, dtype=float) - a) / (b - a), 0.0, 1.0)
         return t ** (self.order + 1) * self._sum_s(t)
 
-    def dh(self, x, a, b):
-        """Closed-form derivative dh/dx (ERRATA 4), in 1/m**2; zero outside (a, b)."""
+    def dh(self, x: ArrayLike, a: float, b: float) -> NDArray[np.float64]:
+        """Closed-form dh/dx (docs/equations.md, slip 4), in 1/m**2; zero outside (a, b)."""
         _check_interval(a, b)
         x = np.asarray(x, dtype=float)
         p = self.order
@@ -76,7 +101,7 @@ class PolyJump:
         value = (xc - a) ** p * (b - xc) ** p * self._inv_beta / (b - a) ** (2 * p + 1)
         return np.where(inside, value, 0.0)
 
-    def ratio(self, x, a, b):
+    def ratio(self, x: ArrayLike, a: float, b: float) -> NDArray[np.float64]:
         """
         Return betabar' = h'(x) / h(x) (eq. 13), in 1/m**2.
 
@@ -106,13 +131,13 @@ class SmoothJump:
     kind = 'smooth'
     order = None
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         """Return a short description."""
         return 'SmoothJump()'
 
     @staticmethod
     @lru_cache(maxsize=4096)
-    def _k_scaled(s, inv_len):
+    def _k_scaled(s: float, inv_len: float) -> float:
         """
         K(s) for 0 < s <= 1/2 with Phi built from ``inv_len = 1 / (b - a)``.
 
@@ -124,26 +149,28 @@ class SmoothJump:
         k = inv_len
         phi_s = k / (s * (1.0 - s))
         if s < 0.3:
-            def integrand(w):
+            def integrand_in_w(w: float) -> float:
                 big_p = phi_s + w
                 return math.exp(-w) * k / (math.sqrt(1.0 - 4.0 * k / big_p) * big_p * big_p)
 
-            value, _ = integrate.quad(integrand, 0.0, math.inf, epsabs=0.0, epsrel=1e-13,
+            value, _ = integrate.quad(integrand_in_w, 0.0, math.inf, epsabs=0.0, epsrel=1e-13,
                                       limit=400)
-            return value
+            return float(value)
 
-        def integrand(sigma):
+        def integrand_in_sigma(sigma: float) -> float:
             if sigma <= 0.0:
                 return 0.0
             return math.exp(phi_s - k / (sigma * (1.0 - sigma)))
 
         width = s * s * (1.0 - s) ** 2 / (k * max(1.0 - 2.0 * s, 1e-300))
         points = [s - width] if width < 0.1 * s else None
-        value, _ = integrate.quad(integrand, 0.0, s, epsabs=0.0, epsrel=1e-13, limit=400,
+        value, _ = integrate.quad(integrand_in_sigma, 0.0, s, epsabs=0.0, epsrel=1e-13, limit=400,
                                   points=points)
-        return value
+        return float(value)
 
-    def _scaled(self, x, a, b):
+    def _scaled(self, x: ArrayLike, a: float, b: float) -> tuple[
+            NDArray[np.float64], NDArray[np.bool_], NDArray[np.float64], NDArray[np.float64],
+            float, float]:
         """Return s, the mask 0 < s < 1, s clipped inside, Phi(1/2) - Phi(s), 1/L, K(1/2)."""
         _check_interval(a, b)
         inv_len = 1.0 / (b - a)
@@ -153,25 +180,25 @@ class SmoothJump:
         log_f_rel = 4.0 * inv_len - inv_len / (sc * (1.0 - sc))
         return s, inside, sc, log_f_rel, inv_len, self._k_scaled(0.5, inv_len)
 
-    def _k_near(self, sc, inv_len):
+    def _k_near(self, sc: NDArray[np.float64], inv_len: float) -> NDArray[np.float64]:
         """K(min(s, 1 - s)) element by element, same shape as ``sc``."""
         near = np.minimum(sc, 1.0 - sc)
         values = [self._k_scaled(float(v), inv_len) for v in near.ravel()]
         return np.array(values, dtype=float).reshape(near.shape)
 
-    def h(self, x, a, b):
+    def h(self, x: ArrayLike, a: float, b: float) -> NDArray[np.float64]:
         """Evaluate the jump function of eq. (5) at x: shape of ``x``, values in [0, 1]."""
         s, inside, sc, log_f_rel, inv_len, k_half = self._scaled(x, a, b)
         tail = np.exp(log_f_rel) * self._k_near(sc, inv_len) / (2.0 * k_half)
         value = np.where(sc <= 0.5, tail, 1.0 - tail)
         return np.where(inside, value, np.where(s <= 0.0, 0.0, 1.0))
 
-    def dh(self, x, a, b):
+    def dh(self, x: ArrayLike, a: float, b: float) -> NDArray[np.float64]:
         """Closed-form derivative dh/dx = f(x - a) f(b - x) / norm, in 1/m**2."""
         _, inside, _, log_f_rel, inv_len, k_half = self._scaled(x, a, b)
         return np.where(inside, np.exp(log_f_rel) * inv_len / (2.0 * k_half), 0.0)
 
-    def ratio(self, x, a, b):
+    def ratio(self, x: ArrayLike, a: float, b: float) -> NDArray[np.float64]:
         """Return betabar' = h'(x) / h(x) (eq. 13), in 1/m**2; 0 for x >= b, +inf for x <= a."""
         s, inside, sc, log_f_rel, inv_len, k_half = self._scaled(x, a, b)
         k_near = self._k_near(sc, inv_len)
@@ -181,7 +208,7 @@ class SmoothJump:
         return np.where(inside, value, np.where(s <= 0.0, np.inf, 0.0))
 
 
-def make_jump(kind, order=2):
+def make_jump(kind: str, order: int = 2) -> JumpFunction:
     """Return the jump function named by ``jump.kind`` ('poly' or 'smooth') and ``jump.order``."""
     if kind == 'poly':
         return PolyJump(order)

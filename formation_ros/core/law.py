@@ -13,13 +13,16 @@ use it, so they agree to rounding.
 
 from dataclasses import dataclass
 import math
+from typing import Callable, Optional
 
-from formation_ros.core.frames import from_frame_velocity, STATIONARY, to_frame, to_frame_vectors
-from formation_ros.core.jump import make_jump
+from formation_ros.core.frames import (FrameSample, from_frame_velocity, STATIONARY, to_frame,
+                                       to_frame_vectors)
+from formation_ros.core.jump import JumpFunction, make_jump
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
 
-PSI_FUNCTIONS = {
+PSI_FUNCTIONS: dict[str, tuple[Callable[[NDArray[np.float64]], NDArray[np.float64]], float]] = {
     'arctan': (np.arctan, math.pi / 2.0),
     'tanh': (np.tanh, 1.0),
 }
@@ -31,17 +34,17 @@ class LawParams:
     Constants of the control law.
 
     gain: c of eq. (14), m/s per unit of psi; kappa: kappa of eqs. (8), (13);
-    psi: 'arctan' or 'tanh' (eq. 15); jump: a jump function object (``core.jump``);
+    psi: 'arctan' or 'tanh' (eq. 15); jump: a ``core.jump.JumpFunction`` (Lemma 1);
     repulsion_radius: b_ij of eq. (11) in m, the same for every pair.
     """
 
     gain: float
     kappa: float
     psi: str
-    jump: object
+    jump: JumpFunction
     repulsion_radius: float
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         """Check the constants once, so that the hot path need not."""
         if self.psi not in PSI_FUNCTIONS:
             raise ValueError(f'psi must be one of {sorted(PSI_FUNCTIONS)}, got {self.psi!r}')
@@ -51,57 +54,58 @@ class LawParams:
                 raise ValueError(f'{name} must be a finite number > 0, got {value!r}')
 
     @property
-    def psi_bound(self):
+    def psi_bound(self) -> float:
         """M1 of eq. (15): the bound of |psi| (pi/2 for arctan, 1 for tanh)."""
         return PSI_FUNCTIONS[self.psi][1]
 
     @property
-    def u_bound(self):
+    def u_bound(self) -> float:
         """Bound c * M1 on every component of the stabilising command (eq. 14), m/s."""
         return self.gain * self.psi_bound
 
 
-def make_law(gain, kappa, psi, jump_kind, jump_order, repulsion_radius):
+def make_law(gain: float, kappa: float, psi: str, jump_kind: str, jump_order: int,
+             repulsion_radius: float) -> LawParams:
     """Build :class:`LawParams` from the parameter values of the YAML file."""
     return LawParams(float(gain), float(kappa), psi, make_jump(jump_kind, jump_order),
                      float(repulsion_radius))
 
 
-def psi(omega, law):
+def psi(omega: ArrayLike, law: LawParams) -> NDArray[np.float64]:
     """Apply psi element by element (eq. 14); same shape as ``omega``."""
-    return PSI_FUNCTIONS[law.psi][0](omega)
+    return PSI_FUNCTIONS[law.psi][0](np.asarray(omega, dtype=float))
 
 
-def beta(distance_sq, law):
-    """Return beta_ij of eq. (11) (ERRATA 1) from squared distances ||q_ij||**2, any shape."""
+def beta(distance_sq: ArrayLike, law: LawParams) -> NDArray[np.float64]:
+    """Return beta_ij of eq. (11) (docs/equations.md, slip 1) from ||q_ij||**2, any shape."""
     b = law.repulsion_radius
     return law.jump.h(0.5 * np.asarray(distance_sq, dtype=float), 0.0, 0.5 * b * b)
 
 
-def repulsion_terms(q_ij, law):
+def repulsion_terms(q_ij: ArrayLike, law: LawParams) -> NDArray[np.float64]:
     """
     Return betabar'_ij * q_ij for rows of relative positions q_ij = q_i - q_j.
 
-    q_ij: (K, dim) in m. Returns (K, dim) in 1/m. betabar' = h'/h (eq. 13, ERRATA 3) is zero for
-    ||q_ij|| >= b. A row with q_ij exactly zero (two robots at one point) has no direction and
-    contributes zero; the callers report such a collision.
+    q_ij: (K, dim) in m. Returns (K, dim) in 1/m. betabar' = h'/h (eq. 13; docs/equations.md,
+    slip 3) is zero for ||q_ij|| >= b. A row with q_ij exactly zero (two robots at one point) has
+    no direction and contributes zero; the callers report such a collision.
     """
     q_ij = np.asarray(q_ij, dtype=float)
     d2 = np.einsum('kd,kd->k', q_ij, q_ij)
     b = law.repulsion_radius
     weight = law.jump.ratio(0.5 * d2, 0.0, 0.5 * b * b)
     with np.errstate(invalid='ignore'):
-        terms = weight[:, None] * q_ij
+        terms: NDArray[np.float64] = weight[:, None] * q_ij
     terms[d2 == 0.0] = 0.0
     return terms
 
 
-def omega(error, repulsion_sum, law):
+def omega(error: ArrayLike, repulsion_sum: ArrayLike, law: LawParams) -> NDArray[np.float64]:
     """Omega_i of eq. (13): ``(q_i - q_if) - kappa * sum_j betabar'_ij q_ij``, shape of error."""
     return np.asarray(error, dtype=float) - law.kappa * np.asarray(repulsion_sum, dtype=float)
 
 
-def bounded_command(omega_value, law):
+def bounded_command(omega_value: ArrayLike, law: LawParams) -> NDArray[np.float64]:
     """Bounded command u_i = -c psi(Omega_i) of eq. (14), same shape as ``omega_value``."""
     return -law.gain * psi(omega_value, law)
 
@@ -116,12 +120,14 @@ class Command:
     omega: Omega of eq. (13) in the formation frame.
     """
 
-    u: np.ndarray
-    u_hat: np.ndarray
-    omega: np.ndarray
+    u: NDArray[np.float64]
+    u_hat: NDArray[np.float64]
+    omega: NDArray[np.float64]
 
 
-def robot_command(q_i, vertex_i, neighbours, sensing_radius, law, frame=STATIONARY):
+def robot_command(q_i: ArrayLike, vertex_i: ArrayLike, neighbours: ArrayLike,
+                  sensing_radius: float, law: LawParams,
+                  frame: Optional[FrameSample] = STATIONARY) -> Command:
     """
     Control of one robot from what it knows (eqs. 13, 14, 21, 25).
 
@@ -142,13 +148,15 @@ def robot_command(q_i, vertex_i, neighbours, sensing_radius, law, frame=STATIONA
     return Command(u=u, u_hat=u_hat, omega=omega_hat)
 
 
-def neighbour_pairs(q, radius):
+def neighbour_pairs(q: ArrayLike, radius: float) -> NDArray[np.intp]:
     """Pairs (i, j), i < j, with ||q_i - q_j|| <= radius, from a k-d tree: (P, 2) int array."""
     tree = cKDTree(np.asarray(q, dtype=float))
-    return tree.query_pairs(r=radius, output_type='ndarray').reshape(-1, 2)
+    pairs: NDArray[np.intp] = tree.query_pairs(r=radius, output_type='ndarray').reshape(-1, 2)
+    return pairs
 
 
-def team_command(q, vertices, sensing_radii, law, frame=STATIONARY):
+def team_command(q: ArrayLike, vertices: ArrayLike, sensing_radii: ArrayLike, law: LawParams,
+                 frame: Optional[FrameSample] = STATIONARY) -> Command:
     """
     Control of every robot at once (the vectorised form of :func:`robot_command`).
 
@@ -175,7 +183,8 @@ def team_command(q, vertices, sensing_radii, law, frame=STATIONARY):
     return Command(u=from_frame_velocity(u_hat, q, frame), u_hat=u_hat, omega=omega_hat)
 
 
-def log_potential(q, vertices, law, frame=STATIONARY):
+def log_potential(q: ArrayLike, vertices: ArrayLike, law: LawParams,
+                  frame: Optional[FrameSample] = STATIONARY) -> float:
     """
     Return log(phi + 1) = gamma - kappa * sum_{i<j} log beta_ij (eqs. 8-11), a float.
 
@@ -192,7 +201,8 @@ def log_potential(q, vertices, law, frame=STATIONARY):
     return gamma - law.kappa * float(np.sum(log_beta))
 
 
-def potential(q, vertices, law, frame=STATIONARY):
+def potential(q: ArrayLike, vertices: ArrayLike, law: LawParams,
+              frame: Optional[FrameSample] = STATIONARY) -> float:
     """Potential phi of eq. (8) (may overflow to +inf far from the formation)."""
     with np.errstate(over='ignore'):
         return float(np.expm1(log_potential(q, vertices, law, frame)))

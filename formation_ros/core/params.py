@@ -11,13 +11,12 @@ one :class:`ParamError`.
 """
 
 from dataclasses import dataclass, field
-import os
 from typing import Any, Dict, List, Mapping, Optional, Tuple, Union
 
 from formation_ros.core.declarations import (check_values, Exe, JumpKind, ParamError, PsiKind,
                                              ReferenceKind)
 from formation_ros.core.law import LawParams, make_law
-from formation_ros.core.params_file import load_params_file
+from formation_ros.core.params_file import load_params_file, PathText
 from formation_ros.core.plant import NS_PER_S, start_positions, StartSpec
 from formation_ros.core.reference import Reference
 import numpy as np
@@ -292,7 +291,7 @@ def validate(raw: Mapping[str, Any], executable: Union[Exe, str] = Exe.SIM) -> F
         values=values, **own)
 
 
-def load_config(path: Union[str, os.PathLike],
+def load_config(path: PathText,
                 executable: Union[Exe, str] = Exe.SIM) -> FormationConfig:
     """Load and validate a parameters file: ``load_params_file`` then :func:`validate`."""
     return validate(load_params_file(path), executable)

@@ -22,6 +22,8 @@ from typing import Any, Dict, Mapping, Union
 from formation_ros.core.declarations import ParamError
 import yaml
 
+PathText = Union[str, 'os.PathLike[str]']
+
 _FLOAT_PATTERN = re.compile(
     r'^(?:[-+]?[0-9][0-9_]*\.[0-9_]*(?:[eE][-+]?[0-9]+)?'
     r'|[-+]?[0-9][0-9_]*[eE][-+]?[0-9]+'
@@ -68,7 +70,7 @@ def nest(values: Mapping[str, Any]) -> Dict[str, Any]:
     return tree
 
 
-def load_params_file(path: Union[str, os.PathLike]) -> Dict[str, Any]:
+def load_params_file(path: PathText) -> Dict[str, Any]:
     """
     Read a ROS 2 parameters YAML file and return the flat ``/**`` parameters.
 
@@ -101,10 +103,10 @@ def parse_params_text(text: str, source: str) -> Dict[str, Any]:
 
 def dump_params_text(values: Mapping[str, Any]) -> str:
     """Return the ROS 2 parameters YAML (``/**: ros__parameters:``) of flat dotted values."""
-    return yaml.safe_dump({'/**': {'ros__parameters': nest(values)}}, sort_keys=True)
+    return str(yaml.safe_dump({'/**': {'ros__parameters': nest(values)}}, sort_keys=True))
 
 
-def write_params_file(path: Union[str, os.PathLike], values: Mapping[str, Any]) -> None:
+def write_params_file(path: PathText, values: Mapping[str, Any]) -> None:
     """Write flat dotted values as a ROS 2 parameters file at ``path``."""
     with open(path, 'w', encoding='utf-8') as stream:
         stream.write(dump_params_text(values))

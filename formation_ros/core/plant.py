@@ -25,7 +25,7 @@ Positions are rows: ``q`` has shape (N, dim), in m; commands (N, dim) in m/s.
 from collections import OrderedDict
 from dataclasses import dataclass, field
 import enum
-from typing import Dict, List, Optional, Tuple
+from typing import Dict, List, Optional, Set, Tuple
 
 from formation_ros.core.frames import to_frame_velocity
 from formation_ros.core.law import LawParams
@@ -289,9 +289,9 @@ class PlantModel:
         distance, _ = self.tree.query(self.q, k=2)
         return float(np.min(distance[:, 1]))
 
-    def _close_pairs(self) -> set:
-        return {tuple(pair) for pair in
-                self.tree.query_pairs(self.collision_distance, output_type='ndarray').tolist()}
+    def _close_pairs(self) -> Set[Tuple[int, int]]:
+        pairs = self.tree.query_pairs(self.collision_distance, output_type='ndarray').tolist()
+        return {(int(i), int(j)) for i, j in pairs}
 
     def _new_collisions(self) -> List[Tuple[int, int, float]]:
         pairs = self._close_pairs()

@@ -18,13 +18,17 @@ Kinds (the ``reference.*`` parameters):
 """
 
 import math
+from typing import Optional
 
 from formation_ros.core.frames import (frame_2d, frame_frenet_3d, frame_planar_3d, FrameSample,
                                        stationary_frame)
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 REFERENCE_KINDS = ('fixed', 'line', 'circle', 'figure_eight', 'helix')
 Z_AXIS = np.array([0.0, 0.0, 1.0])
+Derivatives = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
+                    NDArray[np.float64]]
 GERONO_SAMPLES = 4096
 
 
@@ -51,7 +55,9 @@ class Reference:
     (q, q', q'', q''') as (dim,) arrays (m, m/s, m/s**2, m/s**3).
     """
 
-    def __init__(self, kind, dim, origin=None, velocity=None, radius=1.0, speed=0.0, pitch=0.0):
+    def __init__(self, kind: str, dim: int, origin: Optional[ArrayLike] = None,
+                 velocity: Optional[ArrayLike] = None, radius: float = 1.0, speed: float = 0.0,
+                 pitch: float = 0.0) -> None:
         """Build a reference (values already validated by ``core.params``)."""
         if kind not in REFERENCE_KINDS:
             raise ValueError(f'unknown reference kind {kind!r}; expected one of {REFERENCE_KINDS}')
@@ -68,7 +74,7 @@ class Reference:
         self.pitch = float(pitch)
         self.rate = self._angular_rate()
 
-    def _angular_rate(self):
+    def _angular_rate(self) -> float:
         if self.kind == 'circle':
             return self.speed / self.radius
         if self.kind == 'figure_eight':
@@ -79,11 +85,11 @@ class Reference:
         return 0.0
 
     @property
-    def is_stationary(self):
+    def is_stationary(self) -> bool:
         """Tell whether q_od never moves (fixed, or a line with zero velocity)."""
         return self.kind == 'fixed' or (self.kind == 'line' and not np.any(self.velocity))
 
-    def derivatives(self, t):
+    def derivatives(self, t: float) -> Derivatives:
         """Return (q_od, q_od', q_od'', q_od''') at time t, each (dim,)."""
         dim = self.dim
         zero = np.zeros(dim)
@@ -113,10 +119,9 @@ class Reference:
             if dim == 3:
                 vec[2] = rise[order]
             out.append(vec)
-        out[0] = out[0] + self.origin
-        return tuple(out)
+        return out[0] + self.origin, out[1], out[2], out[3]
 
-    def sample(self, t):
+    def sample(self, t: float) -> FrameSample:
         """Return the :class:`FrameSample` (q_od, qdot_od, J, Jdot) at time t in s."""
         if self.kind == 'fixed':
             return stationary_frame(self.dim, self.origin, t)
@@ -129,7 +134,7 @@ class Reference:
             jmat, jdot = frame_planar_3d(q1, q2, self._plane_normal(q1))
         return FrameSample(float(t), q, q1, jmat, jdot)
 
-    def _plane_normal(self, qdot):
+    def _plane_normal(self, qdot: NDArray[np.float64]) -> NDArray[np.float64]:
         """Return the plane normal of the planar 3D frame: +z, or +y for a line along z."""
         if self.kind == 'line':
             speed = float(np.linalg.norm(qdot))

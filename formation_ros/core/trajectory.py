@@ -2,9 +2,11 @@
 
 from dataclasses import dataclass
 import os
+from typing import Sequence
 
-from formation_ros.core.frames import desired_positions, to_frame_velocity
+from formation_ros.core.frames import desired_positions, FrameSample, to_frame_velocity
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
 ARRAYS = ('t', 'q', 'u', 'u_hat', 'q_desired', 'q_od')
 
@@ -19,29 +21,30 @@ class Trajectory:
     q_od: (T, dim) the reference centre, m.
     """
 
-    t: np.ndarray
-    q: np.ndarray
-    u: np.ndarray
-    u_hat: np.ndarray
-    q_desired: np.ndarray
-    q_od: np.ndarray
+    t: NDArray[np.float64]
+    q: NDArray[np.float64]
+    u: NDArray[np.float64]
+    u_hat: NDArray[np.float64]
+    q_desired: NDArray[np.float64]
+    q_od: NDArray[np.float64]
 
     @property
-    def num_robots(self):
-        """N."""
-        return self.q.shape[1]
+    def num_robots(self) -> int:
+        """Return N."""
+        return int(self.q.shape[1])
 
     @property
-    def dim(self):
-        """2 or 3."""
-        return self.q.shape[2]
+    def dim(self) -> int:
+        """Return the dimension, 2 or 3."""
+        return int(self.q.shape[2])
 
-    def save(self, path):
+    def save(self, path: str) -> None:
         """Write the arrays to ``path`` (a .npz file)."""
         np.savez_compressed(path, **{name: getattr(self, name) for name in ARRAYS})
 
     @classmethod
-    def from_frames(cls, t, q, u, frames, vertices):
+    def from_frames(cls, t: ArrayLike, q: ArrayLike, u: ArrayLike,
+                    frames: Sequence[FrameSample], vertices: ArrayLike) -> 'Trajectory':
         """
         Build a trajectory from states and commands and the reference frame of each sample.
 
@@ -57,7 +60,7 @@ class Trajectory:
                    q_od=np.array([f.q_od for f in frames]))
 
     @classmethod
-    def load(cls, path):
+    def load(cls, path: str) -> 'Trajectory':
         """Read a ``trajectory.npz`` written by :meth:`save`; ValueError if arrays are missing."""
         if not os.path.exists(path):
             raise ValueError(f'{path}: no such file')

@@ -63,7 +63,7 @@ def plot_trajectories(traj, path, title='Trajectories'):
 
 
 def plot_distances(traj, law, path):
-    """dis_min, dis_all (ERRATA 7), ||q_1j|| and beta_1j over time (Fig. 1 C, D)."""
+    """dis_min, dis_all (docs/equations.md, slip 7), ||q_1j||, beta_1j over time (Fig. 1 C, D)."""
     t, q = traj.t, traj.q
     fig, (top, bottom) = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
     if traj.num_robots <= 30:

@@ -1,0 +1,15 @@
+"""Static types: mypy checks every module of formation_ros/core with the settings in mypy.ini."""
+
+import os
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def test_mypy_core():
+    command = [sys.executable, '-m', 'mypy', '--config-file', 'mypy.ini', 'formation_ros/core']
+    result = subprocess.run(command, cwd=ROOT, capture_output=True, text=True, timeout=600)
+    output = result.stdout + result.stderr
+    assert result.returncode == 0, f'{" ".join(command[1:])} (exit {result.returncode}):\n{output}'
+    assert 'Success' in result.stdout, output
