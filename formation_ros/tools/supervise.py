@@ -64,19 +64,28 @@ class ExitInfo:
     @property
     def signal_name(self) -> Optional[str]:
         """Return the name of the signal that ended the process ('SIGKILL'), None if it exited."""
-        if self.returncode >= 0:
-            return None
-        try:
-            return signal.Signals(-self.returncode).name
-        except ValueError:
-            return f'signal {-self.returncode}'
+        return signal_name(self.returncode)
 
     @property
     def reason(self) -> str:
         """Say why it ended: 'exit code 3' or 'signal SIGSEGV'."""
-        if self.signal_name is None:
-            return f'exit code {self.returncode}'
-        return f'signal {self.signal_name}'
+        return describe_returncode(self.returncode)
+
+
+def signal_name(returncode: int) -> Optional[str]:
+    """Return the name of the signal a negative subprocess return code stands for, else None."""
+    if returncode >= 0:
+        return None
+    try:
+        return signal.Signals(-returncode).name
+    except ValueError:
+        return str(-returncode)
+
+
+def describe_returncode(returncode: int) -> str:
+    """Say what a subprocess return code means: 'exit code 3' or 'signal SIGSEGV'."""
+    name = signal_name(returncode)
+    return f'exit code {returncode}' if name is None else f'signal {name}'
 
 
 class _Running:
