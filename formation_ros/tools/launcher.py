@@ -7,11 +7,11 @@ The formation launcher: plant, reference node, N robots and optionally the recor
 ``scripts/launch_formation.sh`` runs this module (``python -m formation_ros.tools.launcher``)
 with an interpreter that can import the installed package; the options and messages are those
 of :data:`USAGE`. Every node runs under :class:`formation_ros.tools.supervise.Supervisor`, its
-output prefixed with its name. The run ends when the duration is over, on SIGINT or SIGTERM,
-or when a node ends on its own (exit code 1); the nodes are then stopped in order (robots,
-reference and plant together, the recorder last) and, with ``--out`` or ``--record``,
-``formation_report`` writes the metrics and figures. Exit codes: 0 done, 1 a node died or the
-report failed, 2 bad usage or parameters.
+output prefixed with its name. The run ends when the duration is over, on SIGINT, SIGTERM or
+SIGHUP (the terminal closed), or when a node ends on its own (exit code 1); the nodes are then
+stopped in order (robots, reference and plant together, the recorder last) and, with ``--out``
+or ``--record``, ``formation_report`` writes the metrics and figures. Exit codes: 0 done, 1 a
+node died or the report failed, 2 bad usage or parameters.
 """
 
 import dataclasses
@@ -246,13 +246,13 @@ class Launch:
         self.failure: Optional[str] = None
 
     def on_signal(self, signum: int, frame: object) -> None:
-        """Note SIGINT or SIGTERM; the main loop then stops the nodes."""
+        """Note SIGINT, SIGTERM or SIGHUP; the main loop then stops the nodes."""
         self.interrupted = signal.Signals(signum).name
 
     def run(self) -> int:
         """Run the nodes until the end, stop them, write the report; return the exit code."""
         previous = {sig: signal.signal(sig, self.on_signal)
-                    for sig in (signal.SIGINT, signal.SIGTERM)}
+                    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
         try:
             self._start_and_watch()
             if self.interrupted:
@@ -343,9 +343,12 @@ class Launch:
 
 
 def say(message: str, stream: Optional[TextIO] = None) -> None:
-    """Print one launcher message (on stderr unless ``stream`` is given)."""
-    sys.stdout.flush()
-    print(f'{PROG}: {message}', file=stream or sys.stderr, flush=True)
+    """Print one launcher message (on stderr unless ``stream`` is given), if it still can."""
+    try:
+        sys.stdout.flush()
+        print(f'{PROG}: {message}', file=stream or sys.stderr, flush=True)
+    except OSError:
+        pass
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
