@@ -91,7 +91,7 @@ def describe_returncode(returncode: int) -> str:
 class _Running:
     """One started process with its threads; internal to :class:`Supervisor`."""
 
-    def __init__(self, spec: ProcessSpec, popen: subprocess.Popen,
+    def __init__(self, spec: ProcessSpec, popen: 'subprocess.Popen[bytes]',
                  log: Optional[IO[str]]) -> None:
         self.spec = spec
         self.popen = popen
@@ -101,6 +101,13 @@ class _Running:
         self.stop_requested = False
         self.reader: Optional[threading.Thread] = None
         self.waiter: Optional[threading.Thread] = None
+
+    def close_log(self) -> None:
+        """Wait (briefly) for the last output lines, then close the log file."""
+        if self.reader is not None:
+            self.reader.join(READER_JOIN)
+        if self.log is not None:
+            self.log.close()
 
 
 class Supervisor:
@@ -135,7 +142,7 @@ class Supervisor:
         """Stop everything still running and close the logs."""
         self.close()
 
-    def start(self, spec: ProcessSpec) -> subprocess.Popen:
+    def start(self, spec: ProcessSpec) -> 'subprocess.Popen[bytes]':
         """
         Start ``spec`` in a new session (its own process group) and return its Popen.
 
@@ -147,6 +154,8 @@ class Supervisor:
             old = self._processes.get(spec.name)
             if old is not None and not old.ended.is_set():
                 raise ValueError(f"a process named '{spec.name}' is running already")
+        if old is not None:
+            old.close_log()
         log = None
         if self.log_dir is not None:
             log = open(self.log_path(spec.name), 'a', encoding='utf-8')
@@ -193,7 +202,7 @@ class Supervisor:
         with self._state_lock:
             return list(self._processes)
 
-    def popen(self, name: str) -> subprocess.Popen:
+    def popen(self, name: str) -> 'subprocess.Popen[bytes]':
         """Return the Popen of the latest process started as ``name``."""
         return self._get(name).popen
 
@@ -280,10 +289,7 @@ class Supervisor:
         with self._state_lock:
             started = list(self._processes.values())
         for running in started:
-            if running.reader is not None:
-                running.reader.join(READER_JOIN)
-            if running.log is not None:
-                running.log.close()
+            running.close_log()
 
     def _get(self, name: str) -> _Running:
         with self._state_lock:
