@@ -45,3 +45,25 @@ def test_launcher_refuses_an_existing_bag_directory(tmp_path):
     result = run('launch_formation.sh', os.path.join(ROOT, 'config', 'square_4.yaml'),
                  '--record', str(tmp_path / 'bag'), '--prefix', str(tmp_path))
     assert result.returncode == 2 and 'exists already' in result.stderr
+
+
+def test_launcher_takes_one_parameters_file():
+    square = os.path.join(ROOT, 'config', 'square_4.yaml')
+    result = run('launch_formation.sh', square, square)
+    assert result.returncode == 2 and 'only one parameters file' in result.stderr
+
+
+def test_launcher_refuses_a_non_empty_out_directory(tmp_path):
+    (tmp_path / 'run').mkdir()
+    (tmp_path / 'run' / 'x').write_text('x')
+    result = run('launch_formation.sh', os.path.join(ROOT, 'config', 'square_4.yaml'),
+                 '--out', str(tmp_path / 'run'))
+    assert result.returncode == 2 and 'is not empty' in result.stderr
+
+
+def test_launcher_names_a_prefix_without_the_package(tmp_path):
+    result = run('launch_formation.sh', os.path.join(ROOT, 'config', 'square_4.yaml'),
+                 '--prefix', str(tmp_path / 'no install'))
+    assert result.returncode == 2
+    assert f"no {tmp_path / 'no install' / 'lib' / 'formation_ros' / 'plant'}" in result.stderr
+    assert len(result.stderr.splitlines()) == 1

@@ -1,11 +1,12 @@
 """colcon builds a normal ament_python install space."""
 
+import json
 import os
 import subprocess
 
-from conftest import exe
+from helpers import exe
 
-EXECUTABLES = ('robot', 'plant', 'reference', 'formation_sim', 'formation_report')
+EXECUTABLES = ('robot', 'plant', 'reference', 'record', 'formation_sim', 'formation_report')
 
 
 def test_install_layout(install):
@@ -23,7 +24,10 @@ def test_install_layout(install):
 
 def test_installed_executable_runs_from_install_space(install, ros_env, tmp_path):
     params = os.path.join(install, 'share', 'formation_ros', 'config', 'square_4.yaml')
-    result = subprocess.run([exe(install, 'formation_sim'), params, '--check'], env=ros_env,
-                            capture_output=True, text=True, timeout=60)
+    out = tmp_path / 'sim'
+    result = subprocess.run([exe(install, 'formation_sim'), params, '--out', str(out),
+                             '--duration', '0.5', '--dt', '0.01', '--no-plots', '--quiet'],
+                            env=ros_env, capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stderr
-    assert result.stdout.split()[0] == '4'
+    metrics = json.loads((out / 'metrics.json').read_text())
+    assert metrics['num_robots'] == 4 and abs(metrics['duration'] - 0.5) < 1e-9

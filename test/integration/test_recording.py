@@ -1,10 +1,7 @@
 """Recording real runs: rosbag2 (MCAP) from the recorder, the report, diagnostics, markers."""
 
 import json
-import os
-import signal
 
-from conftest import CONFIG, exe, write_params
 from formation_ros import fields, qos
 from formation_ros.bag import read_messages
 from formation_ros.core.metrics import compute_metrics
@@ -12,29 +9,20 @@ from formation_ros.core.params import load_config
 from formation_ros.sim import simulate
 from formation_ros.trajectory import Trajectory
 from geometry_msgs.msg import PoseArray, PoseStamped
+from helpers import launch, node, SimClock, SQUARE, stop_when, write_params
 import numpy as np
-from rosgraph_msgs.msg import Clock as ClockMsg
-from test_system import LAUNCHER, wait_exit
 from visualization_msgs.msg import MarkerArray
-
-SQUARE = os.path.join(CONFIG, 'square_4.yaml')
-
-
-def launch_recording(processes, install, params, bag, out, duration):
-    args = ['bash', LAUNCHER, params, '--prefix', install, '--duration', str(duration),
-            '--record', str(bag)]
-    if out is not None:
-        args += ['--out', str(out)]
-    return processes.start('launcher', args)
 
 
 def test_recorded_run_reads_back_and_agrees_with_the_plant(processes, install, probe,
                                                            tmp_path):
     markers = []
     probe.create_subscription(MarkerArray, '/formation/markers', markers.append, qos.MARKERS)
+    clock = SimClock(probe)
     bag, out = tmp_path / 'bag', tmp_path / 'run'
-    launcher = launch_recording(processes, install, SQUARE, bag, out, 10)
-    assert wait_exit(probe, launcher, 90) == 0, processes.log('launcher')
+    launch(processes, install, SQUARE, out=out, record=bag)
+    info = stop_when(probe, processes, lambda: clock.seconds >= 5.0 and bool(markers))
+    assert info.returncode == 0, processes.log('launcher')
     topics, counts = read_messages(str(bag))
     assert counts == {topic: len(messages) for topic, messages in topics.items()}
     for i in range(1, 5):
@@ -69,9 +57,11 @@ def test_recorded_run_reads_back_and_agrees_with_the_plant(processes, install, p
 def test_lockstep_bag_reproduces_formation_sim(processes, install, probe, tmp_path):
     changes = {'plant.lockstep': True, 'plant.realtime_factor': 200.0}
     params = write_params(tmp_path, 'circle_2d.yaml', changes)
+    clock = SimClock(probe)
     bag = tmp_path / 'bag'
-    launcher = launch_recording(processes, install, params, bag, None, 12)
-    assert wait_exit(probe, launcher, 90) == 0, processes.log('launcher')
+    launch(processes, install, params, record=bag)
+    info = stop_when(probe, processes, lambda: clock.seconds >= 1.5)
+    assert info.returncode == 0, processes.log('launcher')
     topics, _ = read_messages(str(bag))
     config = load_config(params)
     poses = {}
@@ -80,7 +70,7 @@ def test_lockstep_bag_reproduces_formation_sim(processes, install, probe, tmp_pa
             stamp = fields.stamp_to_ns(message.header.stamp)
             poses.setdefault(stamp, {})[i] = (message.pose.position.x, message.pose.position.y)
     stamps = sorted(s for s, seen in poses.items() if len(seen) == config.num_robots)
-    assert len(stamps) > 100
+    assert len(stamps) > 150
     steps = [round(s / 1e7) for s in stamps]
     sim = simulate(config, duration=steps[-1] * 0.01, dt=0.01, sample_dt=0.01)
     recorded = np.array([[poses[s][i] for i in range(config.num_robots)] for s in stamps])
@@ -88,13 +78,11 @@ def test_lockstep_bag_reproduces_formation_sim(processes, install, probe, tmp_pa
 
 
 def test_bag_of_a_run_stopped_with_sigint_is_complete(processes, install, probe, tmp_path):
-    clock = []
-    probe.create_subscription(ClockMsg, '/clock', lambda m: clock.append(m.clock.sec), qos.CLOCK)
+    clock = SimClock(probe)
     bag = tmp_path / 'bag'
-    launcher = launch_recording(processes, install, SQUARE, bag, None, 0)
-    assert probe.spin_until(lambda: clock and clock[-1] >= 2, 40), processes.log('launcher')
-    os.kill(launcher.pid, signal.SIGINT)
-    assert wait_exit(probe, launcher, 40) == 0, processes.log('launcher')
+    launch(processes, install, SQUARE, record=bag)
+    info = stop_when(probe, processes, lambda: clock.seconds >= 2.0)
+    assert info.returncode == 0, processes.log('launcher')
     topics, counts = read_messages(str(bag))
     assert counts['/robot_1/cmd_vel'] > 20, processes.log('launcher')[-3000:]
     assert counts == {topic: len(messages) for topic, messages in topics.items()}
@@ -105,29 +93,31 @@ def test_recorder_refuses_an_existing_bag(processes, install, tmp_path):
     bag = tmp_path / 'bag'
     bag.mkdir()
     (bag / 'metadata.yaml').write_text('not yours\n')
-    process = processes.start('record', [exe(install, 'record'), '--ros-args', '--params-file',
-                                         SQUARE, '-p', f'record.path:={bag}'])
-    assert process.wait(30) == 2
+    processes.start(node(install, 'record', SQUARE, '-p', f'record.path:={bag}'))
+    info = processes.wait('record', 60)
+    assert info is not None and info.returncode == 2, processes.log('record')
     assert 'refusing to overwrite' in processes.log('record')
     assert (bag / 'metadata.yaml').read_text() == 'not yours\n'
 
 
 def test_recorder_records_commands_only_once_the_states_reach_it(processes, install, probe,
                                                                  tmp_path):
-    process = processes.start('record', [exe(install, 'record'), '--ros-args', '--params-file',
-                                         SQUARE, '-p', f'record.path:={tmp_path / "bag"}'])
-    assert probe.spin_until(lambda: probe.count_subscribers('/robot_1/pose') == 1, 30), \
+    processes.start(node(install, 'record', SQUARE, '-p', f'record.path:={tmp_path / "bag"}'))
+    assert probe.spin_until(lambda: probe.count_subscribers('/robot_1/pose') == 1, 60), \
         processes.log('record')
-    probe.spin_until(lambda: False, 1.0)
-    assert probe.count_subscribers('/robot_1/cmd_vel') == 0
     pose = probe.create_publisher(PoseStamped, '/robot_1/pose', qos.STATE)
-    assert probe.spin_until(lambda: probe.count_subscribers('/robot_1/cmd_vel') == 0
-                            and pose.get_subscription_count() == 1, 10)
-    probe.spin_until(lambda: False, 0.5)
+    assert probe.spin_until(lambda: pose.get_subscription_count() == 1, 20)
+    # Robot 2's cmd_vel being taken shows that the recorder has looked at its readers since
+    # robot 1's pose matched: robot 1, without neighbours, must still be left out.
+    probe.create_publisher(PoseStamped, '/robot_2/pose', qos.STATE)
+    probe.create_publisher(PoseArray, '/robot_2/neighbors', qos.STATE)
+    assert probe.spin_until(lambda: probe.count_subscribers('/robot_2/cmd_vel') == 1, 20), \
+        processes.log('record')
     assert probe.count_subscribers('/robot_1/cmd_vel') == 0
     probe.create_publisher(PoseArray, '/robot_1/neighbors', qos.STATE)
-    assert probe.spin_until(lambda: probe.count_subscribers('/robot_1/cmd_vel') == 1, 10), \
+    assert probe.spin_until(lambda: probe.count_subscribers('/robot_1/cmd_vel') == 1, 20), \
         processes.log('record')
-    assert probe.count_subscribers('/robot_2/cmd_vel') == 0
+    assert probe.count_subscribers('/robot_3/cmd_vel') == 0
     assert 'recorded once their pose and neighbours are' in processes.log('record')
-    assert processes.stop(process) == 0
+    [info] = processes.stop(['record'])
+    assert info.returncode == 0, processes.log('record')

@@ -1,0 +1,404 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+The formation launcher: plant, reference node, N robots and optionally the recorder.
+
+``scripts/launch_formation.sh`` runs this module (``python -m formation_ros.tools.launcher``)
+with an interpreter that can import the installed package; the options and messages are those
+of :data:`USAGE`. Every node runs under :class:`formation_ros.tools.supervise.Supervisor`, its
+output prefixed with its name. The run ends when the duration is over, on SIGINT, SIGTERM or
+SIGHUP (the terminal closed), or when a node ends on its own (exit code 1); the nodes are then
+stopped in order (robots, reference and plant together, the recorder last) and, with ``--out``
+or ``--record``, ``formation_report`` writes the metrics and figures. Exit codes: 0 done, 1 a
+node died or the report failed, 2 bad usage or parameters.
+"""
+
+import dataclasses
+import glob
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from typing import Mapping, Optional, Sequence, TextIO
+
+from formation_ros.tools.supervise import describe_returncode, ProcessSpec, Supervisor
+
+PROG = 'launch_formation.sh'
+PACKAGE = 'formation_ros'
+STOP_TIMEOUT = 10.0
+RECORDER_START_TIMEOUT = 15.0
+POLL = 0.2
+
+USAGE = """\
+Usage: scripts/launch_formation.sh PARAMS.yaml [--duration S] [--out DIR] [--record DIR]
+                                   [--prefix DIR]
+
+Starts the plant, the reference node and N robot nodes (N = num_robots in PARAMS.yaml), robot i
+in namespace /robot_<i>, all with the same parameters file, the reference node on the plant's
+simulated time (/clock). Output lines are prefixed with the node's name. Stops every
+process it started when the duration ends, on Ctrl-C or on SIGTERM (then still writes the
+report of --out / --record), and when any node exits on its own (then with a non-zero exit
+code).
+
+Options:
+  --duration S   wall-clock seconds to run; 0 runs until Ctrl-C
+                 (default: 'duration' in PARAMS.yaml divided by plant.realtime_factor)
+  --out DIR      run directory: the plant writes trajectory.npz and plant_stats.json there,
+                 PARAMS.yaml is copied there, and formation_report writes metrics.json and the
+                 figures there at the end (the directory must not exist yet, or be empty)
+  --record DIR   record every formation topic into a rosbag2 directory DIR (metadata.yaml +
+                 MCAP; DIR must not exist yet), started before the other nodes and stopped
+                 after them; at the end formation_report reads the bag and writes
+                 metrics.json and the figures (into --out if given, else into DIR)
+  --prefix DIR   install space of formation_ros (default: found from 'ros2', AMENT_PREFIX_PATH
+                 or ./install/formation_ros)
+  -h, --help     show this help
+
+Executables: 'ros2 run formation_ros <exe>' where the ros2 command knows the package, else
+<prefix>/lib/formation_ros/<exe> with the install's Python path set, as 'ros2 run' would.
+"""
+
+
+def read_parameters(path: str) -> tuple[int, float]:
+    """
+    Validate PARAMS for every program the launcher starts; return (num_robots, wall seconds).
+
+    The wall seconds are the default duration of a run: ``duration`` divided by
+    ``plant.realtime_factor``. This is the launcher's only use of the parameter code. Raises
+    UsageError listing every problem.
+    """
+    # Imported here so that --help and usage errors need nothing but the standard library.
+    from formation_ros.core.params import load_params_file, ParamError, validate
+    try:
+        raw = load_params_file(path)
+        config = validate(raw, 'formation_sim')
+        plant = validate(raw, 'plant')
+        validate(raw, 'reference')
+        validate({**raw, 'robot_id': 1}, 'robot')
+    except ParamError as exc:
+        raise UsageError(f'invalid parameters in {path}:\n{exc}') from None
+    return config.num_robots, config.duration / plant.values['plant.realtime_factor']
+
+
+class UsageError(Exception):
+    """Bad command line, files or parameters: the launcher exits 2 with this message."""
+
+
+@dataclasses.dataclass(frozen=True)
+class Options:
+    """The command line; paths as given (``None``: option not given)."""
+
+    params: str
+    duration: Optional[float] = None
+    out: Optional[str] = None
+    record: Optional[str] = None
+    prefix: Optional[str] = None
+
+
+def parse_args(argv: Sequence[str]) -> Optional[Options]:
+    """Parse the command line as the shell launcher always has; None for --help."""
+    needs = {'duration': 'seconds', 'out': 'a directory', 'record': 'a directory',
+             'prefix': 'a directory'}
+    values: dict[str, Optional[str]] = dict.fromkeys(needs)
+    params = None
+    args = list(argv)
+    while args:
+        arg = args.pop(0)
+        name = arg[2:]
+        if arg in ('-h', '--help'):
+            return None
+        if arg.startswith('--') and name in values:
+            value = args.pop(0) if args else ''
+            if not value:
+                raise UsageError(f'--{name} needs {needs[name]}')
+            values[name] = value
+        elif arg.startswith('-') and arg != '-':
+            raise UsageError(f"unknown option '{arg}' (see --help)")
+        elif params is not None:
+            raise UsageError(f"only one parameters file, got '{params}' and '{arg}'")
+        else:
+            params = arg
+    if params is None:
+        raise UsageError(None)
+    duration = values['duration']
+    if duration is not None and not re.fullmatch(r'[0-9]+([.][0-9]+)?', duration):
+        raise UsageError(f"--duration must be a number of seconds >= 0, got '{duration}'")
+    prefix = values['prefix'] or os.environ.get('FORMATION_PREFIX') or None
+    return Options(params, None if duration is None else float(duration), values['out'],
+                   values['record'], prefix)
+
+
+def check_paths(options: Options) -> Options:
+    """Check the files and directories of ``options`` (changing nothing); return them absolute."""
+    if not os.path.isfile(options.params):
+        raise UsageError(f"parameters file '{options.params}' not found")
+    out, record = options.out, options.record
+    if out is not None:
+        if os.path.isdir(out) and os.listdir(out):
+            raise UsageError(f"--out directory '{out}' is not empty; choose a new one")
+        if os.path.exists(out) and not os.path.isdir(out):
+            raise UsageError(f"--out '{out}' is not a directory")
+        out = os.path.abspath(out)
+    if record is not None:
+        if os.path.exists(record) and not (os.path.isdir(record) and not os.listdir(record)):
+            raise UsageError(f"--record directory '{record}' exists already; choose a new one")
+        record = os.path.abspath(record)
+    return dataclasses.replace(options, params=os.path.abspath(options.params), out=out,
+                               record=record)
+
+
+@dataclasses.dataclass(frozen=True)
+class Install:
+    """Where the executables come from: ``ros2 run`` (prefix None) or an install prefix."""
+
+    prefix: Optional[str]
+
+    def command(self, executable: str) -> list[str]:
+        """Return the argv that starts ``executable`` of the package."""
+        if self.prefix is None:
+            return ['ros2', 'run', PACKAGE, executable]
+        return [os.path.join(self.prefix, 'lib', PACKAGE, executable)]
+
+    def environment(self, base: Mapping[str, str]) -> dict[str, str]:
+        """Return ``base`` with what sourcing the install sets, and unbuffered Python output."""
+        env = dict(base, PYTHONUNBUFFERED='1')
+        if self.prefix is not None:
+            sites = sorted(glob.glob(os.path.join(self.prefix, 'lib', 'python3*',
+                                                  'site-packages')))
+            env['PYTHONPATH'] = _join_paths(sites, base.get('PYTHONPATH'))
+            env['AMENT_PREFIX_PATH'] = _join_paths([self.prefix], base.get('AMENT_PREFIX_PATH'))
+        return env
+
+    def describe(self) -> str:
+        """Say where the executables come from, for the start-up line."""
+        return 'ros2 run' if self.prefix is None else self.prefix
+
+
+def find_install(prefix: Optional[str], env: Mapping[str, str]) -> Install:
+    """
+    Find the executables: ``prefix`` if given, else ``ros2 run`` where ros2 knows the package.
+
+    Else the first that holds ``lib/formation_ros/plant`` of: AMENT_PREFIX_PATH, the install
+    this module was imported from, ./install/formation_ros and ./install, and the same two in
+    the source tree this module was imported from.
+    """
+    if prefix is None:
+        if shutil.which('ros2', path=env.get('PATH')) and _ros2_knows_package(env):
+            return Install(None)
+        package = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+        candidates = [p for p in env.get('AMENT_PREFIX_PATH', '').split(os.pathsep) if p]
+        candidates += [os.path.join(package, *['..'] * 4)]
+        for root in ('.', os.path.dirname(package)):
+            candidates += [os.path.join(root, 'install', PACKAGE), os.path.join(root, 'install')]
+        prefix = next((p for p in candidates if _has_plant(p)), None)
+        if prefix is None:
+            raise UsageError("formation_ros is not installed: build it with 'colcon build' "
+                             '(see README) or pass --prefix INSTALL_DIR')
+    if not _has_plant(prefix):
+        raise UsageError(f'no {os.path.join(prefix, "lib", PACKAGE, "plant")}')
+    return Install(os.path.abspath(prefix))
+
+
+def node_specs(install: Install, options: Options, num_robots: int,
+               env: Mapping[str, str]) -> list[ProcessSpec]:
+    """Return the specs of plant, reference and robots, in the order they start."""
+    params = ['--ros-args', '--params-file', options.params]
+    plant = params.copy()
+    if options.out is not None:
+        plant += ['-p', f'plant.output_dir:={options.out}']
+    if options.record is not None:
+        plant += ['-p', 'plant.wait_for_subscribers:=2']
+    waits = 2 if options.record is not None else 1
+    specs = [ProcessSpec('plant', install.command('plant') + plant, env),
+             ProcessSpec('reference', install.command('reference') + params +
+                         ['-p', 'use_sim_time:=true'], env)]
+    for i in range(1, num_robots + 1):
+        specs.append(ProcessSpec(f'robot_{i}', install.command('robot') + [
+            '--ros-args', '-r', f'__ns:=/robot_{i}', '-p', f'robot_id:={i}',
+            '--params-file', options.params, '-p', f'wait_for_subscribers:={waits}'], env))
+    return specs
+
+
+def recorder_spec(install: Install, options: Options, env: Mapping[str, str]) -> ProcessSpec:
+    """Return the spec of the recorder writing into ``options.record``."""
+    return ProcessSpec('record', install.command('record') + [
+        '--ros-args', '--params-file', options.params, '-p', f'record.path:={options.record}'],
+        env)
+
+
+class Launch:
+    """One run: starts the nodes, watches them and the clock, stops them in order."""
+
+    def __init__(self, options: Options, install: Install, num_robots: int,
+                 wall_seconds: float) -> None:
+        """Prepare the run; nothing is started yet."""
+        self.options = options
+        self.install = install
+        self.num_robots = num_robots
+        self.wall_seconds = wall_seconds
+        self.env = install.environment(os.environ)
+        self.supervisor = Supervisor(echo=sys.stdout, env=self.env)
+        self.interrupted: Optional[str] = None
+        self.failure: Optional[str] = None
+
+    def on_signal(self, signum: int, frame: object) -> None:
+        """Note SIGINT, SIGTERM or SIGHUP; the main loop then stops the nodes."""
+        self.interrupted = signal.Signals(signum).name
+
+    def run(self) -> int:
+        """Run the nodes until the end, stop them, write the report; return the exit code."""
+        previous = {sig: signal.signal(sig, self.on_signal)
+                    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
+        try:
+            self._start_and_watch()
+            if self.interrupted:
+                say(f'stopping ({self.interrupted})')
+            self.stop()
+            if self.failure is not None:
+                say(f'{self.failure}; stopped the others')
+                return 1
+            return self.report()
+        finally:
+            self.supervisor.close()
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
+
+    def stop(self) -> None:
+        """Stop robots, reference and plant together, then the recorder."""
+        names = self.supervisor.names()
+        stages = [[name for name in names if name != 'record']]
+        if 'record' in names:
+            stages.append(['record'])
+        self.supervisor.stop_all(stages, STOP_TIMEOUT)
+
+    def _start_and_watch(self) -> None:
+        specs = node_specs(self.install, self.options, self.num_robots, self.env)
+        if self.options.record is not None:
+            specs.insert(0, recorder_spec(self.install, self.options, self.env))
+        for spec in specs:
+            if self.interrupted or not self._start(spec):
+                return
+            if spec.name == 'record' and not self._wait_for_recorder():
+                return
+        deadline = time.monotonic() + self.wall_seconds if self.wall_seconds > 0 else None
+        while not self.interrupted:
+            left = POLL if deadline is None else min(POLL, deadline - time.monotonic())
+            if left <= 0:
+                return
+            if self._died(left):
+                return
+
+    def _start(self, spec: ProcessSpec) -> bool:
+        try:
+            self.supervisor.start(spec)
+        except OSError as exc:
+            self.failure = f'cannot start {spec.name}: {exc}'
+            return False
+        return True
+
+    def _died(self, timeout: float) -> bool:
+        """Wait up to ``timeout`` s for a node to end on its own; True (noted) if one did."""
+        ended = self.supervisor.wait_exit(timeout)
+        if ended is None or ended.stopped:
+            return False
+        self.failure = f'{ended.name} ended first ({ended.reason})'
+        return True
+
+    def _wait_for_recorder(self) -> bool:
+        """Wait until the recorder has created its bag directory; False if it did not."""
+        assert self.options.record is not None
+        deadline = time.monotonic() + RECORDER_START_TIMEOUT
+        while not os.path.isdir(self.options.record):
+            if self.interrupted or self._died(POLL):
+                return False
+            if time.monotonic() > deadline:
+                self.failure = ('the recorder did not start within '
+                                f'{RECORDER_START_TIMEOUT:g} s (see its output above)')
+                return False
+        return True
+
+    def report(self) -> int:
+        """Run formation_report on the bag or the run directory, if any; return the exit code."""
+        options = self.options
+        if options.record is not None:
+            source, target = options.record, options.out or options.record
+        elif options.out is not None:
+            if not os.path.isfile(os.path.join(options.out, 'trajectory.npz')):
+                say(f'the plant wrote no trajectory to {options.out}')
+                return 1
+            source, target = options.out, options.out
+        else:
+            return 0
+        sys.stdout.flush()
+        code = subprocess.call(self.install.command('formation_report') +
+                               [source, '--out', target], env=self.env)
+        if code != 0:
+            say(f'formation_report failed ({describe_returncode(code)})')
+            return 1
+        return 0
+
+
+def say(message: str, stream: Optional[TextIO] = None) -> None:
+    """Print one launcher message (on stderr unless ``stream`` is given), if it still can."""
+    try:
+        sys.stdout.flush()
+        print(f'{PROG}: {message}', file=stream or sys.stderr, flush=True)
+    except OSError:
+        pass
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    """Run the launcher with ``argv`` (default: the command line); return the exit code."""
+    try:
+        options = parse_args(sys.argv[1:] if argv is None else argv)
+        if options is None:
+            print(USAGE, end='')
+            return 0
+        options = check_paths(options)
+        install = find_install(options.prefix, os.environ)
+        num_robots, wall_seconds = read_parameters(options.params)
+    except UsageError as exc:
+        if exc.args[0] is None:
+            print(USAGE, end='', file=sys.stderr)
+        else:
+            say(exc.args[0])
+        return 2
+    if options.duration is not None:
+        wall_seconds = options.duration
+    if options.out is not None:
+        os.makedirs(options.out, exist_ok=True)
+        shutil.copyfile(options.params, os.path.join(options.out, 'params.yaml'))
+    if options.record is not None:
+        if os.path.isdir(options.record):
+            os.rmdir(options.record)
+        os.makedirs(os.path.dirname(options.record), exist_ok=True)
+    span = 'until Ctrl-C' if wall_seconds == 0 else f'for {wall_seconds:g} s'
+    say(f'{num_robots} robots from {options.params} ({install.describe()}), {span}',
+        sys.stdout)
+    return Launch(options, install, num_robots, wall_seconds).run()
+
+
+def _ros2_knows_package(env: Mapping[str, str]) -> bool:
+    try:
+        result = subprocess.run(['ros2', 'pkg', 'prefix', PACKAGE], env=dict(env),
+                                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
+                                stderr=subprocess.DEVNULL, timeout=60)
+    except (OSError, subprocess.TimeoutExpired):
+        return False
+    return result.returncode == 0
+
+
+def _has_plant(prefix: str) -> bool:
+    return os.access(os.path.join(prefix, 'lib', PACKAGE, 'plant'), os.X_OK)
+
+
+def _join_paths(first: Sequence[str], rest: Optional[str]) -> str:
+    return os.pathsep.join(list(first) + ([rest] if rest else []))
+
+
+if __name__ == '__main__':
+    sys.exit(main())

@@ -1,0 +1,133 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+Helpers of the integration tests: executables, parameter files, the launcher, what a probe hears.
+
+The fixtures (install space, supervised processes, probe node) are in ``conftest.py``; test
+modules import these helpers from here.
+"""
+
+import os
+import signal
+import subprocess
+
+from formation_ros import fields, qos
+from formation_ros.tools.supervise import ProcessSpec
+from geometry_msgs.msg import TwistStamped
+from rosgraph_msgs.msg import Clock as ClockMsg
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+CONFIG = os.path.join(ROOT, 'config')
+SQUARE = os.path.join(CONFIG, 'square_4.yaml')
+LAUNCHER = os.path.join(ROOT, 'scripts', 'launch_formation.sh')
+START_UP = 90.0
+
+
+def exe(install, name):
+    """Path of an installed executable, as ``ros2 run formation_ros NAME`` runs it."""
+    return os.path.join(install, 'lib', 'formation_ros', name)
+
+
+def node(install, name, params, *extra, process=None):
+    """Spec of node ``name`` of the install with ``--ros-args --params-file params extra...``."""
+    return ProcessSpec(process or name,
+                       [exe(install, name), '--ros-args', '--params-file', str(params), *extra])
+
+
+def write_params(folder, source, changes, name='params.yaml'):
+    """Copy a shipped config with top-level ``ros__parameters`` entries added or replaced."""
+    import yaml
+    with open(os.path.join(CONFIG, source)) as stream:
+        document = yaml.safe_load(stream)
+    params = document['/**']['ros__parameters']
+    for key, value in changes.items():
+        entry = params
+        parts = key.split('.')
+        for part in parts[:-1]:
+            entry = entry.setdefault(part, {})
+        entry[parts[-1]] = value
+    path = os.path.join(str(folder), name)
+    with open(path, 'w') as stream:
+        yaml.safe_dump(document, stream)
+    return path
+
+
+def launch(processes, install, params, out=None, record=None, duration=0, env=None,
+           name='launcher'):
+    """
+    Start ``scripts/launch_formation.sh`` as process ``name``; return its Popen.
+
+    install: passed as ``--prefix`` (None: the launcher finds the executables itself).
+    duration: the launcher's ``--duration``; the default 0 runs until :func:`stop_when`.
+    """
+    args = ['bash', LAUNCHER, str(params), '--duration', str(duration)]
+    if install is not None:
+        args += ['--prefix', str(install)]
+    if out is not None:
+        args += ['--out', str(out)]
+    if record is not None:
+        args += ['--record', str(record)]
+    return processes.start(ProcessSpec(name, args, env))
+
+
+class SimClock:
+    """The latest simulated time the probe heard on ``/clock``, in seconds (-1 before any)."""
+
+    def __init__(self, probe):
+        """Subscribe ``probe`` to ``/clock``."""
+        self.seconds = -1.0
+        self.subscription = probe.create_subscription(ClockMsg, '/clock', self._on_clock,
+                                                      qos.CLOCK)
+
+    def _on_clock(self, message):
+        self.seconds = fields.stamp_to_ns(message.clock) * 1e-9
+
+
+def watch_commands(probe, count):
+    """
+    Subscribe to the cmd_vel of robots 1..count.
+
+    Return (heard, subscriptions): heard is the list of (robot, (x, y, z)) received.
+    """
+    heard = []
+    subscriptions = [
+        probe.create_subscription(
+            TwistStamped, f'/robot_{i}/cmd_vel',
+            lambda msg, i=i: heard.append((i, (msg.twist.linear.x, msg.twist.linear.y,
+                                               msg.twist.linear.z))), qos.COMMAND)
+        for i in range(1, count + 1)]
+    return heard, subscriptions
+
+
+def matched(subscriptions):
+    """Whether every subscription has matched at least one publisher."""
+    return all(s.get_publisher_count() > 0 for s in subscriptions)
+
+
+def wait_exit(probe, processes, name, timeout):
+    """Spin ``probe`` until process ``name`` has ended (up to ``timeout`` s); return its exit."""
+    probe.spin_until(lambda: not processes.running(name), timeout)
+    return processes.exit_info(name)
+
+
+def stop_when(probe, processes, condition, timeout=START_UP, name='launcher'):
+    """
+    Spin ``probe`` until ``condition()`` holds, then Ctrl-C the launcher; return its exit.
+
+    Asserts that the condition was met while the launcher ran and that the launcher ended.
+    """
+    probe.spin_until(lambda: condition() or not processes.running(name), timeout)
+    assert condition(), f'condition not met within {timeout} s:\n' + processes.log(name)[-4000:]
+    assert processes.running(name), processes.log(name)[-4000:]
+    processes.send_signal(name, signal.SIGINT)
+    info = wait_exit(probe, processes, name, 60)
+    assert info is not None, f'{name} did not end within 60 s after SIGINT'
+    return info
+
+
+def project_processes(install):
+    """Command lines of the running processes that mention the install space."""
+    listing = subprocess.run(['ps', '-ww', '-eo', 'pid=,args='], capture_output=True,
+                             text=True, check=True).stdout
+    return [line for line in listing.splitlines() if install in line]
