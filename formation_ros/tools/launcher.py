@@ -72,16 +72,15 @@ def read_parameters(path: str) -> tuple[int, float]:
     UsageError listing every problem.
     """
     # Imported here so that --help and usage errors need nothing but the standard library.
-    from formation_ros.core.params import load_params_file, ParamError, validate
+    from formation_ros.core.declarations import Exe, ParamError
+    from formation_ros.core.params import validate_for_every_executable
+    from formation_ros.core.params_file import load_params_file
     try:
-        raw = load_params_file(path)
-        config = validate(raw, 'formation_sim')
-        plant = validate(raw, 'plant')
-        validate(raw, 'reference')
-        validate({**raw, 'robot_id': 1}, 'robot')
+        plant = validate_for_every_executable(load_params_file(path))[Exe.PLANT]
     except ParamError as exc:
         raise UsageError(f'invalid parameters in {path}:\n{exc}') from None
-    return config.num_robots, config.duration / plant.values['plant.realtime_factor']
+    assert plant.plant is not None
+    return plant.num_robots, plant.duration / plant.plant.realtime_factor
 
 
 class UsageError(Exception):

@@ -12,7 +12,7 @@ import os
 import signal
 import subprocess
 
-from formation_ros import fields, qos
+from formation_ros.ros import fields, qos
 from formation_ros.tools.supervise import ProcessSpec
 from geometry_msgs.msg import TwistStamped
 from rosgraph_msgs.msg import Clock as ClockMsg

@@ -3,10 +3,10 @@
 import json
 import math
 
-from formation_ros import fields, messages, qos
 from formation_ros.core.law import robot_command
 from formation_ros.core.params import load_config
-from formation_ros.trajectory import Trajectory
+from formation_ros.core.trajectory import Trajectory
+from formation_ros.ros import fields, messages, qos
 from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
 from helpers import node, SQUARE
 from nav_msgs.msg import Odometry

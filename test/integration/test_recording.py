@@ -2,12 +2,12 @@
 
 import json
 
-from formation_ros import fields, qos
-from formation_ros.bag import read_messages
 from formation_ros.core.metrics import compute_metrics
 from formation_ros.core.params import load_config
-from formation_ros.sim import simulate
-from formation_ros.trajectory import Trajectory
+from formation_ros.core.trajectory import Trajectory
+from formation_ros.ros import fields, qos
+from formation_ros.tools.bag import read_messages
+from formation_ros.tools.sim import simulate
 from geometry_msgs.msg import PoseArray, PoseStamped
 from helpers import launch, node, SimClock, SQUARE, stop_when, write_params
 import numpy as np

@@ -6,8 +6,8 @@ import signal
 import time
 
 from formation_ros.core.params import load_config
-from formation_ros.sim import simulate
-from formation_ros.trajectory import Trajectory
+from formation_ros.core.trajectory import Trajectory
+from formation_ros.tools.sim import simulate
 from helpers import (CONFIG, exe, launch, matched, node, project_processes,
                      SimClock, SQUARE, stop_when, watch_commands, write_params)
 import numpy as np
