@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """
 Benchmark of the vectorised law and of the fixed-step simulator (run on demand, not in CI).
 

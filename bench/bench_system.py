@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """
 Benchmark of the multi-process ROS system (run on demand, not in CI).
 

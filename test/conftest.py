@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """Test isolation: each test run talks DDS on its own domain, on this host only."""
 
 import os

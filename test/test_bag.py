@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """rosbag2 writing and reading (bag.py) and the report from a bag (report.py), without DDS."""
 
 import json

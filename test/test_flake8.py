@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """Style: the ament flake8 rules (99 columns, single quotes, import order, docstrings)."""
 
 import os

@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """Arrows point down only: core <- ros adapters <- nodes; offline tools beside the nodes."""
 
 import ast

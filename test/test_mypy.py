@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """Static types: mypy checks every module of formation_ros/core with the settings in mypy.ini."""
 
 import os

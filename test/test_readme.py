@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """The README stays true: its commands are CI's, and it documents every parameter."""
 
 import os

@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """The shell scripts' command lines: help, clear errors, strict mode."""
 
 import os

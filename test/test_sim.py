@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """The offline simulator (sim.py): Section 5 reproduced, tracking, the CLI."""
 
 import json

@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """
 One declaration per parameter: name, type, allowed range, description, who reads it.
 

@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """
 The moving formation frame of Section 6: J, its time derivative, and eqs. (20), (21), (25).
 

@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """
 Jump functions of Lemma 1 (eqs. 5-7) and the collision terms built from them (eq. 11).
 

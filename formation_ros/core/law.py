@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """
 The bounded formation control law: eqs. (8)-(14) and the tracking transform (21), (25).
 

@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """
 Numbers that show the controller kept its promises, from sampled runs (Section 5).
 

@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """
 Read and write ROS 2 parameters files (YAML): the one place that knows their layout.
 

@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """
 The robots' bodies and sensors, without ROS: one model for ``formation_sim --dt`` and the plant.
 

@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """
 Moving references q_od(t) for formation tracking (Section 6) and their frames.
 

@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """A sampled formation run and its ``trajectory.npz`` file."""
 
 from dataclasses import dataclass

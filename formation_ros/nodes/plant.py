@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """
 Plant node (executable ``plant``): the robots' bodies and range sensors on the ROS graph.
 

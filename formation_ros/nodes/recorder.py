@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 r"""
 Recorder node (executable ``record``): every formation topic into a rosbag2 (MCAP) directory.
 

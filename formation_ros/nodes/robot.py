@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 r"""
 Robot node (executable ``robot``): one robot's bounded formation controller.
 

@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """
 Write rosbag2 directories (metadata.yaml + MCAP) with ``rosbags``: what the recorder stores.
 

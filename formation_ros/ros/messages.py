@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """Build ROS messages from the numpy arrays of the core (reading them is ``fields``)."""
 
 from builtin_interfaces.msg import Time

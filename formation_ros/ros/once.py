@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """Log a condition once when it starts and once when it ends, not every cycle."""
 
 from typing import Any, Set

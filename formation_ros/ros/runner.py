@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """
 Run one node as a process: rclpy start-up, spinning, and a clean stop on SIGINT or SIGTERM.
 

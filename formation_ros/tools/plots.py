@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """
 Figures of a formation run (PNG), in the style of the paper's Fig. 1.
 

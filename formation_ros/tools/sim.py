@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """
 Offline simulator ``formation_sim``: the closed loop q' = u of eqs. (1), (14), (25).
 

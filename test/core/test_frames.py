@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """Moving references and the formation frame J (core/reference.py, core/frames.py)."""
 
 import math

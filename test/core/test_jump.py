@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """Jump functions of Lemma 1 (core/jump.py)."""
 
 import math

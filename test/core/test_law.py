@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """The bounded control law (core/law.py): eqs. (8)-(14), (25)."""
 
 import math

@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """Run metrics (core/metrics.py) against brute-force and hand-computed references."""
 
 import itertools

@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """The plant model (core/plant.py): zero-order hold, admission, bound audit, collisions, sensor."""
 
 import math

@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """
 Fixtures of the integration tests: a colcon install space, supervised processes, a probe node.
 

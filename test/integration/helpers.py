@@ -12,6 +12,7 @@ import os
 import signal
 import subprocess
 
+from formation_ros.core.params_file import load_params_file, write_params_file
 from formation_ros.ros import fields, qos
 from formation_ros.tools.supervise import ProcessSpec
 from geometry_msgs.msg import TwistStamped
@@ -36,20 +37,11 @@ def node(install, name, params, *extra, process=None):
 
 
 def write_params(folder, source, changes, name='params.yaml'):
-    """Copy a shipped config with top-level ``ros__parameters`` entries added or replaced."""
-    import yaml
-    with open(os.path.join(CONFIG, source)) as stream:
-        document = yaml.safe_load(stream)
-    params = document['/**']['ros__parameters']
-    for key, value in changes.items():
-        entry = params
-        parts = key.split('.')
-        for part in parts[:-1]:
-            entry = entry.setdefault(part, {})
-        entry[parts[-1]] = value
+    """Copy a shipped config with parameters (dotted names) added or replaced; return its path."""
+    values = load_params_file(os.path.join(CONFIG, source))
+    values.update(changes)
     path = os.path.join(str(folder), name)
-    with open(path, 'w') as stream:
-        yaml.safe_dump(document, stream)
+    write_params_file(path, values)
     return path
 
 

@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """Single nodes driven by the test over DDS: exact commands, bad messages."""
 
 import json

@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """Recording real runs: rosbag2 (MCAP) from the recorder, the report, diagnostics, markers."""
 
 import json

@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """The ROS 2 system with real processes and real DDS: plant, reference, robots, launcher."""
 
 import json
