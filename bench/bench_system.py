@@ -26,19 +26,18 @@ import tempfile
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from bench_core import lattice  # noqa: E402
-import yaml  # noqa: E402, I100
+from formation_ros.core.params_file import write_params_file  # noqa: E402, I100
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
 def params_for(n):
-    """Parameters document for N robots (Section 5 constants)."""
+    """Parameters for N robots (Section 5 constants), flat dotted names."""
     radius = max(1.0, (n / (10.0 * 3.141592653589793)) ** 0.5)
-    return {'/**': {'ros__parameters': {
-        'num_robots': n, 'dim': 2, 'sensing_radius': 2.0, 'repulsion_radius': 1.0,
-        'formation': {'vertices': [float(v) for v in lattice(n, 2.0).ravel()]},
-        'start': {'random_radius': float(radius), 'min_separation': 0.1, 'seed': 1},
-        'duration': 20.0}}}
+    return {'num_robots': n, 'dim': 2, 'sensing_radius': 2.0, 'repulsion_radius': 1.0,
+            'formation.vertices': [float(v) for v in lattice(n, 2.0).ravel()],
+            'start.random_radius': float(radius), 'start.min_separation': 0.1,
+            'start.seed': 1, 'duration': 20.0}
 
 
 def main():
@@ -58,8 +57,7 @@ def main():
     for n in args.sizes:
         with tempfile.TemporaryDirectory() as tmp:
             params = os.path.join(tmp, 'params.yaml')
-            with open(params, 'w') as stream:
-                yaml.safe_dump(params_for(n), stream)
+            write_params_file(params, params_for(n))
             out = os.path.join(tmp, 'run')
             subprocess.run(['bash', os.path.join(ROOT, 'scripts', 'launch_formation.sh'),
                             params, '--duration', str(args.duration), '--out', out,

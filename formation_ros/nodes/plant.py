@@ -39,7 +39,7 @@ from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.markers import formation_markers
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
-from formation_ros.ros.runner import run
+from formation_ros.ros.runner import LOCKSTEP_POLL, run
 from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
 import numpy as np
 from numpy.typing import NDArray
@@ -48,7 +48,6 @@ from rclpy.node import Node
 from rosgraph_msgs.msg import Clock as ClockMsg
 from visualization_msgs.msg import MarkerArray
 
-LOCKSTEP_POLL = 0.001
 RESEND_AFTER = 0.05
 PATH_LENGTH = 100
 

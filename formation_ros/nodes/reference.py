@@ -22,12 +22,10 @@ from formation_ros.core.declarations import Exe
 from formation_ros.ros import fields, messages, qos, topics
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.parameters import declare_parameters
-from formation_ros.ros.runner import run
+from formation_ros.ros.runner import LOCKSTEP_POLL, run
 from nav_msgs.msg import Odometry
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
-
-LOCKSTEP_POLL = 0.001
 
 
 class ReferenceNode(Node):

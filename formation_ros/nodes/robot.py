@@ -27,14 +27,13 @@ from formation_ros.ros import fields, messages, qos, topics
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
-from formation_ros.ros.runner import run
+from formation_ros.ros.runner import LOCKSTEP_POLL, run
 from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
 from nav_msgs.msg import Odometry
 import numpy as np
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 
-LOCKSTEP_POLL = 0.001
 REFERENCE_BUFFER = 64
 INPUTS = ('pose', 'neighbour', 'reference')
 

@@ -23,6 +23,8 @@ from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
 SIGNAL_LATENCY = 0.1
+LOCKSTEP_POLL = 0.001
+"""Period, s (steady clock), of the timer with which a lockstep node looks for a new state."""
 
 
 def make_executor() -> Executor:
