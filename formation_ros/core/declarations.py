@@ -215,6 +215,10 @@ DECLARATIONS = (
     Param('plant.lockstep', Kind.BOOL, False,
           'Deterministic mode: the plant steps only when every robot answered the latest state.',
           users=frozenset({Exe.PLANT, Exe.ROBOT, Exe.REFERENCE, Exe.RECORD})),
+    Param('plant.max_speed', Kind.DOUBLE, 0.0,
+          'Cap on every component of an applied command, m/s (world frame); 0: no cap beyond '
+          "the law's own bound (u_hat within c*M1 at the state a command answers).",
+          low=at_least(0.0), users=PLANT),
     Param('plant.collision_distance', Kind.DOUBLE, DEFAULT_COLLISION_DISTANCE,
           'Two robots closer than this are logged as a collision, m.', low=at_least(0.0),
           users=PLANT),

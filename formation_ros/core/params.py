@@ -37,6 +37,7 @@ class PlantSettings:
     publish_rate: float
     realtime_factor: float
     collision_distance: float
+    max_speed: float
     wait_for_robots: bool
     wait_for_subscribers: int
     marker_rate: float
@@ -233,6 +234,7 @@ def _own_settings(values: Mapping[str, Any], exe: Exe, n: int,
             publish_rate=values['plant.publish_rate'],
             realtime_factor=values['plant.realtime_factor'],
             collision_distance=values['plant.collision_distance'],
+            max_speed=values['plant.max_speed'],
             wait_for_robots=values['plant.wait_for_robots'],
             wait_for_subscribers=values['plant.wait_for_subscribers'],
             marker_rate=values['plant.marker_rate'], output_dir=values['plant.output_dir'])}

@@ -13,10 +13,13 @@ Each step the model
 
 * admits commands (:meth:`PlantModel.admit`): for each robot the latest command counts if there
   is one (else ``MISSING``), it is finite (else ``NON_FINITE``) and its state stamp is at most
-  ``input_timeout`` old (else ``STALE``); a command that does not count is replaced by zero;
-* audits the bound (:meth:`PlantModel.advance`): a new command whose bounded part u_hat of
-  eq. (14) (recovered through eq. (25) for a moving reference) has a component above c M1 is
-  counted and reported, not clipped;
+  ``input_timeout`` old (else ``STALE``) and not newer than the present state (else
+  ``FUTURE``); a command that does not count is replaced by zero. One that counts but asks for
+  more than the law can produce is clipped (``SATURATED``): its bounded part u_hat of eq. (14)
+  (recovered through eq. (25) for a moving reference) to c M1, and every world component to
+  ``max_speed`` when that is set;
+* audits the bound (:meth:`PlantModel.advance`): a new command above c M1 is counted once and
+  reported;
 * integrates and checks collisions: a pair closer than ``collision_distance`` is counted once
   when it comes closer;
 * senses (:meth:`PlantModel.neighbours`): what each robot's range sensor sees, the other robots
@@ -30,7 +33,7 @@ from dataclasses import dataclass, field
 import enum
 from typing import Dict, List, Optional, Set, Tuple
 
-from formation_ros.core.frames import to_frame_velocity
+from formation_ros.core.frames import from_frame_velocity, to_frame_velocity
 from formation_ros.core.law import LawParams
 from formation_ros.core.reference import Reference
 import numpy as np
@@ -52,6 +55,8 @@ class CommandStatus(enum.IntEnum):
     MISSING = 1
     STALE = 2
     NON_FINITE = 3
+    FUTURE = 4
+    SATURATED = 5
 
 
 @dataclass
@@ -88,10 +93,17 @@ class Commands:
 
 @dataclass(frozen=True)
 class Admission:
-    """Commands held over one step (N, dim), and each robot's :class:`CommandStatus` (N,)."""
+    """
+    What counts for one step.
+
+    u: (N, dim) commands held over the step, m/s; status: (N,) :class:`CommandStatus` codes;
+    largest_u_hat: (N,) largest |u_hat| component of each command as sent (0 where it did not
+    count), m/s.
+    """
 
     u: NDArray[np.float64]
     status: NDArray[np.int8]
+    largest_u_hat: NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -131,7 +143,14 @@ class PlantCounts:
                 'bound_violations': self.bound_violations,
                 'stale_command_steps': self.steps_with(CommandStatus.STALE),
                 'bad_command_steps': self.steps_with(CommandStatus.NON_FINITE),
-                'missing_command_steps': self.steps_with(CommandStatus.MISSING)}
+                'missing_command_steps': self.steps_with(CommandStatus.MISSING),
+                'future_command_steps': self.steps_with(CommandStatus.FUTURE),
+                'saturated_command_steps': self.steps_with(CommandStatus.SATURATED)}
+
+    def by_robot(self, status: CommandStatus) -> Dict[int, int]:
+        """Robot-steps with ``status`` per robot (1-based), for the robots that had any."""
+        row = self.status_steps[status]
+        return {int(i) + 1: int(row[i]) for i in np.flatnonzero(row)}
 
 
 @dataclass(frozen=True)
@@ -210,12 +229,13 @@ class PlantModel:
     start: (N, dim) positions, m; sensing_radii: (N,) R_i, m; step_ns: dt in ns; law: the
     control law constants (for the bound c M1); reference: the desired trajectory (to recover
     u_hat when auditing the bound); input_timeout_ns: the oldest state stamp a command may
-    answer; collision_distance: m.
+    answer; collision_distance: m; max_speed: cap on every world command component, m/s (0:
+    none beyond the law's own bound).
     """
 
     def __init__(self, start: ArrayLike, sensing_radii: ArrayLike, step_ns: int,
                  law: LawParams, reference: Reference, input_timeout_ns: int,
-                 collision_distance: float):
+                 collision_distance: float, max_speed: float = 0.0):
         """Place the robots at ``start`` at time 0."""
         self.q = np.array(start, dtype=float)
         self.radii = np.array(sensing_radii, dtype=float)
@@ -227,6 +247,7 @@ class PlantModel:
         self.reference = reference
         self.input_timeout_ns = int(input_timeout_ns)
         self.collision_distance = float(collision_distance)
+        self.max_speed = float(max_speed)
         self.bound_tolerance = (BOUND_TOLERANCE_FIXED if reference.is_stationary
                                 else BOUND_TOLERANCE_MOVING)
         self.t_ns = 0
@@ -249,21 +270,71 @@ class PlantModel:
         return self.step_ns / NS_PER_S
 
     def admit(self, commands: Commands) -> Admission:
-        """Return the commands that count for the coming step (zero where one does not)."""
+        """
+        Return the commands that count for the coming step, and why the others do not.
+
+        A robot's latest command counts if there is one, it is finite, and it answers a state
+        at most ``input_timeout`` old and not newer than the present one; otherwise the robot
+        gets zero for the step. A command that counts but asks for more than the law can
+        produce at the state it answers (a component of u_hat above c M1, eqs. (14), (25)), or
+        a component above ``max_speed``, is saturated: u_hat clipped to c M1 and mapped back,
+        then the world components clipped to ``max_speed``.
+        """
         status = np.full(self.num_robots, CommandStatus.APPLIED, dtype=np.int8)
-        finite = np.all(np.isfinite(commands.u), axis=1)
-        stale = self.t_ns - commands.stamp_ns > self.input_timeout_ns
-        status[stale] = CommandStatus.STALE
-        status[~finite] = CommandStatus.NON_FINITE
+        age = self.t_ns - commands.stamp_ns
+        status[age > self.input_timeout_ns] = CommandStatus.STALE
+        status[age < 0] = CommandStatus.FUTURE
+        status[~np.all(np.isfinite(commands.u), axis=1)] = CommandStatus.NON_FINITE
         status[~commands.present] = CommandStatus.MISSING
-        applied = status == CommandStatus.APPLIED
-        u = np.where(applied[:, None], commands.u, 0.0)
-        return Admission(u=u, status=status)
+        counted = status == CommandStatus.APPLIED
+        u = np.where(counted[:, None], commands.u, 0.0)
+        largest = np.zeros(self.num_robots)
+        if np.any(counted):
+            self._saturate(u, commands.stamp_ns, counted, status, largest)
+        return Admission(u=u, status=status, largest_u_hat=largest)
+
+    def _saturate(self, u: NDArray[np.float64], stamps: NDArray[np.int64],
+                  counted: NDArray[np.bool_], status: NDArray[np.int8],
+                  largest: NDArray[np.float64]) -> None:
+        """Clip the counted commands (in place) to the law's bound and to max_speed."""
+        bound = self.law.u_bound
+        limit = bound + self.bound_tolerance
+        if self.reference.is_stationary:
+            largest[counted] = np.max(np.abs(u[counted]), axis=1)
+            over = counted & (largest > limit)
+            u[over] = np.clip(u[over], -bound, bound)
+        else:
+            over = np.zeros(self.num_robots, dtype=bool)
+            for stamp in np.unique(stamps[counted]):
+                rows = counted & (stamps == stamp)
+                state = self._state_at(int(stamp))[rows]
+                frame = self.reference.sample(int(stamp) / NS_PER_S)
+                u_hat = to_frame_velocity(u[rows], state, frame)
+                largest[rows] = np.max(np.abs(u_hat), axis=1)
+                clip = largest[rows] > limit
+                if np.any(clip):
+                    index = np.flatnonzero(rows)[clip]
+                    u[index] = from_frame_velocity(np.clip(u_hat[clip], -bound, bound),
+                                                   state[clip], frame)
+                    over[index] = True
+        if self.max_speed > 0.0:
+            capped = counted & np.any(np.abs(u) > self.max_speed, axis=1)
+            u[capped] = np.clip(u[capped], -self.max_speed, self.max_speed)
+            over |= capped
+        status[over] = CommandStatus.SATURATED
+
+    def _state_at(self, stamp_ns: int) -> NDArray[np.float64]:
+        """Return the state a command stamped ``stamp_ns`` answers (or the one before it)."""
+        state = self._states.get(stamp_ns)
+        if state is not None:
+            return state
+        earlier = [t for t in self._states if t <= stamp_ns]
+        return self._states[max(earlier)] if earlier else next(iter(self._states.values()))
 
     def advance(self, commands: Commands) -> StepReport:
         """Admit the commands, audit the bound, step q' = u over dt, check collisions."""
         admission = self.admit(commands)
-        violations = self._audit(commands, admission.status == CommandStatus.APPLIED)
+        violations = self._audit(commands, admission)
         t_ns, q = self.t_ns, self.q
         self.q = q + self.dt * admission.u
         self.t_ns += self.step_ns
@@ -302,23 +373,11 @@ class PlantModel:
         self._colliding = pairs
         return [(i, j, float(np.linalg.norm(self.q[i] - self.q[j]))) for i, j in new]
 
-    def _audit(self, commands: Commands, applied: NDArray[np.bool_]) -> List[Tuple[int, float]]:
-        """Check each applied command not audited before against c M1; return violations."""
-        fresh = applied & (commands.stamp_ns != self._audited)
-        if not np.any(fresh):
-            return []
+    def _audit(self, commands: Commands, admission: Admission) -> List[Tuple[int, float]]:
+        """Return (robot, largest |u_hat| component) of new commands above c M1 (once each)."""
+        counted = np.isin(admission.status, (CommandStatus.APPLIED, CommandStatus.SATURATED))
+        fresh = counted & (commands.stamp_ns != self._audited)
         self._audited[fresh] = commands.stamp_ns[fresh]
-        largest = np.full(self.num_robots, -np.inf)
-        if self.reference.is_stationary:
-            largest[fresh] = np.max(np.abs(commands.u[fresh]), axis=1)
-        else:
-            for stamp in np.unique(commands.stamp_ns[fresh]):
-                state = self._states.get(int(stamp))
-                if state is None:
-                    continue
-                rows = fresh & (commands.stamp_ns == stamp)
-                frame = self.reference.sample(int(stamp) / NS_PER_S)
-                u_hat = to_frame_velocity(commands.u[rows], state[rows], frame)
-                largest[rows] = np.max(np.abs(u_hat), axis=1)
-        over = np.flatnonzero(largest - self.law.u_bound > self.bound_tolerance)
-        return [(int(i), float(largest[i])) for i in over]
+        over = np.flatnonzero(fresh & (admission.largest_u_hat - self.law.u_bound
+                                       > self.bound_tolerance))
+        return [(int(i), float(admission.largest_u_hat[i])) for i in over]

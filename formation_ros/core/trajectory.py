@@ -5,7 +5,7 @@
 
 from dataclasses import dataclass
 import os
-from typing import Sequence
+from typing import List, Sequence, Tuple
 
 from formation_ros.core.frames import desired_positions, FrameSample, to_frame_velocity
 import numpy as np
@@ -72,3 +72,68 @@ class Trajectory:
             if missing:
                 raise ValueError(f"{path}: missing arrays {', '.join(missing)}")
             return cls(**{name: data[name] for name in ARRAYS})
+
+
+CHUNKS_DIR = 'trajectory_chunks'
+
+
+class ChunkWriter:
+    """
+    Writes samples (t, q, u) to a folder of numbered ``.npz`` files as a run goes.
+
+    A process that keeps its samples only here holds at most one chunk in memory, and a run cut
+    short (even by SIGKILL) loses at most the chunk not yet written: :func:`read_chunks` reads
+    back every complete file. t in s; q, u (N, dim).
+    """
+
+    def __init__(self, folder: str):
+        """Write into ``folder`` (created; files already there are kept and read back)."""
+        self.folder = folder
+        os.makedirs(folder, exist_ok=True)
+        self.count = len(_chunk_files(folder))
+        self._t: List[float] = []
+        self._q: List[NDArray[np.float64]] = []
+        self._u: List[NDArray[np.float64]] = []
+
+    def append(self, t: float, q: ArrayLike, u: ArrayLike) -> None:
+        """Keep one sample until the next :meth:`flush`."""
+        self._t.append(float(t))
+        self._q.append(np.array(q, dtype=float))
+        self._u.append(np.array(u, dtype=float))
+
+    def flush(self) -> None:
+        """Write the samples kept so far as the next chunk (atomically: a rename)."""
+        if not self._t:
+            return
+        path = os.path.join(self.folder, f'{self.count:06d}.npz')
+        partial = path + '.part'
+        with open(partial, 'wb') as stream:
+            np.savez(stream, t=np.array(self._t), q=np.array(self._q), u=np.array(self._u))
+        os.replace(partial, path)
+        self.count += 1
+        self._t, self._q, self._u = [], [], []
+
+
+def _chunk_files(folder: str) -> List[str]:
+    return sorted(name for name in os.listdir(folder) if name.endswith('.npz'))
+
+
+def read_chunks(folder: str) -> Tuple[NDArray[np.float64], NDArray[np.float64],
+                                      NDArray[np.float64]]:
+    """
+    Read back what a :class:`ChunkWriter` wrote: (t (T,), q (T, N, dim), u (T, N, dim)).
+
+    Raises ValueError when the folder holds no readable chunk.
+    """
+    t, q, u = [], [], []
+    for name in _chunk_files(folder):
+        try:
+            with np.load(os.path.join(folder, name)) as data:
+                t.append(data['t'])
+                q.append(data['q'])
+                u.append(data['u'])
+        except (OSError, ValueError, KeyError, EOFError) as exc:
+            raise ValueError(f'{folder}/{name}: cannot read it: {exc}') from None
+    if not t:
+        raise ValueError(f'{folder}: no trajectory chunk')
+    return np.concatenate(t), np.concatenate(q), np.concatenate(u)

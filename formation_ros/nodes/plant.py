@@ -24,16 +24,16 @@ makes a run reproduce ``formation_sim --dt 1/plant.rate``.
 from collections import deque
 import json
 import os
+import shutil
 import time
-from typing import List, Optional, Tuple
+from typing import Any, Dict, List, Optional
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.declarations import Exe
 from formation_ros.core.frames import desired_positions
-from formation_ros.core.metrics import compute_metrics
 from formation_ros.core.plant import (Commands, CommandStatus, NS_PER_S, PLANT_STATS_FILE,
                                       PlantModel, StepReport)
-from formation_ros.core.trajectory import Trajectory
+from formation_ros.core.trajectory import CHUNKS_DIR, ChunkWriter, read_chunks, Trajectory
 from formation_ros.ros import fields, messages, qos, topics
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.markers import formation_markers
@@ -42,7 +42,6 @@ from formation_ros.ros.parameters import declare_parameters
 from formation_ros.ros.runner import LOCKSTEP_POLL, run
 from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
 import numpy as np
-from numpy.typing import NDArray
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock as ClockMsg
@@ -50,8 +49,7 @@ from visualization_msgs.msg import MarkerArray
 
 RESEND_AFTER = 0.05
 PATH_LENGTH = 100
-
-Sample = Tuple[int, NDArray[np.float64], NDArray[np.float64]]
+CHUNK_PERIOD = 1.0
 
 
 class PlantNode(Node):
@@ -69,14 +67,18 @@ class PlantNode(Node):
         self.n, self.dim = config.num_robots, config.dim
         self.model = PlantModel(config.start, config.sensing_radii, settings.step_ns, self.law,
                                 self.reference, settings.input_timeout_ns,
-                                settings.collision_distance)
+                                settings.collision_distance, settings.max_speed)
         self.commands = Commands.empty(self.n, self.dim)
         self.status = np.full(self.n, CommandStatus.MISSING, dtype=np.int8)
         self.lockstep = config.lockstep
         self.publish_every = 1 if self.lockstep else settings.steps_per_publish
         self.once = OnceLog(self.get_logger())
         self.steady = Clock(clock_type=ClockType.STEADY_TIME)
-        self.samples: List[Sample] = []
+        self.chunks = (ChunkWriter(os.path.join(settings.output_dir, CHUNKS_DIR))
+                       if settings.output_dir else None)
+        self.closest = self.model.closest_pair_distance()
+        self.largest_u_hat = 0.0
+        self.command_subs = []
         self.last_publish_wall = 0.0
         self.started_wall: Optional[float] = None
         self.waiting = settings.wait_for_robots or self.lockstep
@@ -89,9 +91,9 @@ class PlantNode(Node):
                 PoseStamped, topics.robot_topic(i, topics.POSE), qos.STATE))
             self.neighbour_pubs.append(self.create_publisher(
                 PoseArray, topics.robot_topic(i, topics.NEIGHBOURS), qos.STATE))
-            self.create_subscription(TwistStamped, topics.robot_topic(i, topics.CMD_VEL),
-                                     lambda msg, index=i - 1: self.on_command(index, msg),
-                                     qos.COMMAND)
+            self.command_subs.append(self.create_subscription(
+                TwistStamped, topics.robot_topic(i, topics.CMD_VEL),
+                lambda msg, index=i - 1: self.on_command(index, msg), qos.COMMAND))
         self.clock_pub = self.create_publisher(ClockMsg, topics.CLOCK, qos.CLOCK)
         self.diagnostics_pub = self.create_publisher(
             DiagnosticArray, topics.DIAGNOSTICS, qos.DIAGNOSTICS)
@@ -100,6 +102,9 @@ class PlantNode(Node):
         self.timer = self.create_timer(period, self.on_timer, clock=self.steady)
         self.diagnostics_timer = self.create_timer(PERIOD, self.on_diagnostics,
                                                    clock=self.steady)
+        if self.chunks is not None:
+            self.chunk_timer = self.create_timer(CHUNK_PERIOD, self.chunks.flush,
+                                                 clock=self.steady)
         if settings.marker_rate > 0.0:
             self.marker_pub = self.create_publisher(MarkerArray, topics.MARKERS, qos.MARKERS)
             self.marker_timer = self.create_timer(1.0 / settings.marker_rate, self.on_markers,
@@ -146,8 +151,12 @@ class PlantNode(Node):
 
     def _step(self) -> None:
         report = self.model.advance(self.commands)
+        self.largest_u_hat = max(self.largest_u_hat,
+                                 float(np.max(report.admission.largest_u_hat)))
         if (self.model.counts.steps - 1) % self.publish_every == 0:
-            self.samples.append((report.t_ns, report.q, report.admission.u))
+            self.closest = min(self.closest, self.model.closest_pair_distance())
+            if self.chunks is not None:
+                self.chunks.append(report.t_ns / NS_PER_S, report.q, report.admission.u)
         self._log(report)
 
     def _log(self, report: StepReport) -> None:
@@ -167,15 +176,26 @@ class PlantNode(Node):
                 f'{self.model.t:.3f} s (< plant.collision_distance)')
 
     def _log_status(self, i: int, status: CommandStatus, t_ns: int) -> None:
+        age = (t_ns - int(self.commands.stamp_ns[i])) / NS_PER_S
         if status is CommandStatus.STALE:
-            age = (t_ns - int(self.commands.stamp_ns[i])) / NS_PER_S
             self.once.start(f'stale-{i}', f'robot {i + 1}: latest command is {age:.3g} s old; '
                                           'using zero')
+        elif status is CommandStatus.FUTURE:
+            self.once.start(f'future-{i}', f'robot {i + 1}: command stamped {-age:.3g} s after '
+                                           'the present state (a sender on another clock? '
+                                           'check use_sim_time); using zero', 'error')
         elif status is CommandStatus.NON_FINITE:
             self.once.start(f'bad-{i}', f'robot {i + 1} sent a non-finite command; using zero '
                                         '(logged once; counted in bad command steps)', 'error')
-        elif status is CommandStatus.APPLIED:
+        elif status is CommandStatus.SATURATED:
+            self.once.start(f'saturated-{i}', f'robot {i + 1}: command beyond what the law '
+                                              'allows; saturating it (counted in saturated '
+                                              'command steps)', 'error')
+        if status in (CommandStatus.APPLIED, CommandStatus.SATURATED):
             self.once.end(f'stale-{i}', f'robot {i + 1}: commands fresh again')
+            self.once.end(f'future-{i}', f'robot {i + 1}: commands answer present states again')
+        if status is CommandStatus.APPLIED:
+            self.once.end(f'saturated-{i}')
 
     def _publish_clock(self) -> None:
         self.clock_pub.publish(ClockMsg(clock=messages.ns_to_stamp(self.model.t_ns)))
@@ -226,9 +246,24 @@ class PlantNode(Node):
                   'min pair distance [m]': self.model.closest_pair_distance(),
                   'bound c*M1 [m/s]': self.law.u_bound}
         values.update({name.replace('_', ' '): count for name, count in counts.totals().items()})
-        if counts.collisions or counts.bound_violations:
+        for status in (CommandStatus.STALE, CommandStatus.FUTURE, CommandStatus.NON_FINITE,
+                       CommandStatus.SATURATED):
+            robots = counts.by_robot(status)
+            if robots:
+                values[f'robots with {status.name.lower().replace("_", "-")} commands'] = \
+                    ', '.join(f'{robot}: {steps}' for robot, steps in robots.items())
+        shared = [i + 1 for i, sub in enumerate(self.command_subs)
+                  if sub.get_publisher_count() > 1]
+        for robot in shared:
+            self.once.start(f'publishers-{robot}', f'robot {robot}: its cmd_vel has more than '
+                                                   'one publisher (a second node with this '
+                                                   'robot_id?)', 'error')
+        if shared:
+            values['cmd_vel with more than one publisher'] = ', '.join(map(str, shared))
+        if counts.collisions or counts.bound_violations or shared:
             level, message = 'error', (f'{counts.collisions} collisions, '
-                                       f'{counts.bound_violations} commands above the bound')
+                                       f'{counts.bound_violations} commands above the bound, '
+                                       f'{len(shared)} cmd_vel topics with several publishers')
         elif self.waiting:
             level, message = 'ok', 'waiting for the robots'
         elif not self.lockstep and rate < 0.9 * target:
@@ -246,47 +281,54 @@ class PlantNode(Node):
             np.array(self.paths), self.model.t_ns))
 
     def trajectory(self) -> Optional[Trajectory]:
-        """Return the run so far as a Trajectory (a sample per published state)."""
-        if not self.samples:
+        """Return the run written so far (``plant.output_dir``): a sample per published state."""
+        if self.chunks is None:
             return None
-        t = np.array([sample[0] for sample in self.samples]) / NS_PER_S
+        self.chunks.flush()
+        try:
+            t, q, u = read_chunks(self.chunks.folder)
+        except ValueError:
+            return None
         frames = [self.reference.sample(time_s) for time_s in t]
-        return Trajectory.from_frames(t, [sample[1] for sample in self.samples],
-                                      [sample[2] for sample in self.samples], frames,
-                                      self.config.vertices)
+        return Trajectory.from_frames(t, q, u, frames, self.config.vertices)
 
     def finish(self) -> None:
         """Log a summary of the run; with ``plant.output_dir`` write trajectory and counters."""
-        trajectory = self.trajectory()
-        if trajectory is None or self.started_wall is None:
+        if self.started_wall is None or self.model.counts.steps == 0:
             self.get_logger().info('plant: stopped before the first step')
             return
         wall = time.monotonic() - self.started_wall
-        counts = self.model.counts.totals()
-        stats = {'integrator': f'plant, zero-order hold, dt = {self.model.dt:g} s'
-                               + (', lockstep' if self.lockstep else ''),
-                 'simulated_time': self.model.t, 'wall_time': wall,
-                 'achieved_step_rate': counts['steps'] / wall if wall > 0 else None}
-        stats.update(counts)
-        metrics = compute_metrics(trajectory.t, trajectory.q, trajectory.u, trajectory.u_hat,
-                                  trajectory.q_desired, self.law.u_bound)
+        counts = self.model.counts
+        totals = counts.totals()
+        desired = desired_positions(self.config.vertices, self.reference.sample(self.model.t))
+        error = float(np.max(np.linalg.norm(self.model.q - desired, axis=1)))
         self.get_logger().info(
-            f"plant: {counts['steps']} steps ({self.model.t:.2f} s simulated in {wall:.1f} s), "
-            f"final max error {metrics['final_max_error']:.3g} m, min pair distance "
-            f"{metrics['min_pair_distance']:.4g} m, max |u_hat| "
-            f"{metrics['max_abs_u_hat_component']:.4g} m/s (bound {self.law.u_bound:.4g}), "
-            f"{counts['collisions']} collisions, {counts['bound_violations']} "
-            f"commands above the bound, {counts['stale_command_steps']} stale commands")
+            f"plant: {totals['steps']} steps ({self.model.t:.2f} s simulated in {wall:.1f} s), "
+            f'final max error {error:.3g} m, min pair distance {self.closest:.4g} m, max '
+            f'|u_hat| {self.largest_u_hat:.4g} m/s (bound {self.law.u_bound:.4g}), '
+            f"{totals['collisions']} collisions, {totals['bound_violations']} commands above "
+            f"the bound, {totals['stale_command_steps']} stale commands")
         output_dir = self.settings.output_dir
-        if output_dir:
-            os.makedirs(output_dir, exist_ok=True)
+        if not output_dir:
+            return
+        stats: Dict[str, Any] = {
+            'integrator': f'plant, zero-order hold, dt = {self.model.dt:g} s'
+                          + (', lockstep' if self.lockstep else ''),
+            'simulated_time': self.model.t, 'wall_time': wall,
+            'achieved_step_rate': totals['steps'] / wall if wall > 0 else None}
+        stats.update(totals)
+        stats['by_robot'] = {status.name.lower(): counts.by_robot(status)
+                             for status in CommandStatus if status is not CommandStatus.APPLIED}
+        with open(os.path.join(output_dir, PLANT_STATS_FILE), 'w', encoding='utf-8') as stream:
+            json.dump(stats, stream, indent=2)
+            stream.write('\n')
+        trajectory = self.trajectory()
+        if trajectory is not None:
             trajectory.save(os.path.join(output_dir, 'trajectory.npz'))
-            with open(os.path.join(output_dir, PLANT_STATS_FILE), 'w',
-                      encoding='utf-8') as stream:
-                json.dump(stats, stream, indent=2)
-                stream.write('\n')
-            self.get_logger().info(f'plant: wrote trajectory.npz and {PLANT_STATS_FILE} to '
-                                   f'{output_dir}')
+            assert self.chunks is not None
+            shutil.rmtree(self.chunks.folder, ignore_errors=True)
+        self.get_logger().info(f'plant: wrote trajectory.npz and {PLANT_STATS_FILE} to '
+                               f'{output_dir}')
 
 
 def main(args: Optional[List[str]] = None) -> int:
