@@ -21,7 +21,7 @@ Kinds (the ``reference.*`` parameters):
 """
 
 import math
-from typing import Optional
+from typing import Optional, Tuple
 
 from formation_ros.core.frames import (frame_2d, frame_frenet_3d, frame_planar_3d, FrameSample,
                                        stationary_frame)
@@ -33,6 +33,7 @@ Z_AXIS = np.array([0.0, 0.0, 1.0])
 Derivatives = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
                     NDArray[np.float64]]
 GERONO_SAMPLES = 4096
+RATE_SAMPLES = 1024
 
 
 def _gerono_loop_length() -> float:
@@ -91,6 +92,23 @@ class Reference:
     def is_stationary(self) -> bool:
         """Tell whether q_od never moves (fixed, or a line with zero velocity)."""
         return self.kind == 'fixed' or (self.kind == 'line' and not np.any(self.velocity))
+
+    def rate_limits(self) -> Tuple[float, float]:
+        """
+        Return the largest speed |q_od'| (m/s) and turn rate |w| (rad/s) the reference reaches.
+
+        Exact for the fixed, line, circle and helix kinds (constant rates); the figure eight's
+        are the largest over RATE_SAMPLES points of one loop (relative error below 1e-4).
+        """
+        if self.kind in ('fixed', 'line'):
+            return float(np.linalg.norm(self.velocity)), 0.0
+        times = np.arange(RATE_SAMPLES) * (2.0 * math.pi / self.rate / RATE_SAMPLES)
+        speed = turn = 0.0
+        for t in times:
+            frame = self.sample(float(t))
+            speed = max(speed, float(np.linalg.norm(frame.qdot_od)))
+            turn = max(turn, float(np.linalg.norm(frame.Jdot)) / math.sqrt(2.0))
+        return speed, turn
 
     def derivatives(self, t: float) -> Derivatives:
         """Return (q_od, q_od', q_od'', q_od''') at time t, each (dim,)."""

@@ -21,6 +21,7 @@ from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.declarations import Exe
 from formation_ros.ros import fields, messages, qos, topics
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
+from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
 from formation_ros.ros.runner import LOCKSTEP_POLL, run
 from nav_msgs.msg import Odometry
@@ -43,6 +44,7 @@ class ReferenceNode(Node):
         self.sim_time = self.get_parameter('use_sim_time').value
         self.epoch_ns = 0 if self.sim_time else self.get_clock().now().nanoseconds
         self.last_stamp: Optional[int] = None
+        self.once = OnceLog(self.get_logger())
         self.pub = self.create_publisher(Odometry, topics.REFERENCE, qos.REFERENCE)
         self.published = 0
         self.diagnostics_pub = self.create_publisher(DiagnosticArray, topics.DIAGNOSTICS,
@@ -76,6 +78,12 @@ class ReferenceNode(Node):
                   'time [s]': ('none yet' if self.last_stamp is None
                                else (self.last_stamp - self.epoch_ns) / fields.NS_PER_S)}
         level, message = ('ok', 'publishing') if self.published else ('warn', 'no sample yet')
+        if not self.sim_time and self.count_publishers(topics.CLOCK) > 0:
+            level, message = 'error', 'on wall-clock time while /clock is published'
+            self.once.start('clock', f'{topics.CLOCK} is published (a plant runs) but this node '
+                                     'runs on wall-clock time: robots refuse its samples, '
+                                     'stamped in another time base; restart it with '
+                                     'use_sim_time:=true', 'error')
         self.diagnostics_pub.publish(diagnostics('formation_ros/reference', level, message,
                                                  values))
 

@@ -17,8 +17,10 @@ how old it is (and, in lockstep, which state it answers).
 """
 
 from collections import deque
-from typing import List, Optional
+import enum
+from typing import Dict, List, Optional, Tuple
 
+from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.declarations import Exe
 from formation_ros.core.frames import advance, FrameSample
@@ -33,9 +35,21 @@ from nav_msgs.msg import Odometry
 import numpy as np
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
+from std_msgs.msg import Header
 
 REFERENCE_BUFFER = 64
+RATE_TOLERANCE = 1e-3
 INPUTS = ('pose', 'neighbour', 'reference')
+
+
+class Reason(enum.Enum):
+    """Why a robot ignores a message it heard."""
+
+    NON_FINITE = 'non-finite values'
+    FRAME = f"a frame other than '{messages.WORLD_FRAME}'"
+    CLOCK = 'stamps from another clock'
+    TOO_MANY = 'more neighbours than there are robots'
+    TOO_FAST = 'a speed or turn rate its reference kind cannot have'
 
 
 class RobotNode(Node):
@@ -54,6 +68,9 @@ class RobotNode(Node):
         self.law = config.law()
         self.lockstep = config.lockstep
         self.timeout_ns = int(settings.input_timeout * fields.NS_PER_S)
+        self.num_robots = config.num_robots
+        self.speed_limit, self.turn_limit = config.reference().rate_limits()
+        self.sim_time = bool(self.get_parameter('use_sim_time').value)
         self.once = OnceLog(self.get_logger())
         self.steady = Clock(clock_type=ClockType.STEADY_TIME)
 
@@ -63,7 +80,7 @@ class RobotNode(Node):
         self.received_ns = dict.fromkeys(INPUTS)
         self.pose_count = 0
         self.answered_count = 0
-        self.rejected = dict.fromkeys(INPUTS, 0)
+        self.rejected: Dict[Tuple[str, Reason], int] = {}
         self.last: Optional[Command] = None
         self.waiting = True
         self.wait_subscribers = settings.wait_for_subscribers
@@ -87,35 +104,74 @@ class RobotNode(Node):
     def _now_ns(self) -> int:
         return self.steady.now().nanoseconds
 
-    def _accept(self, name: str, finite: bool) -> bool:
-        if finite:
-            return True
-        self.rejected[name] += 1
-        self.once.start(f'bad-{name}', f'ignoring {name} messages with non-finite values '
-                                       '(logged once; diagnostics count them)', 'error')
+    def _reject(self, name: str, reason: Reason, detail: str = '') -> bool:
+        """Count and (once per input and reason) log a message ignored; return False."""
+        key = (name, reason)
+        self.rejected[key] = self.rejected.get(key, 0) + 1
+        self.once.start(f'{name}-{reason.name}', f'ignoring {name} messages with '
+                                                 f'{reason.value}{detail} (logged once; '
+                                                 'diagnostics count them)', 'error')
         return False
+
+    def _clock_gap_s(self, stamp: Time) -> float:
+        """Return how far a stamp is from this node's clock, s (0 before sim time has come)."""
+        now = self.get_clock().now().nanoseconds
+        if self.sim_time and now == 0:
+            return 0.0
+        return (fields.stamp_to_ns(stamp) - now) / fields.NS_PER_S
+
+    def _check(self, name: str, header: Header, values: List[float]) -> bool:
+        """Accept a state message only in the world frame, finite, stamped on this clock."""
+        if header.frame_id != messages.WORLD_FRAME:
+            return self._reject(name, Reason.FRAME, f' (got {header.frame_id!r})')
+        if not np.all(np.isfinite(values)):
+            return self._reject(name, Reason.NON_FINITE)
+        gap = self._clock_gap_s(header.stamp)
+        if abs(gap) * fields.NS_PER_S > self.timeout_ns:
+            clock = 'simulated' if self.sim_time else 'wall-clock'
+            return self._reject(name, Reason.CLOCK, f' ({gap:+.3g} s from the {clock} time '
+                                                    'of this node: start the robots and the '
+                                                    'reference with use_sim_time:=true)')
+        self.once.end(f'{name}-{Reason.CLOCK.name}', f'{name} messages on this clock again')
+        return True
 
     def on_pose(self, msg: PoseStamped) -> None:
         """Store the latest own pose."""
         p = msg.pose.position
-        if self._accept('pose', np.all(np.isfinite([p.x, p.y, p.z]))):
+        if self._check('pose', msg.header, [p.x, p.y, p.z]):
             self.pose = msg
             self.pose_count += 1
             self.received_ns['pose'] = self._now_ns()
 
     def on_neighbours(self, msg: PoseArray) -> None:
         """Store the latest sensed neighbour positions."""
-        finite = all(np.isfinite([p.position.x, p.position.y, p.position.z]).all()
-                     for p in msg.poses)
-        if self._accept('neighbour', finite):
+        if len(msg.poses) > self.num_robots - 1:
+            self._reject('neighbour', Reason.TOO_MANY, f' ({len(msg.poses)})')
+            return
+        values = [v for p in msg.poses for v in (p.position.x, p.position.y, p.position.z)]
+        if self._check('neighbour', msg.header, values):
             self.neighbours = msg
             self.received_ns['neighbour'] = self._now_ns()
 
     def on_reference(self, msg: Odometry) -> None:
         """Store a reference sample (a few are kept to match state stamps in lockstep)."""
-        if self._accept('reference', fields.odometry_is_finite(msg)):
+        if msg.header.frame_id != messages.WORLD_FRAME:
+            self._reject('reference', Reason.FRAME, f' (got {msg.header.frame_id!r})')
+        elif not fields.odometry_is_finite(msg):
+            self._reject('reference', Reason.NON_FINITE)
+        elif not self._plausible(msg):
+            self._reject('reference', Reason.TOO_FAST)
+        else:
             self.references.append(msg)
             self.received_ns['reference'] = self._now_ns()
+
+    def _plausible(self, msg: Odometry) -> bool:
+        """Whether a reference sample's speed and turn rate fit the configured reference."""
+        twist = msg.twist.twist
+        speed = float(np.linalg.norm([twist.linear.x, twist.linear.y, twist.linear.z]))
+        turn = float(np.linalg.norm([twist.angular.x, twist.angular.y, twist.angular.z]))
+        return (speed <= self.speed_limit * (1.0 + RATE_TOLERANCE) + RATE_TOLERANCE
+                and turn <= self.turn_limit * (1.0 + RATE_TOLERANCE) + RATE_TOLERANCE)
 
     def _reference_for(self, stamp_ns: int, exact: bool) -> Optional[FrameSample]:
         """Return the reference frame at ``stamp_ns``: that sample, else the newest carried on."""
@@ -125,7 +181,13 @@ class RobotNode(Node):
         if exact or not self.references:
             return None
         newest = fields.frame_of(self.references[-1], self.dim)
-        return advance(newest, stamp_ns / fields.NS_PER_S - newest.t)
+        ahead = stamp_ns / fields.NS_PER_S - newest.t
+        if abs(ahead) * fields.NS_PER_S > self.timeout_ns:
+            self._reject('reference', Reason.CLOCK, f' ({-ahead:+.3g} s from the state: start '
+                                                    'the reference with use_sim_time:=true)')
+            return None
+        self.once.end(f'reference-{Reason.CLOCK.name}', 'reference on the clock of the states')
+        return advance(newest, ahead)
 
     def _command(self, stamp_ns: int, exact: bool) -> Optional[np.ndarray]:
         frame = self._reference_for(stamp_ns, exact)
@@ -155,8 +217,9 @@ class RobotNode(Node):
             return
         self.once.end('stale', 'inputs fresh again: controlling')
         stamp = fields.stamp_to_ns(self.pose.header.stamp)
-        self.cmd_pub.publish(messages.twist_stamped(self._command(stamp, False), stamp,
-                                                    self.dim))
+        command = self._command(stamp, False)
+        self.cmd_pub.publish(messages.twist_stamped(
+            np.zeros(self.dim) if command is None else command, stamp, self.dim))
 
     def _ready(self) -> bool:
         """Start-up: every input heard once and cmd_vel has its subscribers (plant, recorder)."""
@@ -202,8 +265,8 @@ class RobotNode(Node):
             values['max |u| component [m/s]'] = float(np.max(np.abs(self.last.u)))
             values['max |u_hat| component [m/s]'] = float(np.max(np.abs(self.last.u_hat)))
         values['bound c*M1 [m/s]'] = self.law.u_bound
-        values.update({f'rejected {name} messages': count
-                       for name, count in self.rejected.items()})
+        values.update({f'rejected {name} messages ({reason.value})': count
+                       for (name, reason), count in self.rejected.items()})
         if self.waiting:
             level, message = 'warn', 'waiting for its first inputs'
         elif self.once.is_active('stale'):

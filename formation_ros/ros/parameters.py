@@ -11,12 +11,14 @@ and range. Optional parameters without a value (``start.positions`` when the sta
 and ``ros2 param get`` answer for every declared parameter.
 """
 
+import re
 import sys
 from typing import Any, Dict, Optional
 
 from formation_ros.core.declarations import (Bound, did_you_mean, Exe, is_known, Kind, Param,
                                              ParamError, used_by)
 from formation_ros.core.params import FormationConfig, validate
+from formation_ros.ros.topics import robot_namespace
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 from rclpy.node import Node
@@ -85,6 +87,30 @@ def _warn_unknown(node: Node) -> None:
             node.get_logger().warning(f"ignoring unknown parameter '{name}'{did_you_mean(name)}")
 
 
+def robot_id_of_namespace(namespace: str) -> Optional[int]:
+    """Return i for a namespace ``/robot_<i>`` (i >= 1), else None."""
+    match = re.fullmatch(r'/robot_([1-9][0-9]*)', namespace)
+    return int(match.group(1)) if match else None
+
+
+def _robot_identity(namespace: str, given: Dict[str, Any]) -> None:
+    """``robot_id`` must agree with the namespace ``/robot_<id>``, or is taken from it."""
+    implied = robot_id_of_namespace(namespace)
+    stated = given.get('robot_id')
+    if stated is None and implied is not None:
+        given['robot_id'] = implied
+    elif stated is not None and implied is not None and stated != implied:
+        raise ParamError([('robot_id', f'is {stated} but the node runs in namespace '
+                                       f'{namespace}: robot {stated} belongs in '
+                                       f'{robot_namespace(stated)} (or leave robot_id out)')])
+    elif stated is not None and implied is None:
+        raise ParamError([('robot_id', f'is {stated} but the node runs in namespace '
+                                       f"'{namespace}': start it in "
+                                       f'{robot_namespace(stated)} (-r __ns:='
+                                       f'{robot_namespace(stated)}), where the plant talks '
+                                       'to it')])
+
+
 def declare_parameters(node: Node, exe: Exe) -> FormationConfig:
     """
     Declare and validate the parameters of ``exe`` on ``node``; return its configuration.
@@ -94,7 +120,10 @@ def declare_parameters(node: Node, exe: Exe) -> FormationConfig:
     warning with the closest known name (it may be meant for another tool).
     """
     _warn_unknown(node)
-    config = validate(_given(node, exe), exe)
+    given = _given(node, exe)
+    if exe is Exe.ROBOT:
+        _robot_identity(node.get_namespace(), given)
+    config = validate(given, exe)
     effective = dict(config.values)
     for name in DEFAULT_ZERO_VECTORS:
         effective.setdefault(name, [0.0] * config.dim)
