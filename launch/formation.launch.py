@@ -47,8 +47,8 @@ def formation_nodes(context):
                       {'plant.wait_for_subscribers': 2} if record else {},
                       {'plant.output_dir': output_dir} if output_dir else {}))
     nodes.append(node('reference', {'use_sim_time': True}))
-    nodes += [node('robot', {'robot_id': i, 'wait_for_subscribers': subscribers},
-                   namespace=f'robot_{i}')
+    nodes += [node('robot', {'robot_id': i, 'wait_for_subscribers': subscribers,
+                             'use_sim_time': True}, namespace=f'robot_{i}')
               for i in range(1, num_robots + 1)]
     return nodes
 

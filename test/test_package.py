@@ -236,7 +236,7 @@ def test_launch_file_starts_the_system_of_the_shell_launcher(launch_file, setup_
         assert isinstance(node.kwargs['on_exit'], Shutdown), f'{executable} exits alone'
         params_file, overrides = node_parameters(node)
         assert params_file == params
-        assert overrides.pop('use_sim_time', False) == (executable == 'reference')
+        assert overrides.pop('use_sim_time', False) == (executable in ('reference', 'robot'))
         for name in overrides:
             assert name in schema, f'{executable}: {name} is not a parameter of the schema'
             assert Exe(executable) in schema[name].users, f'{executable} does not read {name}'

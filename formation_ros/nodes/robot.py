@@ -204,11 +204,11 @@ class RobotNode(Node):
         if self.lockstep:
             self._lockstep_answer()
             return
+        if self.waiting and not self._ready():
+            return
         now = self._now_ns()
         stale = [name for name in INPUTS if self.received_ns[name] is None
                  or now - self.received_ns[name] > self.timeout_ns]
-        if self.waiting and not self._ready():
-            return
         if stale:
             stamp = fields.stamp_to_ns(self.pose.header.stamp)
             self.cmd_pub.publish(messages.twist_stamped(np.zeros(self.dim), stamp, self.dim))
