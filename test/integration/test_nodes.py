@@ -21,7 +21,7 @@ STAMP_NS = 123_450_000_000
 def test_robot_publishes_the_core_command_and_survives_bad_poses(processes, install, probe):
     config = load_config(SQUARE)
     processes.start(node(install, 'robot', SQUARE, '-r', '__ns:=/robot_1', '-p', 'robot_id:=1',
-                         process='robot_1'))
+                         '-p', 'use_sim_time:=true', process='robot_1'))
     own = np.array([0.2, -0.1])
     neighbours = np.array([[0.6, 0.2], [3.5, 0.0], [0.2, -0.8]])
     pose_pub = probe.create_publisher(PoseStamped, '/robot_1/pose', qos.STATE)
