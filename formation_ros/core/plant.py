@@ -131,6 +131,8 @@ class PlantCounts:
     steps: int = 0
     collisions: int = 0
     bound_violations: int = 0
+    oldest_counted_ns: int = 0
+    """Age of the oldest command that counted for a step (how late commands arrive), ns."""
     status_steps: NDArray[np.int64] = field(default_factory=lambda: np.zeros((4, 0), np.int64))
 
     def steps_with(self, status: CommandStatus) -> int:
@@ -346,6 +348,10 @@ class PlantModel:
         counts.steps += 1
         np.add.at(counts.status_steps, (admission.status, np.arange(self.num_robots)), 1)
         counts.bound_violations += len(violations)
+        counted = np.isin(admission.status, (CommandStatus.APPLIED, CommandStatus.SATURATED))
+        if np.any(counted):
+            counts.oldest_counted_ns = max(counts.oldest_counted_ns,
+                                           int(np.max(t_ns - commands.stamp_ns[counted])))
         collisions = self._new_collisions()
         counts.collisions += len(collisions)
         return StepReport(t_ns, q, admission, violations, collisions)

@@ -244,7 +244,8 @@ class PlantNode(Node):
                   'step rate achieved [Hz]': rate,
                   'step rate target [Hz]': 'lockstep' if self.lockstep else target,
                   'min pair distance [m]': self.model.closest_pair_distance(),
-                  'bound c*M1 [m/s]': self.law.u_bound}
+                  'bound c*M1 [m/s]': self.law.u_bound,
+                  'oldest command counted [s]': counts.oldest_counted_ns / NS_PER_S}
         values.update({name.replace('_', ' '): count for name, count in counts.totals().items()})
         for status in (CommandStatus.STALE, CommandStatus.FUTURE, CommandStatus.NON_FINITE,
                        CommandStatus.SATURATED):
@@ -317,6 +318,7 @@ class PlantNode(Node):
             'simulated_time': self.model.t, 'wall_time': wall,
             'achieved_step_rate': totals['steps'] / wall if wall > 0 else None}
         stats.update(totals)
+        stats['oldest_command_counted'] = counts.oldest_counted_ns / NS_PER_S
         stats['by_robot'] = {status.name.lower(): counts.by_robot(status)
                              for status in CommandStatus if status is not CommandStatus.APPLIED}
         with open(os.path.join(output_dir, PLANT_STATS_FILE), 'w', encoding='utf-8') as stream:
