@@ -489,10 +489,11 @@ def test_known_law_failures(name, request):
     team_nan_position: the k-d tree raises ValueError for a NaN position instead of giving NaN.
     huge_gain: c = 1.5e308 (a valid controller.gain) makes c M1 and the command infinite.
     smooth_small_repulsion_radius: with g = exp(-1/y) and b = 1e-4 m, h'/h is NaN for a
-    neighbour beyond b / sqrt(2) (the scaled integrals underflow). smooth_large_repulsion_radius:
-    b = 1e12 m makes ``SmoothJump._k_scaled`` divide by a product that underflows to zero
-    (ZeroDivisionError) on every call. team_far_apart: robots 1.35e154 m apart overflow the squared distances in the k-d tree's
-    ``query_pairs``, which raises ValueError (``robot_command`` has no k-d tree).
+    neighbour beyond b / sqrt(2) (the scaled integrals underflow).
+    smooth_large_repulsion_radius: b = 1e12 m makes ``SmoothJump._k_scaled`` divide by a
+    product that underflows to zero (ZeroDivisionError) on every call. team_far_apart: robots
+    1.35e154 m apart overflow the squared distances in the k-d tree's ``query_pairs``, which
+    raises ValueError (``robot_command`` has no k-d tree).
     """
     call, error = KNOWN_LAW[name]
     request.applymarker(pytest.mark.xfail(strict=True, raises=error))
