@@ -26,7 +26,7 @@ def soak():
 
 @pytest.fixture
 def fake_install(tmp_path):
-    """Make an install prefix whose node executables are Python scripts reading stdin to its end."""
+    """Make an install prefix whose node executables are Python scripts that read stdin."""
     prefix = tmp_path / 'install' / 'formation_ros'
     lib = prefix / 'lib' / 'formation_ros'
     lib.mkdir(parents=True)
