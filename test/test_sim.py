@@ -126,3 +126,105 @@ def test_cli_bad_option_and_help():
     assert run_cli(SECTION5, '--out', '/tmp/x', '--dt', '-1').returncode == 2
     result = run_cli('--help')
     assert result.returncode == 0 and '--dt' in result.stdout and 'RK45' in result.stdout
+    assert '--overwrite' in result.stdout and '10,000,000' in result.stdout
+
+
+def refusal(result):
+    """Return the one line of a refused run, after checking how it was refused."""
+    assert result.returncode == 2, result.stderr
+    assert 'Traceback' not in result.stderr
+    assert result.stdout == ''
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1, result.stderr
+    assert lines[0].startswith('formation_sim: ')
+    return lines[0]
+
+
+def test_cli_refuses_a_non_empty_out_directory(tmp_path):
+    out = tmp_path / 'run'
+    out.mkdir()
+    (out / 'notes.txt').write_text('mine')
+    line = refusal(run_cli(SECTION5, '--out', str(out), '--dt', '0.01', '--duration', '0.5'))
+    assert 'not empty' in line and '--overwrite' in line
+    assert [p.name for p in out.iterdir()] == ['notes.txt']
+
+
+def test_cli_overwrite_writes_into_a_non_empty_directory(tmp_path):
+    out = tmp_path / 'run'
+    out.mkdir()
+    (out / 'notes.txt').write_text('mine')
+    options = ('--out', str(out), '--dt', '0.01', '--duration', '0.5', '--no-plots',
+               '--overwrite')
+    first = run_cli(SECTION5, *options)
+    assert first.returncode == 0, first.stderr
+    assert Trajectory.load(str(out / 'trajectory.npz')).t[-1] == pytest.approx(0.5)
+    assert (out / 'notes.txt').read_text() == 'mine'
+    again = run_cli(str(out / 'params.yaml'), *options[:-2], '--duration', '0.25',
+                    '--overwrite')
+    assert again.returncode == 0, again.stderr
+    assert Trajectory.load(str(out / 'trajectory.npz')).t[-1] == pytest.approx(0.25)
+    assert (out / 'params.yaml').read_text() == open(SECTION5).read()
+
+
+def test_cli_refuses_an_out_path_with_a_file_in_the_way(tmp_path):
+    blocker = tmp_path / 'file'
+    blocker.write_text('in the way')
+    line = refusal(run_cli(SECTION5, '--out', str(blocker), '--duration', '0.5'))
+    assert 'not a directory' in line and str(blocker) in line
+    line = refusal(run_cli(SECTION5, '--out', str(blocker / 'run'), '--duration', '0.5'))
+    assert 'cannot write' in line
+    assert blocker.read_text() == 'in the way'
+    assert [p.name for p in tmp_path.iterdir()] == ['file']
+
+
+def test_cli_refuses_an_output_name_that_is_a_directory(tmp_path):
+    out = tmp_path / 'run'
+    (out / 'metrics.json').mkdir(parents=True)
+    line = refusal(run_cli(SECTION5, '--out', str(out), '--duration', '0.5', '--overwrite'))
+    assert 'metrics.json' in line
+    assert [p.name for p in out.iterdir()] == ['metrics.json']
+
+
+@pytest.mark.skipif(not os.path.isdir('/sys'), reason='needs /sys (Linux)')
+def test_cli_finds_an_unwritable_out_before_simulating():
+    out = '/sys/formation_sim_test_out'
+    line = refusal(run_cli(SECTION5, '--out', out, '--duration', '100'))
+    assert 'cannot write' in line and out in line
+    assert not os.path.exists(out)
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason='root writes into read-only directories')
+def test_cli_refuses_a_read_only_out_directory(tmp_path):
+    out = tmp_path / 'read_only'
+    out.mkdir()
+    out.chmod(0o500)
+    try:
+        line = refusal(run_cli(SECTION5, '--out', str(out), '--duration', '100'))
+    finally:
+        out.chmod(0o700)
+    assert 'cannot write' in line
+    assert list(out.iterdir()) == []
+
+
+@pytest.mark.parametrize('options,words', [
+    (('--duration', '10', '--dt', '15'), ('--dt 15 s', 'longer than the run (10 s)')),
+    (('--duration', '10', '--dt', '1e-9'), ('--dt 1e-09 s', '1e+10 steps', '10,000,000')),
+    (('--duration', '10', '--sample-dt', '30'), ('--sample-dt 30 s', 'longer than the run')),
+    (('--duration', '10', '--sample-dt', '1e-9'), ('--sample-dt 1e-09 s', '1e+10 samples')),
+    (('--duration', '1e6'), ('(the default)', '1e+08 samples')),
+    (('--duration', '10', '--dt', '0.01', '--sample-dt', '11'), ('--sample-dt 11 s',)),
+])
+def test_cli_refuses_impossible_run_lengths(tmp_path, options, words):
+    out = tmp_path / 'never'
+    line = refusal(run_cli(SECTION5, '--out', str(out), *options))
+    for word in words:
+        assert word in line
+    assert not out.exists()
+
+
+def test_cli_accepts_a_step_equal_to_the_duration(tmp_path):
+    out = tmp_path / 'run'
+    result = run_cli(SECTION5, '--out', str(out), '--duration', '0.5', '--dt', '0.5',
+                     '--sample-dt', '0.5', '--no-plots')
+    assert result.returncode == 0, result.stderr
+    assert Trajectory.load(str(out / 'trajectory.npz')).t.tolist() == [0.0, 0.5]

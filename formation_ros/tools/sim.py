@@ -15,8 +15,9 @@ import math
 import os
 import shutil
 import sys
+import tempfile
 import time
-from typing import Optional, TextIO
+from typing import Optional, Sequence, TextIO, Tuple
 
 from formation_ros.core.declarations import DEFAULT_COLLISION_DISTANCE, Exe, ParamError
 from formation_ros.core.frames import desired_positions
@@ -33,6 +34,10 @@ from scipy.integrate import solve_ivp
 RTOL = 1e-8
 ATOL = 1e-10
 DEFAULT_SAMPLE_DT = 0.01
+MAX_STEPS = 10_000_000
+TRAJECTORY_FILE = 'trajectory.npz'
+METRICS_FILE = 'metrics.json'
+PARAMS_COPY = 'params.yaml'
 
 
 class Progress:
@@ -192,20 +197,97 @@ def build_parser() -> argparse.ArgumentParser:
                     'write trajectory.npz, metrics.json and figures.',
         epilog='Example: formation_sim config/paper_section5.yaml --out /tmp/section5')
     parser.add_argument('params', help='ROS 2 parameters YAML file (/**: ros__parameters: ...)')
-    parser.add_argument('--out', help='output directory (created if missing); required unless '
-                                      '--check')
+    parser.add_argument('--out', help='output directory (created if missing; must be empty '
+                                      'unless --overwrite); required unless --check')
+    parser.add_argument('--overwrite', action='store_true',
+                        help='write into a non-empty --out directory, replacing the files '
+                             'formation_sim writes there and leaving the others')
     parser.add_argument('--check', action='store_true',
                         help='only validate the parameters as the simulator and every node '
                              'read them, say so and exit (0 valid, 2 not)')
     parser.add_argument('--duration', type=float, help='simulated seconds (default: duration '
                                                        'in the parameters file)')
-    parser.add_argument('--dt', type=float, help='fixed step with zero-order hold, s (default: '
+    parser.add_argument('--dt', type=float, help='fixed step with zero-order hold, s, at most '
+                                                 'the duration and at most '
+                                                 f'{MAX_STEPS:,} steps per run (default: '
                                                  'adaptive RK45 at rtol 1e-8)')
-    parser.add_argument('--sample-dt', type=float, default=DEFAULT_SAMPLE_DT,
-                        help='spacing of saved samples, s (default %(default)s)')
+    parser.add_argument('--sample-dt', type=float,
+                        help='spacing of saved samples, s, at most the duration and at most '
+                             f'{MAX_STEPS:,} samples per run (default {DEFAULT_SAMPLE_DT:g})')
     parser.add_argument('--no-plots', action='store_true', help='skip the figures')
     parser.add_argument('--quiet', action='store_true', help='print no progress')
     return parser
+
+
+def run_length_problem(duration: float, dt: Optional[float],
+                       sample_dt: Optional[float]) -> Optional[str]:
+    """
+    Say what is wrong with ``--dt`` and ``--sample-dt`` for a run of ``duration`` s, or None.
+
+    Either step must not exceed the duration, a run has at most :data:`MAX_STEPS` fixed steps,
+    and an RK45 run at most as many samples. ``sample_dt`` None is the default spacing.
+    """
+    if dt is not None:
+        if dt > duration:
+            return f'--dt {dt:g} s is longer than the run ({duration:g} s); give at most that'
+        if duration / dt > MAX_STEPS:
+            return (f'--dt {dt:g} s makes {duration / dt:.3g} steps of a {duration:g} s run, '
+                    f'more than {MAX_STEPS:,}; choose a larger --dt or a shorter --duration')
+    if sample_dt is not None and sample_dt > duration:
+        return (f'--sample-dt {sample_dt:g} s is longer than the run ({duration:g} s); give at '
+                'most that')
+    spacing = DEFAULT_SAMPLE_DT if sample_dt is None else sample_dt
+    if dt is None and duration / spacing > MAX_STEPS:
+        given = '' if sample_dt is not None else ' (the default)'
+        return (f'--sample-dt {spacing:g} s{given} makes {duration / spacing:.3g} samples of a '
+                f'{duration:g} s run, more than {MAX_STEPS:,}; choose a larger --sample-dt or a '
+                'shorter --duration')
+    return None
+
+
+def prepare_out(path: str, overwrite: bool, names: Sequence[str]) -> Optional[str]:
+    """
+    Make sure the results can be written to directory ``path``; return a problem or None.
+
+    Creates ``path`` (and its parents) if missing and writes and removes a temporary file in
+    it. An existing directory must be empty unless ``overwrite``; then each of ``names`` (the
+    files of a run) already there must be a file that can be replaced. Nothing is created when
+    a problem is found before the directory exists.
+    """
+    if os.path.lexists(path) and not os.path.isdir(path):
+        return f"--out '{path}' is a file, not a directory"
+    try:
+        if os.path.isdir(path):
+            entries = set(os.listdir(path))
+            if entries and not overwrite:
+                return (f"--out directory '{path}' is not empty; pass --overwrite to write "
+                        'into it anyway, or choose a new one')
+            for name in sorted(entries.intersection(names)):
+                if not os.path.isfile(os.path.join(path, name)):
+                    return f"--out '{path}' holds '{name}', which is not a file it can replace"
+        os.makedirs(path, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError as exc:
+        return f"cannot write into --out '{path}': {exc.strerror or exc}"
+    return None
+
+
+def output_names(plots_wanted: bool) -> Tuple[str, ...]:
+    """Return the names of the files a run writes into its output directory."""
+    names: Tuple[str, ...] = (TRAJECTORY_FILE, METRICS_FILE, PARAMS_COPY)
+    if plots_wanted:
+        from formation_ros.tools.plots import FIGURES
+        names += tuple(FIGURES)
+    return names
+
+
+def _copy_params(source: str, out_dir: str) -> None:
+    """Copy the parameters file into the run directory (nothing to do if it is already there)."""
+    target = os.path.join(out_dir, PARAMS_COPY)
+    if os.path.exists(target) and os.path.samefile(source, target):
+        return
+    shutil.copyfile(source, target)
 
 
 def main(argv: Optional[list] = None) -> int:
@@ -231,15 +313,20 @@ def main(argv: Optional[list] = None) -> int:
               'formation_sim, plant, reference and robot')
         return 0
     duration = config.duration if args.duration is None else args.duration
-    os.makedirs(args.out, exist_ok=True)
+    problem = (run_length_problem(duration, args.dt, args.sample_dt)
+               or prepare_out(args.out, args.overwrite, output_names(not args.no_plots)))
+    if problem:
+        print(f'formation_sim: {problem}', file=sys.stderr)
+        return 2
+    sample_dt = DEFAULT_SAMPLE_DT if args.sample_dt is None else args.sample_dt
     integrator = 'RK45' if args.dt is None else f'zero-order hold, dt = {args.dt:g} s'
     progress = Progress(duration, quiet=args.quiet)
-    trajectory = simulate(config, duration, args.dt, args.sample_dt, progress)
+    trajectory = simulate(config, duration, args.dt, sample_dt, progress)
     metrics = run_metrics(trajectory, config, integrator)
     metrics['wall_time'] = progress.elapsed
-    trajectory.save(os.path.join(args.out, 'trajectory.npz'))
-    shutil.copyfile(args.params, os.path.join(args.out, 'params.yaml'))
-    with open(os.path.join(args.out, 'metrics.json'), 'w', encoding='utf-8') as stream:
+    trajectory.save(os.path.join(args.out, TRAJECTORY_FILE))
+    _copy_params(args.params, args.out)
+    with open(os.path.join(args.out, METRICS_FILE), 'w', encoding='utf-8') as stream:
         json.dump(metrics, stream, indent=2)
         stream.write('\n')
     if not args.no_plots:

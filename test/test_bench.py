@@ -1,0 +1,141 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""The soak benchmark's command line, process discovery, summary and JSON (no long run)."""
+
+import importlib.util
+import json
+import os
+import subprocess
+import sys
+import time
+
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SOAK = os.path.join(ROOT, 'bench', 'bench_soak.py')
+
+
+@pytest.fixture(scope='module')
+def soak():
+    spec = importlib.util.spec_from_file_location('bench_soak', SOAK)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture
+def fake_install(tmp_path):
+    """Make an install prefix whose node executables are Python scripts that read stdin."""
+    prefix = tmp_path / 'install' / 'formation_ros'
+    lib = prefix / 'lib' / 'formation_ros'
+    lib.mkdir(parents=True)
+    for name in ('plant', 'robot', 'formation_report'):
+        path = lib / name
+        path.write_text('import sys\nsys.stdin.read()\n')
+        path.chmod(0o755)
+    return prefix
+
+
+def test_help_runs_without_an_install():
+    result = subprocess.run([sys.executable, SOAK, '--help'], capture_output=True, text=True,
+                            timeout=120)
+    assert result.returncode == 0, result.stderr
+    for option in ('--duration', '--interval', '--prefix', '--json', 'VmRSS'):
+        assert option in result.stdout
+
+
+def test_arguments_defaults_and_quick_check(soak, fake_install, tmp_path):
+    args = soak.parse_args(['--prefix', str(fake_install), '--out', str(tmp_path / 'soak')])
+    assert args.duration == 1800.0 and args.interval == 5.0
+    assert args.json == os.path.join(str(tmp_path / 'soak'), 'soak.json')
+    quick = soak.parse_args(['--duration', '60', '--prefix', str(fake_install), '--out',
+                             str(tmp_path / 'quick'), '--json', str(tmp_path / 'q.json')])
+    assert quick.duration == 60.0 and quick.json == str(tmp_path / 'q.json')
+    assert not (tmp_path / 'soak').exists()
+
+
+@pytest.mark.parametrize('options', [
+    ['--duration', '0'], ['--interval', '-1'], ['--prefix', '/nonexistent/install'],
+])
+def test_bad_arguments_exit_2(soak, fake_install, tmp_path, options):
+    argv = ['--prefix', str(fake_install), '--out', str(tmp_path / 'soak'), *options]
+    with pytest.raises(SystemExit) as info:
+        soak.parse_args(argv)
+    assert info.value.code == 2
+
+
+def test_existing_out_directory_is_refused(soak, fake_install, tmp_path):
+    with pytest.raises(SystemExit) as info:
+        soak.parse_args(['--prefix', str(fake_install), '--out', str(tmp_path)])
+    assert info.value.code == 2
+
+
+def test_node_names_from_command_lines(soak):
+    prefix = '/opt/x/formation_ros'
+    exe = prefix + '/lib/formation_ros/'
+    assert soak.node_name(['python3', exe + 'plant', '--ros-args'], prefix) == 'plant'
+    assert soak.node_name(['python3', exe + 'robot', '--ros-args', '-r', '__ns:=/robot_7',
+                           '-p', 'robot_id:=7'], prefix) == 'robot_7'
+    assert soak.node_name(['python3', exe + 'record'], prefix) == 'record'
+    assert soak.node_name(['python3', exe + 'formation_report', 'bag'], prefix) is None
+    assert soak.node_name(['python3', '/other/lib/formation_ros/plant'], prefix) is None
+
+
+def test_finds_the_nodes_a_process_started_and_reads_their_memory(soak, fake_install):
+    exe = fake_install / 'lib' / 'formation_ros'
+    children = [subprocess.Popen([sys.executable, str(exe / 'robot'), '--ros-args', '-p',
+                                  'robot_id:=3'], stdin=subprocess.PIPE),
+                subprocess.Popen([sys.executable, str(exe / 'plant')], stdin=subprocess.PIPE),
+                subprocess.Popen([sys.executable, str(exe / 'formation_report')],
+                                 stdin=subprocess.PIPE)]
+    try:
+        found = soak.find_run_processes(os.getpid(), str(fake_install))
+        assert found == {'robot_3': children[0].pid, 'plant': children[1].pid}
+        assert soak.find_run_processes(children[2].pid, str(fake_install)) == {}
+        assert soak.read_rss_kib(children[0].pid) > 1000
+    finally:
+        for child in children:
+            child.stdin.close()
+            child.wait(timeout=30)
+    assert soak.read_rss_kib(children[0].pid) is None
+
+
+def test_summary_compares_first_and_last_window(soak):
+    samples = {
+        'launcher': [(float(t), 1000) for t in range(0, 200, 5)],
+        'plant': [(float(t), 2000 + 10 * t) for t in range(5, 200, 5)],
+        'robot_1': [(float(t), 3000) for t in range(5, 180, 5)],
+    }
+    table = soak.summarise(samples, 60.0)
+    assert table['launcher']['growth_percent'] == 0.0
+    assert table['plant']['first_kib'] == 2000 + 10 * 35
+    assert table['plant']['last_kib'] == 2000 + 10 * 145
+    assert table['plant']['growth_percent'] == pytest.approx(100.0 * 1100 / 2350)
+    assert table['robot_1']['growth_percent'] == 0.0
+    ramp = {'launcher': [(0.0, 10)] + samples['launcher'][1:], 'plant': samples['plant']}
+    assert soak.summarise(ramp, 5.0)['launcher']['first_kib'] == 1000
+    text = soak.format_table(table, 60.0)
+    assert text.splitlines()[2].startswith('| launcher |')
+    assert '| plant | 2.3 | 3.4 | +46.81 |' in text
+
+
+def test_json_and_figure_are_written(soak, tmp_path):
+    samples = {'plant': [(0.0, 2048), (5.0, 2048)], 'robot_2': [(5.0, 4096)]}
+    path = tmp_path / 'deep' / 'soak.json'
+    soak.write_json(str(path), {'processes': soak.summarise(samples, 60.0), 'samples': samples})
+    written = json.loads(path.read_text())
+    assert written['processes']['plant']['growth_percent'] == 0.0
+    assert written['samples']['robot_2'] == [[5.0, 4096]]
+    figure = tmp_path / 'rss.png'
+    soak.write_figure(str(figure), samples)
+    assert figure.read_bytes()[:8] == b'\x89PNG\r\n\x1a\n'
+
+
+def test_sampling_ends_with_the_launcher(soak, fake_install):
+    process = subprocess.Popen([sys.executable, '-c', 'import time; time.sleep(1.0)'])
+    samples, pids = soak.sample_run(process, str(fake_install), 0.05, time.monotonic())
+    assert process.returncode == 0
+    assert set(samples) == {'launcher'} and pids == {'launcher': [process.pid]}
+    times = [t for t, _ in samples['launcher']]
+    assert times == sorted(times) and all(kib > 0 for _, kib in samples['launcher'])
