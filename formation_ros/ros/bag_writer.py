@@ -146,10 +146,19 @@ class BagWriter:
         self._connections = {}
         self.counts = {}
 
-    def add_topic(self, topic, msgtype, qos=None):
-        """Register ``topic`` with ROS type ``msgtype`` (e.g. 'geometry_msgs/msg/PoseStamped')."""
+    def add_topic(self, topic, msgtype, qos=None, definition=None):
+        """
+        Register ``topic`` with ROS type ``msgtype`` (e.g. 'geometry_msgs/msg/PoseStamped').
+
+        qos: the offered QoS profile, or a list of them. definition: (message definition text,
+        RIHS01 type hash) as another bag carried them; by default both come from the Jazzy type
+        store.
+        """
+        profiles = [] if qos is None else list(qos) if isinstance(qos, list) else [qos]
+        msgdef, rihs01 = definition if definition is not None else (None, None)
         self._connections[topic] = self._writer.add_connection(
-            topic, msgtype, typestore=TYPESTORE, offered_qos_profiles=[qos] if qos else [])
+            topic, msgtype, typestore=TYPESTORE, msgdef=msgdef, rihs01=rihs01,
+            offered_qos_profiles=profiles)
         self.counts[topic] = 0
 
     def write(self, topic, timestamp_ns, data):
