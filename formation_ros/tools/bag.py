@@ -295,20 +295,20 @@ def read_or_recover(path: str) -> Tuple[Recorded, Dict[str, int], Optional[str]]
             recorded, counts = read_messages(path)
             return recorded, counts, None
         except BagError as exc:
-            why = str(exc)
+            why = f'{exc}; '
     elif os.path.isdir(path):
-        why = f'{path}: no {METADATA} (the bag was not finished: recorder killed or running)'
+        why = f'{path}: no {METADATA} (the bag was not finished: recorder killed or running); '
     else:
-        why = f'{path}: a single MCAP file'
+        why = f'{path}: '
     try:
         recovery = recover_bag(path)
     except BagError as exc:
-        raise BagError(f'{why}; nothing to recover: {exc}') from None
+        raise BagError(f'{why}nothing to recover: {exc}') from None
     recorded, counts = decode_recovered(recovery)
     if not recorded:
-        raise BagError(f'{why}; nothing to recover: none of the {recovery.count} messages '
+        raise BagError(f'{why}nothing to recover: none of the {recovery.count} messages '
                        'decodes')
-    return recorded, counts, f'{why}; {recovery.describe()}'
+    return recorded, counts, f'{why}{recovery.describe()}'
 
 
 def _whole(path: str) -> bool:
@@ -348,7 +348,7 @@ def repair_bag(path: str) -> str:
     it is. Raises :class:`BagError` if nothing can be recovered.
     """
     if not os.path.isdir(path):
-        raise BagError(f'{path}: not a bag directory')
+        raise BagError('not a bag directory' if os.path.exists(path) else 'no such directory')
     path = os.path.abspath(path)
     if os.path.isfile(os.path.join(path, METADATA)) and _whole(path):
         return f'{path} is whole; nothing to repair'
