@@ -1,3 +1,6 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
 """
 Read rosbag2 directories of formation runs (``rosbags``) back into a trajectory; recover cut bags.
 
