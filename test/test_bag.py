@@ -478,3 +478,17 @@ def test_out_that_cannot_be_written_is_one_line_and_exit_2(tmp_path):
         assert result.returncode == 2 and 'Traceback' not in result.stderr, result.stderr
         assert result.stderr.count('\n') == 1 and expected in result.stderr, result.stderr
     assert taken.read_text() == 'mine'
+
+
+def test_topics_of_unknown_types_are_counted_not_read(tmp_path):
+    with BagWriter(str(tmp_path / 'odd')) as odd:
+        odd.add_topic('/blobs', 'my_pkg/msg/Blob',
+                      definition=('uint8[] data', 'RIHS01_' + '0' * 64))
+        odd.write('/blobs', 5, b'\x00\x01\x00\x00\x02\x00\x00\x00\x07\x08')
+    topics, counts = read_messages(str(tmp_path / 'odd'))
+    assert counts == {'/blobs': 1} and topics == {}
+    (tmp_path / 'odd' / 'metadata.yaml').unlink()
+    with pytest.raises(BagError, match='none of the 1 messages decodes'):
+        read_or_recover(str(tmp_path / 'odd'))
+    recovery = recover_bag(str(tmp_path / 'odd'))
+    assert recovery.topics['/blobs'].msgtype == 'my_pkg/msg/Blob' and recovery.count == 1

@@ -51,7 +51,8 @@ def read_messages(path: str) -> Tuple[Recorded, Dict[str, int]]:
     Return ({topic: [(timestamp_ns, message), ...]}, {topic: count in metadata.yaml}).
 
     Only a whole bag is read (metadata.yaml and complete MCAP files); anything else raises
-    :class:`BagError` saying what is wrong (see :func:`read_or_recover`).
+    :class:`BagError` saying what is wrong (see :func:`read_or_recover`). Topics of types that
+    the Jazzy type store does not know are counted but not read.
     """
     if not os.path.isfile(os.path.join(path, METADATA)):
         raise BagError(f'{path}: no {METADATA}, not a rosbag2 directory')
@@ -61,7 +62,8 @@ def read_messages(path: str) -> Tuple[Recorded, Dict[str, int]]:
         with Reader(path) as reader:
             for connection in reader.connections:
                 counts[connection.topic] = counts.get(connection.topic, 0) + connection.msgcount
-            for connection, timestamp, raw in reader.messages():
+            known = [c for c in reader.connections if c.msgtype in TYPESTORE.types]
+            for connection, timestamp, raw in reader.messages(known) if known else ():
                 message = _decode(raw, connection.msgtype, connection.topic)
                 recorded.setdefault(connection.topic, []).append((timestamp, message))
     except BagError:
@@ -110,6 +112,7 @@ class Recovery:
     dropped_chunks: int = 0
     dropped_records: int = 0
     dropped_messages: int = 0
+    undecodable: int = 0
 
     @property
     def count(self) -> int:
@@ -128,6 +131,8 @@ class Recovery:
             if number:
                 dropped.append(f'{number} {what}')
         ending = '; dropped ' + ', '.join(dropped) if dropped else ''
+        if self.undecodable:
+            ending += f'; {self.undecodable} of them do not decode and are left out'
         state = ('data section whole' if self.complete
                  else 'no summary or footer: writing was cut')
         return (f'recovered {self.count} messages on {len(self.topics)} topics from {shown} '
@@ -270,8 +275,8 @@ def decode_recovered(recovery: Recovery) -> Tuple[Recorded, Dict[str, int]]:
     """
     Deserialize the recovered messages: ({topic: [(timestamp_ns, message), ...]}, counts).
 
-    A message that does not decode as its type is dropped and counted in
-    ``recovery.dropped_messages``.
+    A message that does not decode as its type (or whose type is not in the Jazzy type store)
+    is left out and counted in ``recovery.undecodable``.
     """
     recorded: Recorded = {}
     for name, topic in recovery.topics.items():
@@ -279,7 +284,7 @@ def decode_recovered(recovery: Recovery) -> Tuple[Recorded, Dict[str, int]]:
             try:
                 message = _decode(raw, topic.msgtype, name)
             except BagError:
-                recovery.dropped_messages += 1
+                recovery.undecodable += 1
                 continue
             recorded.setdefault(name, []).append((timestamp, message))
     return recorded, {name: len(messages) for name, messages in recorded.items()}
