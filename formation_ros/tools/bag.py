@@ -102,7 +102,12 @@ class RecoveredTopic:
 
 @dataclass
 class Recovery:
-    """What the MCAP files of a bag still hold, and what was dropped to get it."""
+    """
+    What the MCAP files of a bag still hold, and what was dropped to get it.
+
+    size: bytes in the files; kept: bytes up to the end of the last whole record (the rest was
+    cut short); complete: every file's data section ended properly (its writer finished it).
+    """
 
     files: List[str]
     topics: Dict[str, RecoveredTopic] = field(default_factory=dict)
