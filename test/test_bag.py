@@ -13,7 +13,7 @@ from formation_ros.core.params import load_config, validate
 from formation_ros.core.params_file import dump_params_text, load_params_file, parse_params_text
 from formation_ros.ros.bag_writer import BagError, BagWriter, TYPESTORE
 from formation_ros.ros.topics import PARAMS as PARAMS_TOPIC
-from formation_ros.tools.bag import read_messages
+from formation_ros.tools.bag import read_messages, read_or_recover, recover_bag, repair_bag
 from formation_ros.tools.report import main as report_main
 from formation_ros.tools.sim import run_metrics, simulate
 import numpy as np
@@ -22,6 +22,7 @@ import yaml
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CONFIG = os.path.join(ROOT, 'config')
+SQUARE = os.path.join(CONFIG, 'square_4.yaml')
 NS = 1_000_000_000
 Time = TYPESTORE.types['builtin_interfaces/msg/Time']
 Header = TYPESTORE.types['std_msgs/msg/Header']
@@ -77,8 +78,14 @@ def odometry_msg(stamp_ns, frame, dim):
             covariance=np.zeros(36)))
 
 
-def write_run_as_bag(path, config, trajectory, with_params=True):
-    """Write a simulated run as the recorder would record it."""
+def write_run_as_bag(path, config, trajectory, with_params=True, flush_every=0,
+                     on_flush=None):
+    """
+    Write a simulated run as the recorder would record it.
+
+    flush_every: flush the bag after every that many samples, as the recorder's timer does,
+    calling ``on_flush(bag)`` after each flush (the bag is still open: what SIGKILL would leave).
+    """
     reference = config.reference()
     with BagWriter(path) as bag:
         for i in range(1, config.num_robots + 1):
@@ -97,6 +104,10 @@ def write_run_as_bag(path, config, trajectory, with_params=True):
                     pose_msg(stamp, trajectory.q[k, i]), 'geometry_msgs/msg/PoseStamped'))
                 bag.write(f'/robot_{i + 1}/cmd_vel', stamp + 3, TYPESTORE.serialize_cdr(
                     twist_msg(stamp, trajectory.u[k, i]), 'geometry_msgs/msg/TwistStamped'))
+            if flush_every and (k + 1) % flush_every == 0:
+                bag.flush()
+                if on_flush is not None:
+                    on_flush(bag)
     return bag
 
 
@@ -207,3 +218,277 @@ def test_rviz_config_shows_the_markers():
     assert manager['Global Options']['Fixed Frame'] == 'world'
     topics = [d.get('Topic', {}).get('Value') for d in manager['Displays']]
     assert '/formation/markers' in topics
+
+
+# Bags cut short: what a recorder killed with SIGKILL leaves, and damaged files.
+
+def _mcap_of(folder):
+    (name,) = [n for n in os.listdir(folder) if n.endswith('.mcap')]
+    return os.path.join(str(folder), name)
+
+
+@pytest.fixture(scope='module')
+def killed_recordings(tmp_path_factory):
+    """
+    Record a run, keeping the MCAP bytes on disk after each flush (what SIGKILL would leave).
+
+    Returns (config, [(bytes, messages written so far), ...]).
+    """
+    config = load_config(os.path.join(CONFIG, 'square_4.yaml'))
+    trajectory = simulate(config, duration=3.0, dt=0.01, sample_dt=0.02)
+    folder = tmp_path_factory.mktemp('killed') / 'bag'
+    snapshots = []
+
+    def snapshot(bag):
+        with open(_mcap_of(folder), 'rb') as stream:
+            snapshots.append((stream.read(), sum(bag.counts.values())))
+
+    write_run_as_bag(str(folder), config, trajectory, flush_every=10, on_flush=snapshot)
+    return config, snapshots
+
+
+def cut_bag(folder, data, config=None):
+    """Make a bag directory as a killed recorder leaves it: params.yaml, an MCAP, no metadata."""
+    folder.mkdir()
+    (folder / f'{folder.name}.mcap').write_bytes(data)
+    if config is not None:
+        (folder / 'params.yaml').write_text(dump_params_text(config.values))
+    return folder
+
+
+def run_report(*args):
+    return subprocess.run([sys.executable, '-m', 'formation_ros.tools.report', *map(str, args)],
+                          capture_output=True, text=True, timeout=120)
+
+
+def test_every_flush_reaches_the_file_and_is_recovered(killed_recordings, tmp_path):
+    _, snapshots = killed_recordings
+    assert len(snapshots) >= 10
+    sizes = [len(data) for data, _ in snapshots]
+    assert sizes == sorted(sizes) and sizes[0] > 0
+    for k, (data, written) in enumerate(snapshots):
+        recovery = recover_bag(str(cut_bag(tmp_path / f'flush{k}', data)))
+        assert recovery.count == written
+        assert not recovery.complete and recovery.kept == recovery.size
+        assert recovery.dropped_chunks == recovery.dropped_messages == 0
+
+
+def test_a_cut_at_any_byte_keeps_the_whole_chunks_before_it(killed_recordings, tmp_path):
+    _, snapshots = killed_recordings
+    ends = [(len(data), written) for data, written in snapshots]
+    data = snapshots[-1][0]
+    offsets = set()
+    for (start, _), (end, _) in zip(ends, ends[1:]):
+        offsets.update({start + 1, start + 9, start + 10, (start + end) // 2, end - 100,
+                        end - 1})
+    for offset in sorted(offsets):
+        folder = cut_bag(tmp_path / f'cut{offset}', data[:offset])
+        recovery = recover_bag(str(folder))
+        before = max(written for end, written in ends if end <= offset)
+        after = min(written for end, written in ends if end > offset)
+        assert before <= recovery.count <= after, offset
+        assert recovery.count in {written for _, written in ends}, offset
+        assert recovery.kept <= offset and recovery.dropped_chunks == 0
+        recorded, counts, note = read_or_recover(str(folder))
+        assert sum(counts.values()) == recovery.count
+        assert f'recovered {recovery.count} messages' in note and 'no metadata.yaml' in note
+
+
+def test_a_cut_before_the_first_chunk_recovers_nothing(killed_recordings, tmp_path):
+    _, snapshots = killed_recordings
+    data = snapshots[0][0]
+    for offset in (0, 4, 8, 20, 100, 1000):
+        folder = cut_bag(tmp_path / f'cut{offset}', data[:offset])
+        with pytest.raises(BagError) as caught:
+            read_or_recover(str(folder))
+        assert 'nothing to recover' in str(caught.value)
+        assert '\n' not in str(caught.value)
+
+
+def test_a_damaged_chunk_is_dropped_and_counted(killed_recordings, tmp_path):
+    _, snapshots = killed_recordings
+    (before, written_before), (after, written_after) = snapshots[3:5]
+    data = bytearray(snapshots[-1][0])
+    data[(len(before) + len(after)) // 2] ^= 0xFF
+    recovery = recover_bag(str(cut_bag(tmp_path / 'flipped', bytes(data))))
+    assert recovery.dropped_chunks == 1
+    assert recovery.count == snapshots[-1][1] - (written_after - written_before)
+    assert 'dropped 1 damaged chunks' in recovery.describe()
+
+
+def test_random_bytes_are_never_more_than_a_bag_error(killed_recordings, tmp_path):
+    _, snapshots = killed_recordings
+    head = snapshots[0][0][:40]
+    rng = np.random.default_rng(9)
+    for k in range(60):
+        noise = rng.integers(0, 256, int(rng.integers(0, 3000)), dtype=np.uint8).tobytes()
+        for prefix in (b'', head):
+            folder = tmp_path / f'noise{k}_{len(prefix)}'
+            try:
+                recover_bag(str(cut_bag(folder, prefix + noise)))
+            except BagError as exc:
+                assert '\n' not in str(exc)
+
+
+def test_report_recovers_a_killed_recording(killed_recordings, tmp_path):
+    config, snapshots = killed_recordings
+    (before, recovered), (data, _) = snapshots[-3][0:2], snapshots[-2]
+    bag = cut_bag(tmp_path / 'bag', data[:(len(before) + len(data)) // 2], config)
+    result = run_report(bag, '--out', tmp_path / 'out', '--no-plots')
+    assert result.returncode == 0, result.stderr
+    assert 'Traceback' not in result.stderr
+    (line,) = [ln for ln in result.stderr.splitlines() if 'recovered' in ln]
+    assert f'recovered {recovered} messages on ' in line and 'no metadata.yaml' in line
+    assert 'dropped the last' in line
+    metrics = json.loads((tmp_path / 'out' / 'metrics.json').read_text())
+    assert metrics['recovered_messages'] == metrics['messages'] == recovered
+    assert metrics['source'] == 'rosbag2' and metrics['reference_source'] == 'recorded'
+    assert metrics['num_robots'] == 4 and metrics['min_pair_distance'] > 0
+
+
+def test_repair_makes_a_killed_recording_whole(killed_recordings, tmp_path):
+    config, snapshots = killed_recordings
+    data, written = snapshots[-1]
+    bag = cut_bag(tmp_path / 'bag', data, config)
+    result = run_report(bag, '--repair')
+    assert result.returncode == 0 and 'Traceback' not in result.stderr, result.stderr
+    assert f'repaired {bag}: {written} messages on 10 topics' in result.stdout
+    assert (bag / 'bag.mcap.damaged').read_bytes() == data
+    topics, counts = read_messages(str(bag))
+    assert counts == {topic: len(messages) for topic, messages in topics.items()}
+    assert sum(counts.values()) == written
+    with open(bag / 'metadata.yaml') as stream:
+        metadata = yaml.safe_load(stream)['rosbag2_bagfile_information']
+    assert metadata['message_count'] == written
+    qos = {t['topic_metadata']['name']: t['topic_metadata']['offered_qos_profiles']
+           for t in metadata['topics_with_message_count']}
+    assert qos[PARAMS_TOPIC][0]['durability'] == 'transient_local'
+    again = run_report(bag, '--repair', '--out', tmp_path / 'out', '--no-plots')
+    assert again.returncode == 0, again.stderr
+    assert 'nothing to repair' in again.stdout and 'recovered' not in again.stderr
+    assert json.loads((tmp_path / 'out' / 'metrics.json').read_text())['messages'] == written
+
+
+def test_report_recovers_a_bag_with_a_garbage_metadata_file(tmp_path):
+    config = load_config(os.path.join(CONFIG, 'square_4.yaml'))
+    trajectory = simulate(config, duration=0.5, dt=0.01, sample_dt=0.05)
+    write_run_as_bag(str(tmp_path / 'bag'), config, trajectory)
+    for text in ('', ':: not yaml [', 'rosbag2_bagfile_information: 3\n'):
+        (tmp_path / 'bag' / 'metadata.yaml').write_text(text)
+        recorded, counts, note = read_or_recover(str(tmp_path / 'bag'))
+        assert sum(counts.values()) == 4 * 2 * len(trajectory.t) + len(trajectory.t) + 1
+        assert 'rosbags cannot read it' in note and 'data section whole' in note
+    assert repair_bag(str(tmp_path / 'bag')).startswith(f'repaired {tmp_path / "bag"}')
+    assert (tmp_path / 'bag' / 'metadata.yaml.damaged').read_text() == text
+    assert (tmp_path / 'bag' / 'bag.mcap.damaged').exists()
+    topics, counts = read_messages(str(tmp_path / 'bag'))
+    assert counts == {topic: len(messages) for topic, messages in topics.items()}
+    assert repair_bag(str(tmp_path / 'bag')).endswith('is whole; nothing to repair')
+
+
+def _not_an_mcap(tmp_path):
+    path = tmp_path / 'random.mcap'
+    path.write_bytes(np.random.default_rng(3).integers(0, 256, 5000, dtype=np.uint8).tobytes())
+    return path
+
+
+def _random_mcap_in_a_bag(tmp_path):
+    folder = tmp_path / 'bag'
+    folder.mkdir()
+    _not_an_mcap(folder)
+    return folder
+
+
+def _truncated_whole_bag(tmp_path):
+    config = load_config(os.path.join(CONFIG, 'square_4.yaml'))
+    write_run_as_bag(str(tmp_path / 'bag'), config,
+                     simulate(config, duration=0.2, dt=0.01, sample_dt=0.05))
+    mcap = _mcap_of(tmp_path / 'bag')
+    with open(mcap, 'r+b') as stream:
+        stream.truncate(300)
+    return tmp_path / 'bag'
+
+
+def _garbage_metadata(tmp_path):
+    folder = tmp_path / 'bag'
+    folder.mkdir()
+    (folder / 'metadata.yaml').write_bytes(b'\x00\xff garbage: [')
+    return folder
+
+
+def _empty_metadata(tmp_path):
+    folder = tmp_path / 'bag'
+    folder.mkdir()
+    (folder / 'metadata.yaml').write_text('')
+    return folder
+
+
+def _not_a_bag(tmp_path):
+    folder = tmp_path / 'photos'
+    folder.mkdir()
+    (folder / 'cat.jpg').write_bytes(b'meow')
+    return folder
+
+
+def _plain_file(tmp_path):
+    path = tmp_path / 'notes.txt'
+    path.write_text('hello')
+    return path
+
+
+def _garbage_trajectory(tmp_path):
+    folder = tmp_path / 'run'
+    folder.mkdir()
+    (folder / 'params.yaml').write_text(dump_params_text(load_params_file(SQUARE)))
+    (folder / 'trajectory.npz').write_bytes(b'PK\x03\x04 not a zip')
+    return folder
+
+
+@pytest.mark.parametrize('make, expected', [
+    (_not_an_mcap, 'not an MCAP file'),
+    (_random_mcap_in_a_bag, 'not an MCAP file'),
+    (_truncated_whole_bag, 'nothing to recover: no whole message'),
+    (_garbage_metadata, 'no .mcap file'),
+    (_empty_metadata, 'no .mcap file'),
+    (_not_a_bag, 'neither a bag'),
+    (_plain_file, 'not a bag directory'),
+    (lambda tmp_path: tmp_path / 'missing', 'no such file or directory'),
+    (_garbage_trajectory, 'not a readable trajectory'),
+])
+def test_unreadable_input_is_one_line_and_exit_2(tmp_path, capsys, make, expected):
+    source = make(tmp_path)
+    result = run_report(source, '--out', tmp_path / 'out', '--no-plots')
+    assert result.returncode == 2, result.stdout + result.stderr
+    assert 'Traceback' not in result.stderr
+    assert result.stderr.count('\n') == 1 and expected in result.stderr, result.stderr
+    assert not (tmp_path / 'out').exists()
+    assert report_main([str(source), '--repair']) == 2
+    assert capsys.readouterr().err.count('\n') == 1
+
+
+def test_out_that_cannot_be_written_is_one_line_and_exit_2(tmp_path):
+    config = load_config(os.path.join(CONFIG, 'square_4.yaml'))
+    write_run_as_bag(str(tmp_path / 'bag'), config,
+                     simulate(config, duration=0.2, dt=0.01, sample_dt=0.05))
+    taken = tmp_path / 'taken'
+    taken.write_text('mine')
+    for out, expected in ((taken, 'exists and is not a directory'),
+                          (taken / 'report', 'is not a directory')):
+        result = run_report(tmp_path / 'bag', '--out', out, '--no-plots')
+        assert result.returncode == 2 and 'Traceback' not in result.stderr, result.stderr
+        assert result.stderr.count('\n') == 1 and expected in result.stderr, result.stderr
+    assert taken.read_text() == 'mine'
+
+
+def test_topics_of_unknown_types_are_counted_not_read(tmp_path):
+    with BagWriter(str(tmp_path / 'odd')) as odd:
+        odd.add_topic('/blobs', 'my_pkg/msg/Blob',
+                      definition=('uint8[] data', 'RIHS01_' + '0' * 64))
+        odd.write('/blobs', 5, b'\x00\x01\x00\x00\x02\x00\x00\x00\x07\x08')
+    topics, counts = read_messages(str(tmp_path / 'odd'))
+    assert counts == {'/blobs': 1} and topics == {}
+    (tmp_path / 'odd' / 'metadata.yaml').unlink()
+    with pytest.raises(BagError, match='none of the 1 messages decodes'):
+        read_or_recover(str(tmp_path / 'odd'))
+    recovery = recover_bag(str(tmp_path / 'odd'))
+    assert recovery.topics['/blobs'].msgtype == 'my_pkg/msg/Blob' and recovery.count == 1

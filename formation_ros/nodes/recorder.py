@@ -7,11 +7,14 @@ Recorder node (executable ``record``): every formation topic into a rosbag2 (MCA
 Subscribes with ``raw=True`` (the serialized CDR bytes, no deserialise/serialise round trip) and
 with the reliability and durability of each publisher (best effort for poses and neighbours,
 transient local for the reference) but a deep history, stores the bytes in its callbacks and
-writes them to the bag from a timer. Robot i's ``cmd_vel`` is subscribed only once the
-recorder's own readers of its ``pose`` and ``neighbors`` have matched a publisher: a robot that
-waits for the recorder on ``cmd_vel`` (``wait_for_subscribers``) then cannot start before its
-states are recorded, whichever side of the DDS discovery finishes first. The bag is finished
-(metadata.yaml written) when the node stops, on Ctrl-C or SIGTERM too. It carries the run's
+writes them to the bag from a timer, every 0.2 s, each time as a complete MCAP chunk handed to
+the operating system: a recorder killed with SIGKILL loses at most the last 0.2 s, and
+``formation_report`` recovers the rest (``--repair`` makes the bag whole again). Robot i's
+``cmd_vel`` is subscribed only once the recorder's own readers of its ``pose`` and
+``neighbors`` have matched a publisher: a robot that waits for the recorder on ``cmd_vel``
+(``wait_for_subscribers``) then cannot start before its states are recorded, whichever side of
+the DDS discovery finishes first. The bag is finished (metadata.yaml written) when the node
+stops, on Ctrl-C or SIGTERM too. It carries the run's
 parameters on /formation/params and in params.yaml, for ``formation_report``::
 
     ros2 run formation_ros record --ros-args --params-file config/paper_section5.yaml \\
@@ -122,10 +125,11 @@ class RecorderNode(Node):
         self.pending.append((topic, self.get_clock().now().nanoseconds, data))
 
     def flush(self) -> None:
-        """Write the buffered messages to the bag."""
+        """Write the buffered messages to the bag and the bag's file (one MCAP chunk)."""
         pending, self.pending = self.pending, []
         for topic, stamp, data in pending:
             self.bag.write(topic, stamp, data)
+        self.bag.flush()
 
     def finish(self) -> None:
         """Write what is left and finish the bag (metadata.yaml)."""

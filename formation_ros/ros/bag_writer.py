@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-Write rosbag2 directories (metadata.yaml + MCAP) with ``rosbags``: what the recorder stores.
+Write rosbag2 directories (metadata.yaml + MCAP): what the recorder stores.
 
 Writing takes messages already serialized as CDR (what an rclpy subscription with ``raw=True``
 hands over), so nothing is deserialized on the way. The ROS 2 message definitions are embedded
@@ -10,20 +10,34 @@ from rosbags' Jazzy type store, so ``ros2 bag info`` / ``ros2 bag play`` read th
 any MCAP tool. Every bag also carries its parameters as YAML text on ``/formation/params``
 (std_msgs/String) and as ``params.yaml`` next to ``metadata.yaml``, so it describes itself.
 Reading bags back is an offline tool's job (``formation_ros.tools.bag``).
+
+``rosbags`` keeps the rosbag2 bookkeeping (connections, type hashes, QoS, metadata.yaml); the
+MCAP file itself is written by the ``mcap`` library, because rosbags holds up to 1 MiB of
+messages in memory before anything reaches the file and writes the schemas and channels only
+with that first chunk. :meth:`BagWriter.flush` ends the chunk in progress and hands it to the
+operating system, so a recorder killed with SIGKILL leaves an MCAP whose complete chunks (each
+with its CRC) hold everything up to its last flush; ``formation_ros.tools.bag`` recovers them.
 """
 
 import os
+from pathlib import Path
 import shutil
+from typing import Dict, Union
 
 from formation_ros.core.params_file import dump_params_text
 from formation_ros.ros import topics
-from rosbags.interfaces import Qos, QosDurability, QosHistory, QosLiveliness, QosReliability
-from rosbags.interfaces import QosTime
-from rosbags.rosbag2 import StoragePlugin, Writer
+from mcap import __version__ as MCAP_VERSION
+from mcap.writer import CompressionType, Writer as McapWriter
+from rosbags.interfaces import Connection, MessageDefinitionFormat, Qos, QosDurability
+from rosbags.interfaces import QosHistory, QosLiveliness, QosReliability, QosTime
+from rosbags.rosbag2 import CompressionMode, StoragePlugin, Writer
 from rosbags.typesys import get_typestore, Stores
 
 PARAMS_FILE = 'params.yaml'
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
+CHUNK_SIZE = 1 << 20
+SCHEMA_ENCODINGS = {MessageDefinitionFormat.MSG: 'ros2msg',
+                    MessageDefinitionFormat.IDL: 'ros2idl'}
 
 
 class BagError(Exception):
@@ -47,6 +61,68 @@ def _looks_like_bag(path):
     return 'metadata.yaml' in names or any(name.endswith('.mcap') for name in names)
 
 
+class McapStorage:
+    """
+    rosbags storage plugin: the bag's MCAP file, written with the ``mcap`` library.
+
+    The records are the ones rosbag2's own MCAP storage writes: profile ``ros2``, one schema
+    (``ros2msg`` text) per message type, one channel per topic with ``offered_qos_profiles`` and
+    ``topic_type_hash`` metadata, CDR messages in CRC-checked chunks, the ``rosbag2`` metadata
+    record and a full summary (statistics, chunk and message indexes) when it is closed.
+    """
+
+    def __init__(self, path: Path, compression: CompressionMode) -> None:
+        """Create ``<path>/<path.name>.mcap`` (it must not exist) and write its header."""
+        if compression != CompressionMode.NONE:
+            raise BagError(f'{path}: only uncompressed bags are written here')
+        self.path = path / f'{path.name}.mcap'
+        self._stream = self.path.open('xb')
+        self._mcap = McapWriter(self._stream, chunk_size=CHUNK_SIZE,
+                                compression=CompressionType.NONE)
+        self._mcap.start(profile='ros2', library=f'formation_ros (mcap-python {MCAP_VERSION})')
+        self._schemas: Dict[str, int] = {}
+        self._channels: Dict[int, int] = {}
+
+    def add_msgtype(self, connection: Connection) -> None:
+        """Store the message definition of ``connection``'s type as a schema."""
+        self._schemas[connection.msgtype] = self._mcap.register_schema(
+            connection.msgtype, SCHEMA_ENCODINGS[connection.msgdef.format],
+            connection.msgdef.data.encode())
+
+    def add_connection(self, connection: Connection, offered_qos_profiles: str) -> None:
+        """Store ``connection`` as a channel (topic, encoding, QoS and type hash)."""
+        self._channels[connection.id] = self._mcap.register_channel(
+            connection.topic, connection.ext.serialization_format,
+            self._schemas[connection.msgtype],
+            {'offered_qos_profiles': offered_qos_profiles, 'topic_type_hash': connection.digest})
+
+    def write(self, connection: Connection, timestamp: int,
+              data: Union[bytes, memoryview]) -> None:
+        """Add one serialized message to the chunk in progress."""
+        self._mcap.add_message(self._channels[connection.id], timestamp, bytes(data), timestamp)
+
+    def flush(self) -> None:
+        """End the chunk in progress (if it holds messages) and hand the file to the OS."""
+        self._mcap.flush()
+
+    def close(self, version: int, metadata: str) -> None:
+        """Write the last chunk, the ``rosbag2`` metadata record and the summary."""
+        self._mcap.flush()
+        self._mcap.add_metadata('rosbag2', {'serialized_metadata': metadata})
+        self._mcap.finish()
+        self._stream.close()
+
+    def abort(self) -> None:
+        """Close the file as it is (no summary)."""
+        self._stream.close()
+
+
+class _Rosbag2Writer(Writer):
+    """rosbags' rosbag2 writer with :class:`McapStorage` as its MCAP storage."""
+
+    STORAGE_PLUGINS = {StoragePlugin.MCAP: McapStorage}
+
+
 class BagWriter:
     """A rosbag2 (MCAP) being written; close it (or use ``with``) to write metadata.yaml."""
 
@@ -62,15 +138,27 @@ class BagWriter:
             if os.listdir(self.path) and not _looks_like_bag(self.path):
                 raise BagError(f'{self.path} is not a bag directory; not replacing it')
             shutil.rmtree(self.path)
-        self._writer = Writer(self.path, version=9, storage_plugin=StoragePlugin.MCAP)
+        self._writer = _Rosbag2Writer(self.path, version=9, storage_plugin=StoragePlugin.MCAP)
         self._writer.open()
+        storage = self._writer.storage
+        assert isinstance(storage, McapStorage)
+        self._storage = storage
         self._connections = {}
         self.counts = {}
 
-    def add_topic(self, topic, msgtype, qos=None):
-        """Register ``topic`` with ROS type ``msgtype`` (e.g. 'geometry_msgs/msg/PoseStamped')."""
+    def add_topic(self, topic, msgtype, qos=None, definition=None):
+        """
+        Register ``topic`` with ROS type ``msgtype`` (e.g. 'geometry_msgs/msg/PoseStamped').
+
+        qos: the offered QoS profile, or a list of them. definition: (message definition text,
+        RIHS01 type hash) as another bag carried them; by default both come from the Jazzy type
+        store.
+        """
+        profiles = [] if qos is None else list(qos) if isinstance(qos, list) else [qos]
+        msgdef, rihs01 = definition if definition is not None else (None, None)
         self._connections[topic] = self._writer.add_connection(
-            topic, msgtype, typestore=TYPESTORE, offered_qos_profiles=[qos] if qos else [])
+            topic, msgtype, typestore=TYPESTORE, msgdef=msgdef, rihs01=rihs01,
+            offered_qos_profiles=profiles)
         self.counts[topic] = 0
 
     def write(self, topic, timestamp_ns, data):
@@ -89,6 +177,12 @@ class BagWriter:
                    TYPESTORE.serialize_cdr(message, 'std_msgs/msg/String'))
         with open(os.path.join(self.path, PARAMS_FILE), 'w', encoding='utf-8') as stream:
             stream.write(text)
+        self.flush()
+
+    def flush(self):
+        """Put every message written so far into the file (one chunk); the recorder's timer."""
+        if self._writer is not None:
+            self._storage.flush()
 
     def close(self):
         """Finish the MCAP file and write metadata.yaml."""

@@ -2,42 +2,401 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-Read rosbag2 directories of formation runs (``rosbags``) back into a trajectory.
+Read rosbag2 directories of formation runs (``rosbags``) back into a trajectory; recover cut bags.
 
 Bags are written by the recorder (:mod:`formation_ros.ros.bag_writer`). Reading rebuilds a
 :class:`formation_ros.core.trajectory.Trajectory` from the recorded poses, commands and
 reference samples (header stamps, i.e. simulated time).
+
+A bag whose recorder was killed (SIGKILL, power cut) has no metadata.yaml and an MCAP without
+summary or footer, its last record possibly cut short. :func:`recover_bag` reads such a file
+record by record with the ``mcap`` library's record parsers, keeps every record that is whole
+(chunks only if their CRC holds) and stops at the first one that runs past the end of the file;
+:func:`repair_bag` writes what it recovered as a complete bag in place and keeps the damaged
+files beside it.
 """
 
+from dataclasses import dataclass, field
+from io import BytesIO
 import os
+import shutil
+import struct
+import tempfile
 from typing import Any, Dict, List, Optional, Tuple
 
 from formation_ros.core.frames import advance, FrameSample
 from formation_ros.core.params import FormationConfig
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.ros import topics as names
-from formation_ros.ros.bag_writer import BagError, PARAMS_FILE, TYPESTORE
+from formation_ros.ros.bag_writer import BagError, BagWriter, PARAMS_FILE, TYPESTORE
 from formation_ros.ros.fields import frame_of, NS_PER_S, position_of, stamp_to_ns, velocity_of
+from mcap.data_stream import ReadDataStream
+from mcap.opcode import Opcode
+from mcap.records import Channel, Chunk, Header, Message, Schema
+from mcap.stream_reader import breakup_chunk
 import numpy as np
 from rosbags.rosbag2 import Reader
+from rosbags.rosbag2.metadata import parse_qos
 
 
 Recorded = Dict[str, List[Tuple[int, Any]]]
+MCAP_MAGIC = b'\x89MCAP0\r\n'
+METADATA = 'metadata.yaml'
+DAMAGED = '.damaged'
+RECORD_HEAD = struct.Struct('<BQ')
 
 
 def read_messages(path: str) -> Tuple[Recorded, Dict[str, int]]:
-    """Return ({topic: [(timestamp_ns, message), ...]}, {topic: count in metadata.yaml})."""
-    if not os.path.isfile(os.path.join(path, 'metadata.yaml')):
-        raise BagError(f'{path}: no metadata.yaml, not a rosbag2 directory')
+    """
+    Return ({topic: [(timestamp_ns, message), ...]}, {topic: count in metadata.yaml}).
+
+    Only a whole bag is read (metadata.yaml and complete MCAP files); anything else raises
+    :class:`BagError` saying what is wrong (see :func:`read_or_recover`). Topics of types that
+    the Jazzy type store does not know are counted but not read.
+    """
+    if not os.path.isfile(os.path.join(path, METADATA)):
+        raise BagError(f'{path}: no {METADATA}, not a rosbag2 directory')
     recorded: Recorded = {}
     counts: Dict[str, int] = {}
-    with Reader(path) as reader:
-        for connection in reader.connections:
-            counts[connection.topic] = counts.get(connection.topic, 0) + connection.msgcount
-        for connection, timestamp, raw in reader.messages():
-            message = TYPESTORE.deserialize_cdr(raw, connection.msgtype)
-            recorded.setdefault(connection.topic, []).append((timestamp, message))
+    try:
+        with Reader(path) as reader:
+            for connection in reader.connections:
+                counts[connection.topic] = counts.get(connection.topic, 0) + connection.msgcount
+            known = [c for c in reader.connections if c.msgtype in TYPESTORE.types]
+            for connection, timestamp, raw in reader.messages(known) if known else ():
+                message = _decode(raw, connection.msgtype, connection.topic)
+                recorded.setdefault(connection.topic, []).append((timestamp, message))
+    except BagError:
+        raise
+    # rosbags parses untrusted files: whatever it raises means that this bag is not whole.
+    except Exception as exc:
+        raise BagError(f'{path}: rosbags cannot read it ({_one_line(exc)})') from None
     return recorded, counts
+
+
+def _one_line(exc: BaseException) -> str:
+    text = ' '.join(str(exc).split())
+    return f'{type(exc).__name__}: {text}' if text else type(exc).__name__
+
+
+def _decode(raw: bytes, msgtype: str, topic: str) -> Any:
+    if msgtype not in TYPESTORE.types:
+        raise BagError(f'{topic} has type {msgtype}, unknown to the ROS 2 Jazzy type store')
+    try:
+        return TYPESTORE.deserialize_cdr(raw, msgtype)
+    # CDR bytes from the file: a message cut or corrupted in any way fails here.
+    except Exception as exc:
+        raise BagError(f'a message on {topic} is not a valid {msgtype} '
+                       f'({_one_line(exc)})') from None
+
+
+@dataclass
+class RecoveredTopic:
+    """One topic of a recovered MCAP: its channel, its schema and its messages (raw CDR)."""
+
+    msgtype: str
+    definition: str
+    metadata: Dict[str, str]
+    messages: List[Tuple[int, bytes]] = field(default_factory=list)
+
+
+@dataclass
+class Recovery:
+    """
+    What the MCAP files of a bag still hold, and what was dropped to get it.
+
+    size: bytes in the files; kept: bytes up to the end of the last whole record (the rest was
+    cut short); complete: every file's data section ended properly (its writer finished it).
+    """
+
+    files: List[str]
+    topics: Dict[str, RecoveredTopic] = field(default_factory=dict)
+    size: int = 0
+    kept: int = 0
+    complete: bool = True
+    dropped_chunks: int = 0
+    dropped_records: int = 0
+    dropped_messages: int = 0
+    undecodable: int = 0
+
+    @property
+    def count(self) -> int:
+        """Messages recovered, on every topic."""
+        return sum(len(topic.messages) for topic in self.topics.values())
+
+    def describe(self) -> str:
+        """One line: how many messages were recovered from which files, and what was dropped."""
+        shown = ', '.join(os.path.basename(name) for name in self.files)
+        dropped = []
+        if self.size > self.kept:
+            dropped.append(f'the last {self.size - self.kept} bytes (a record cut short)')
+        for number, what in ((self.dropped_chunks, 'damaged chunks'),
+                             (self.dropped_records, 'damaged records'),
+                             (self.dropped_messages, 'messages without a usable channel')):
+            if number:
+                dropped.append(f'{number} {what}')
+        ending = '; dropped ' + ', '.join(dropped) if dropped else ''
+        if self.undecodable:
+            ending += f'; {self.undecodable} of them do not decode and are left out'
+        state = ('data section whole' if self.complete
+                 else 'no summary or footer: writing was cut')
+        return (f'recovered {self.count} messages on {len(self.topics)} topics from {shown} '
+                f'({state}){ending}')
+
+
+class _McapScan:
+    """Walks the records of one MCAP file and adds what is whole to a :class:`Recovery`."""
+
+    def __init__(self, recovery: Recovery) -> None:
+        self.recovery = recovery
+        self.schemas: Dict[int, Schema] = {}
+        self.channels: Dict[int, Channel] = {}
+
+    def run(self, path: str) -> None:
+        with open(path, 'rb') as stream:
+            size = os.fstat(stream.fileno()).st_size
+            self.recovery.size += size
+            name = os.path.basename(path)
+            if size == 0:
+                raise BagError(f'{name} is empty: nothing reached the file')
+            if stream.read(len(MCAP_MAGIC)) != MCAP_MAGIC:
+                raise BagError(f'{name} is not an MCAP file (no MCAP magic at its start)')
+            offset = len(MCAP_MAGIC)
+            first = True
+            while True:
+                head = stream.read(RECORD_HEAD.size)
+                if len(head) < RECORD_HEAD.size:
+                    self.recovery.complete = False
+                    break
+                opcode, length = RECORD_HEAD.unpack(head)
+                if length > size - offset - RECORD_HEAD.size:
+                    self.recovery.complete = False
+                    break
+                body = stream.read(length)
+                offset += RECORD_HEAD.size + length
+                if first:
+                    self._check_header(name, opcode, body)
+                    first = False
+                    continue
+                if opcode in (Opcode.DATA_END, Opcode.FOOTER):
+                    offset = size
+                    break
+                self._record(opcode, body)
+            self.recovery.kept += offset
+
+    @staticmethod
+    def _check_header(name: str, opcode: int, body: bytes) -> None:
+        if opcode != Opcode.HEADER:
+            raise BagError(f'{name} is not an MCAP file (its first record is not a header)')
+        try:
+            profile = Header.read(ReadDataStream(BytesIO(body))).profile
+        # Header bytes from the file: any failure means that it is not an MCAP header.
+        except Exception:
+            raise BagError(f'{name} is not an MCAP file (unreadable header)') from None
+        if profile != 'ros2':
+            raise BagError(f'{name} is an MCAP file of profile {profile!r}, not a ROS 2 bag')
+
+    def _record(self, opcode: int, body: bytes) -> None:
+        stream = ReadDataStream(BytesIO(body))
+        try:
+            if opcode == Opcode.CHUNK:
+                inner = breakup_chunk(Chunk.read(stream), validate_crc=True)
+            elif opcode == Opcode.SCHEMA:
+                inner = [Schema.read(stream)]
+            elif opcode == Opcode.CHANNEL:
+                inner = [Channel.read(stream)]
+            elif opcode == Opcode.MESSAGE:
+                inner = [Message.read(stream, len(body))]
+            else:
+                return
+        # Record bytes from the file (CRC checked for chunks): any parse failure drops it.
+        except Exception:
+            if opcode == Opcode.CHUNK:
+                self.recovery.dropped_chunks += 1
+            else:
+                self.recovery.dropped_records += 1
+            return
+        for record in inner:
+            if isinstance(record, Schema):
+                self.schemas[record.id] = record
+            elif isinstance(record, Channel):
+                self.channels[record.id] = record
+            elif isinstance(record, Message):
+                self._message(record)
+
+    def _message(self, message: Message) -> None:
+        channel = self.channels.get(message.channel_id)
+        schema = self.schemas.get(channel.schema_id) if channel is not None else None
+        if channel is None or schema is None or channel.message_encoding != 'cdr':
+            self.recovery.dropped_messages += 1
+            return
+        topic = self.recovery.topics.get(channel.topic)
+        if topic is None:
+            topic = RecoveredTopic(schema.name, schema.data.decode('utf-8', 'replace'),
+                                   dict(channel.metadata))
+            self.recovery.topics[channel.topic] = topic
+        elif topic.msgtype != schema.name:
+            self.recovery.dropped_messages += 1
+            return
+        topic.messages.append((message.log_time, message.data))
+
+
+def mcap_files(path: str) -> List[str]:
+    """Return the MCAP files of a bag directory (each ``*.mcap``, sorted), or [path] itself."""
+    if os.path.isfile(path):
+        return [path]
+    if not os.path.isdir(path):
+        raise BagError(f'{path}: no such file or directory')
+    return [os.path.join(path, name) for name in sorted(os.listdir(path))
+            if name.endswith('.mcap') and os.path.isfile(os.path.join(path, name))]
+
+
+def recover_bag(path: str) -> Recovery:
+    """
+    Recover the messages of a bag directory (or one MCAP file) without trusting its metadata.
+
+    Raises :class:`BagError` if there is no MCAP file, a file is not an MCAP file of a ROS 2
+    bag, or no message at all is left.
+    """
+    files = mcap_files(path)
+    if not files:
+        raise BagError('no .mcap file to recover messages from')
+    recovery = Recovery(files)
+    try:
+        for name in files:
+            _McapScan(recovery).run(name)
+    except OSError as exc:
+        raise BagError(f'cannot read {exc.filename}: {exc.strerror or exc}') from None
+    if not recovery.count:
+        shown = ', '.join(os.path.basename(name) for name in files)
+        raise BagError(f'no whole message in {shown} ({recovery.kept} of {recovery.size} bytes '
+                       'readable)')
+    for topic in recovery.topics.values():
+        topic.messages.sort(key=lambda item: item[0])
+    return recovery
+
+
+def decode_recovered(recovery: Recovery) -> Tuple[Recorded, Dict[str, int]]:
+    """
+    Deserialize the recovered messages: ({topic: [(timestamp_ns, message), ...]}, counts).
+
+    A message that does not decode as its type (or whose type is not in the Jazzy type store)
+    is left out and counted in ``recovery.undecodable``.
+    """
+    recorded: Recorded = {}
+    for name, topic in recovery.topics.items():
+        for timestamp, raw in topic.messages:
+            try:
+                message = _decode(raw, topic.msgtype, name)
+            except BagError:
+                recovery.undecodable += 1
+                continue
+            recorded.setdefault(name, []).append((timestamp, message))
+    return recorded, {name: len(messages) for name, messages in recorded.items()}
+
+
+def read_or_recover(path: str) -> Tuple[Recorded, Dict[str, int], Optional[str]]:
+    """
+    Read a whole bag, else recover what its MCAP files hold.
+
+    Returns (recorded, counts, note): note is None for a whole bag, else one line that says why
+    the bag was recovered and how many messages were. Raises :class:`BagError` (one line,
+    both reasons) when neither works.
+    """
+    if os.path.isdir(path) and os.path.isfile(os.path.join(path, METADATA)):
+        try:
+            recorded, counts = read_messages(path)
+            return recorded, counts, None
+        except BagError as exc:
+            why = f'{exc}; '
+    elif os.path.isdir(path):
+        why = f'{path}: no {METADATA} (the bag was not finished: recorder killed or running); '
+    else:
+        why = f'{path}: '
+    try:
+        recovery = recover_bag(path)
+    except BagError as exc:
+        raise BagError(f'{why}nothing to recover: {exc}') from None
+    recorded, counts = decode_recovered(recovery)
+    if not recorded:
+        raise BagError(f'{why}nothing to recover: none of the {recovery.count} messages '
+                       'decodes')
+    return recorded, counts, f'{why}{recovery.describe()}'
+
+
+def _whole(path: str) -> bool:
+    """Whether rosbags reads every message that metadata.yaml counts."""
+    try:
+        with Reader(path) as reader:
+            expected = sum(connection.msgcount for connection in reader.connections)
+            return sum(1 for _ in reader.messages()) == expected
+    # Untrusted files: whatever rosbags raises means that this bag is not whole.
+    except Exception:
+        return False
+
+
+def _aside(name: str) -> str:
+    target, number = name + DAMAGED, 1
+    while os.path.exists(target):
+        target, number = f'{name}{DAMAGED}.{number}', number + 1
+    os.rename(name, target)
+    return target
+
+
+def _qos_profiles(metadata: Dict[str, str]) -> List[Any]:
+    try:
+        return parse_qos(metadata.get('offered_qos_profiles', ''))
+    # Channel metadata from the file: unreadable QoS leaves the profiles out.
+    except Exception:
+        return []
+
+
+def repair_bag(path: str) -> str:
+    """
+    Make a cut or damaged bag directory whole again, in place; return one line saying so.
+
+    The recovered messages are written as a new MCAP and metadata.yaml (a complete rosbag2
+    directory that rosbags and ``ros2 bag info`` read); the damaged MCAP files and
+    metadata.yaml are kept beside them with the suffix ``.damaged``. A whole bag is left as
+    it is. Raises :class:`BagError` if nothing can be recovered.
+    """
+    if not os.path.isdir(path):
+        raise BagError('not a bag directory' if os.path.exists(path) else 'no such directory')
+    path = os.path.abspath(path)
+    if os.path.isfile(os.path.join(path, METADATA)) and _whole(path):
+        return f'{path} is whole; nothing to repair'
+    recovery = recover_bag(path)
+    skipped = []
+    work = tempfile.mkdtemp(prefix=f'.{os.path.basename(path)}.repair-',
+                            dir=os.path.dirname(path))
+    try:
+        fresh = os.path.join(work, os.path.basename(path))
+        with BagWriter(fresh) as bag:
+            for name, topic in recovery.topics.items():
+                digest = topic.metadata.get('topic_type_hash', '')
+                if not digest and topic.msgtype in TYPESTORE.types:
+                    digest = TYPESTORE.hash_rihs01(topic.msgtype)
+                if not digest:
+                    skipped.append(name)
+                    continue
+                bag.add_topic(name, topic.msgtype, _qos_profiles(topic.metadata),
+                              (topic.definition, digest))
+            merged = sorted((timestamp, name, raw) for name, topic in recovery.topics.items()
+                            if name not in skipped for timestamp, raw in topic.messages)
+            for timestamp, name, raw in merged:
+                bag.write(name, timestamp, raw)
+        kept = [_aside(name) for name in recovery.files]
+        if os.path.exists(os.path.join(path, METADATA)):
+            kept.append(_aside(os.path.join(path, METADATA)))
+        for name in os.listdir(fresh):
+            os.rename(os.path.join(fresh, name), os.path.join(path, name))
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+    written = sum(bag.counts.values())
+    note = f'; left out {", ".join(skipped)} (no type hash)' if skipped else ''
+    return (f'repaired {path}: {written} messages on {len(recovery.topics) - len(skipped)} '
+            f'topics in a new MCAP and {METADATA}; the damaged files are kept as '
+            f'{", ".join(os.path.basename(name) for name in kept)}{note}')
 
 
 def bag_params_text(path: str, recorded: Recorded) -> Optional[str]:

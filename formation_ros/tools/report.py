@@ -9,16 +9,23 @@ They are computed by the same code as ``formation_sim``. Input:
 * a rosbag2 directory written by ``record`` (or ``launch_formation.sh --record``): the
   trajectory is rebuilt from the recorded poses, commands and reference samples, and the
   parameters come from the bag itself (``/formation/params``, else ``params.yaml`` beside
-  ``metadata.yaml``); the plant's counters come from its last ``/diagnostics`` status;
+  ``metadata.yaml``); the plant's counters come from its last ``/diagnostics`` status. A bag
+  that is not whole (recorder killed: no metadata.yaml, MCAP cut short; or a damaged
+  metadata.yaml) is recovered from its MCAP file, with one line saying how many messages were
+  recovered; ``--repair`` rewrites it in place as a whole bag, keeping the damaged files;
+* a single ``.mcap`` file of such a bag (recovered the same way);
 * or a run directory holding ``trajectory.npz`` and ``params.yaml`` (``formation_sim`` output,
   or ``launch_formation.sh --out``; a ``plant_stats.json`` there is merged into the metrics).
+
+Unreadable input, or an ``--out`` that cannot be written, ends with exit code 2 and one line
+that says what is wrong.
 """
 
 import argparse
 import json
 import os
 import sys
-from typing import Any, Dict, Optional, Tuple
+from typing import Any, Dict, List, Optional, Tuple
 
 from formation_ros.core.declarations import ParamError
 from formation_ros.core.params import FormationConfig, load_config, validate
@@ -27,24 +34,33 @@ from formation_ros.core.plant import PLANT_STATS_FILE
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.ros import topics as names
 from formation_ros.ros.bag_writer import BagError, PARAMS_FILE
-from formation_ros.tools.bag import (bag_params_text, plant_status, read_messages,
-                                     trajectory_from_topics)
+from formation_ros.tools.bag import (bag_params_text, mcap_files, METADATA, plant_status,
+                                     read_or_recover, repair_bag, trajectory_from_topics)
 from formation_ros.tools.sim import format_summary, run_metrics
 
 Loaded = Tuple[Trajectory, FormationConfig, Dict[str, Any]]
 
 
 class ReportError(Exception):
-    """The input cannot be reported on; the message says why."""
+    """The input cannot be reported on; the message (one line) says why."""
 
 
-def load_bag(path: str) -> Loaded:
-    """Return (Trajectory, FormationConfig, extra metrics) of a recorded bag."""
+def _one_line(text: str) -> str:
+    return '; '.join(line.strip() for line in str(text).splitlines() if line.strip())
+
+
+def load_bag(path: str, notes: Optional[List[str]] = None) -> Loaded:
+    """
+    Return (Trajectory, FormationConfig, extra metrics) of a recorded bag (or MCAP file).
+
+    A bag that is not whole is recovered; the line saying so is appended to ``notes``.
+    """
     try:
-        recorded, counts = read_messages(path)
-    except (BagError, OSError, ValueError) as exc:
-        raise ReportError(f'{path}: cannot read the bag: {exc}') from None
-    text = bag_params_text(path, recorded)
+        recorded, counts, note = read_or_recover(path)
+    except BagError as exc:
+        raise ReportError(f'cannot read the bag: {exc}') from None
+    folder = path if os.path.isdir(path) else os.path.dirname(path)
+    text = bag_params_text(folder, recorded)
     if text is None:
         raise ReportError(f'{path}: the bag has no parameters (no {names.PARAMS} message and '
                           'no '
@@ -55,42 +71,93 @@ def load_bag(path: str) -> Loaded:
         config = validate(parse_params_text(text, f'{path} parameters'))
         trajectory, info = trajectory_from_topics(recorded, config)
     except (ParamError, BagError) as exc:
-        raise ReportError(f'{path}: {exc}') from None
-    extra = {'source': 'rosbag2', 'integrator': 'recorded run (rosbag2)',
-             'messages': int(sum(counts.values()))}
+        raise ReportError(f'{path}: {_one_line(str(exc))}') from None
+    extra: Dict[str, Any] = {'source': 'rosbag2', 'integrator': 'recorded run (rosbag2)',
+                             'messages': int(sum(counts.values()))}
+    if note is not None:
+        extra['recovered_messages'] = extra['messages']
+        if notes is not None:
+            notes.append(note)
     extra.update(info)
     extra.update(plant_status(recorded))
     return trajectory, config, extra
 
 
-def load_run(path: str) -> Loaded:
+def _is_bag(path: str) -> bool:
+    return os.path.isfile(os.path.join(path, METADATA)) or bool(mcap_files(path))
+
+
+def load_run(path: str, notes: Optional[List[str]] = None) -> Loaded:
     """Return (Trajectory, FormationConfig, extra metrics) of a bag or a run directory."""
-    if not os.path.isdir(path):
-        raise ReportError(f'{path}: not a directory')
-    if os.path.isfile(os.path.join(path, 'metadata.yaml')):
-        return load_bag(path)
+    if not os.path.exists(path):
+        raise ReportError(f'{path}: no such file or directory')
+    if os.path.isfile(path):
+        if path.endswith('.mcap'):
+            return load_bag(path, notes)
+        raise ReportError(f'{path}: a file, not a bag directory, an .mcap file or a run '
+                          'directory')
+    try:
+        if _is_bag(path):
+            return load_bag(path, notes)
+    except OSError as exc:
+        raise ReportError(f'{path}: cannot list it: {exc.strerror}') from None
     params = os.path.join(path, 'params.yaml')
+    arrays = os.path.join(path, 'trajectory.npz')
+    if not os.path.exists(params) and not os.path.exists(arrays):
+        raise ReportError(f'{path}: neither a bag ({METADATA} or an .mcap file) nor a run '
+                          'directory (trajectory.npz and params.yaml)')
     if not os.path.exists(params):
         raise ReportError(f'{path}: no params.yaml: the run cannot be interpreted without the '
                           'parameters it ran with (formation, bound, reference)')
     try:
         config = load_config(params)
     except ParamError as exc:
-        raise ReportError(f'{params}: {exc}') from None
+        raise ReportError(_one_line(str(exc))) from None
     try:
-        trajectory = Trajectory.load(os.path.join(path, 'trajectory.npz'))
-    except ValueError as exc:
-        raise ReportError(str(exc)) from None
-    if trajectory.q.shape[1:] != (config.num_robots, config.dim):
-        raise ReportError(f'{path}: trajectory has {trajectory.q.shape[1]} robots in '
-                          f'{trajectory.q.shape[2]}D but params.yaml says {config.num_robots} '
-                          f'in {config.dim}D')
+        trajectory = Trajectory.load(arrays)
+    # trajectory.npz from the disk: numpy and zipfile raise many kinds of error on a bad file.
+    except Exception as exc:
+        raise ReportError(f'{arrays}: not a readable trajectory '
+                          f'({_one_line(str(exc)) or type(exc).__name__})') from None
+    samples = trajectory.t.shape[0] if trajectory.t.ndim == 1 else 0
+    robots = (samples, config.num_robots, config.dim)
+    expected = {'t': (samples,), 'q': robots, 'u': robots, 'u_hat': robots,
+                'q_desired': robots, 'q_od': (samples, config.dim)}
+    wrong = [f'{name} {getattr(trajectory, name).shape}' for name, shape in expected.items()
+             if getattr(trajectory, name).shape != shape]
+    if not samples or wrong:
+        raise ReportError(f'{arrays}: arrays of the wrong shape for {config.num_robots} robots '
+                          f'in {config.dim}D and {samples} samples: '
+                          f'{", ".join(wrong) or "no samples"}')
     extra = {}
     stats = os.path.join(path, PLANT_STATS_FILE)
     if os.path.exists(stats):
-        with open(stats, encoding='utf-8') as stream:
-            extra = json.load(stream)
+        try:
+            with open(stats, encoding='utf-8') as stream:
+                extra = json.load(stream)
+        except (OSError, ValueError) as exc:
+            raise ReportError(f'{stats}: not readable JSON ({_one_line(str(exc))})') from None
+        if not isinstance(extra, dict):
+            raise ReportError(f'{stats}: not a JSON object')
     return trajectory, config, extra
+
+
+def check_out(out: str) -> Optional[str]:
+    """Return why the report cannot be written to directory ``out``, or None if it can."""
+    if os.path.exists(out):
+        if not os.path.isdir(out):
+            return f'--out {out}: exists and is not a directory'
+        if not os.access(out, os.W_OK | os.X_OK):
+            return f'--out {out}: the directory is not writable'
+        return None
+    parent = os.path.dirname(os.path.abspath(out))
+    while not os.path.exists(parent):
+        parent = os.path.dirname(parent)
+    if not os.path.isdir(parent):
+        return f'--out {out}: cannot be created, {parent} is not a directory'
+    if not os.access(parent, os.W_OK | os.X_OK):
+        return f'--out {out}: cannot be created, {parent} is not writable'
+    return None
 
 
 def write_report(trajectory: Trajectory, config: FormationConfig, out_dir: str,
@@ -110,23 +177,56 @@ def write_report(trajectory: Trajectory, config: FormationConfig, out_dir: str,
     return metrics
 
 
+def _fail(message: str) -> int:
+    print(f'formation_report: {message}', file=sys.stderr)
+    return 2
+
+
 def main(argv: Optional[list] = None) -> int:
     """Entry point of ``formation_report``; returns the exit code."""
     parser = argparse.ArgumentParser(
         prog='formation_report',
         description='Metrics and figures of a recorded formation run.',
-        epilog='Example: formation_report runs/demo/bag --out runs/demo')
-    parser.add_argument('input', help='rosbag2 directory (metadata.yaml + MCAP) or run '
-                                      'directory with trajectory.npz and params.yaml')
-    parser.add_argument('--out', required=True, help='where to write metrics.json and figures')
+        epilog='Examples: formation_report runs/demo/bag --out runs/demo; '
+               'formation_report runs/cut_bag --repair (a bag whose recorder was killed: '
+               'rewritten in place as a whole bag, the damaged files kept as *.damaged)')
+    parser.add_argument('input', help='rosbag2 directory (metadata.yaml + MCAP), .mcap file, '
+                                      'or run directory with trajectory.npz and params.yaml')
+    parser.add_argument('--out', help='where to write metrics.json and figures (required '
+                                      'unless --repair)')
+    parser.add_argument('--repair', action='store_true',
+                        help='make a bag that is not whole (recorder killed, MCAP cut short) '
+                             'whole again in place, keeping the damaged files as *.damaged; '
+                             'then report if --out is given')
     parser.add_argument('--no-plots', action='store_true', help='skip the figures')
     args = parser.parse_args(argv)
+    if args.out is None and not args.repair:
+        parser.error('the following arguments are required: --out (or give --repair)')
+    if args.out is not None:
+        problem = check_out(args.out)
+        if problem is not None:
+            return _fail(problem)
+    if args.repair:
+        try:
+            print(f'formation_report: {repair_bag(args.input)}')
+        except BagError as exc:
+            return _fail(f'cannot repair {args.input}: {_one_line(str(exc))}')
+        except OSError as exc:
+            return _fail(f'cannot repair {args.input}: {exc.strerror or exc}'
+                         f'{f" ({exc.filename})" if exc.filename else ""}')
+        if args.out is None:
+            return 0
+    notes: List[str] = []
     try:
-        trajectory, config, extra = load_run(args.input)
+        trajectory, config, extra = load_run(args.input, notes)
     except ReportError as exc:
-        print(f'formation_report: {exc}', file=sys.stderr)
-        return 2
-    metrics = write_report(trajectory, config, args.out, extra, plots=not args.no_plots)
+        return _fail(_one_line(str(exc)))
+    for note in notes:
+        print(f'formation_report: {note}', file=sys.stderr)
+    try:
+        metrics = write_report(trajectory, config, args.out, extra, plots=not args.no_plots)
+    except OSError as exc:
+        return _fail(f'cannot write the report to {args.out}: {exc.strerror or exc}')
     print(f'formation_report: {args.input}')
     print(format_summary(metrics, args.out))
     return 0
