@@ -25,7 +25,7 @@ ROSDEP_KEYS = {
     'yaml': 'python3-yaml',
 }
 # Imports without an apt package: package.xml must say, in a comment, how to install them.
-PIP_ONLY = {'rosbags': 'pip install rosbags'}
+PIP_ONLY = {'rosbags': 'pip install rosbags', 'mcap': 'pip install mcap'}
 TEST_DEPENDS = ('ament_flake8', 'ament_pep257', 'python3-pytest', 'python3-mypy',
                 'python3-hypothesis')
 
