@@ -25,6 +25,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
 
+MAX_REPULSION = 1e200
+GAIN_MAX = 1e6
+KAPPA_MAX = 1e6
+REPULSION_RANGE = (1e-3, 1e4)
+"""Where every formula stays within double precision (tested): c and kappa up to 1e6, b from 1 mm
+to 10 km (the smooth jump's integrals underflow below, its scaling above)."""
+RADIUS_MAX = 1e150
 PSI_FUNCTIONS: dict[str, tuple[Callable[[NDArray[np.float64]], NDArray[np.float64]], float]] = {
     'arctan': (np.arctan, math.pi / 2.0),
     'tanh': (np.tanh, 1.0),
@@ -55,6 +62,12 @@ class LawParams:
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0.0):
                 raise ValueError(f'{name} must be a finite number > 0, got {value!r}')
+        low, high = REPULSION_RANGE
+        if not (self.gain <= GAIN_MAX and self.kappa <= KAPPA_MAX
+                and low <= self.repulsion_radius <= high):
+            raise ValueError(f'the law is computed for gain <= {GAIN_MAX:g} m/s, kappa <= '
+                             f'{KAPPA_MAX:g} and {low:g} m <= b <= {high:g} m; got gain '
+                             f'{self.gain!r}, kappa {self.kappa!r}, b {self.repulsion_radius!r}')
 
     @property
     def psi_bound(self) -> float:
@@ -91,15 +104,22 @@ def repulsion_terms(q_ij: ArrayLike, law: LawParams) -> NDArray[np.float64]:
 
     q_ij: (K, dim) in m. Returns (K, dim) in 1/m. betabar' = h'/h (eq. 13; docs/equations.md,
     slip 3) is zero for ||q_ij|| >= b. A row with q_ij exactly zero (two robots at one point) has
-    no direction and contributes zero; the callers report such a collision.
+    no direction and contributes zero; the callers report such a collision. Where the term
+    overflows (robots closer than about 1e-150 m, where h'/h is beyond the doubles) it is
+    :data:`MAX_REPULSION` along q_ij: the command saturates at c M1 all the same.
     """
     q_ij = np.asarray(q_ij, dtype=float)
     d2 = np.einsum('kd,kd->k', q_ij, q_ij)
     b = law.repulsion_radius
-    weight = law.jump.ratio(0.5 * d2, 0.0, 0.5 * b * b)
-    with np.errstate(invalid='ignore'):
+    with np.errstate(invalid='ignore', over='ignore', divide='ignore'):
+        weight = law.jump.ratio(0.5 * d2, 0.0, 0.5 * b * b)
         terms: NDArray[np.float64] = weight[:, None] * q_ij
-    terms[d2 == 0.0] = 0.0
+    apart = np.any(q_ij != 0.0, axis=1)
+    huge = apart & ((d2 == 0.0) | ~np.all(np.isfinite(terms), axis=1))
+    if np.any(huge):
+        rows = q_ij[huge] / np.max(np.abs(q_ij[huge]), axis=1, keepdims=True)
+        terms[huge] = MAX_REPULSION * rows / np.linalg.norm(rows, axis=1, keepdims=True)
+    terms[~apart] = 0.0
     return terms
 
 
@@ -142,7 +162,7 @@ def robot_command(q_i: ArrayLike, vertex_i: ArrayLike, neighbours: ArrayLike,
     q_i = np.asarray(q_i, dtype=float)
     neighbours = np.asarray(neighbours, dtype=float).reshape(-1, q_i.shape[0])
     q_ij = q_i[None, :] - neighbours
-    in_range = np.einsum('kd,kd->k', q_ij, q_ij) < sensing_radius ** 2
+    in_range = np.einsum('kd,kd->k', q_ij, q_ij) < min(float(sensing_radius), RADIUS_MAX) ** 2
     q_hat_ij = to_frame_vectors(q_ij[in_range], frame)
     error_hat = to_frame(q_i[None, :], frame)[0] - np.asarray(vertex_i, dtype=float)
     omega_hat = omega(error_hat, repulsion_terms(q_hat_ij, law).sum(axis=0), law)
@@ -166,7 +186,8 @@ def team_command(q: ArrayLike, vertices: ArrayLike, sensing_radii: ArrayLike, la
     q: (N, dim) positions, world frame, m. vertices: (N, dim). sensing_radii: (N,) R_i in m.
     Neighbours are found with a k-d tree within b (betabar' vanishes beyond b and b <= R_i), then
     each robot keeps only those within its own R_i, so a step costs O(N log N).
-    Returns a :class:`Command` with (N, dim) arrays.
+    Returns a :class:`Command` with (N, dim) arrays. Raises ValueError for a non-finite position
+    or robots farther apart than about 1e150 m (the k-d tree cannot search them).
     """
     q = np.asarray(q, dtype=float)
     radii = np.asarray(sensing_radii, dtype=float)

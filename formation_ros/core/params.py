@@ -14,6 +14,7 @@ one :class:`ParamError`.
 """
 
 from dataclasses import dataclass, field
+import math
 from typing import Any, Dict, List, Mapping, Optional, Tuple, Union
 
 from formation_ros.core.declarations import (check_values, Exe, JumpKind, ParamError, PsiKind,
@@ -150,8 +151,8 @@ def _closest_pair(points: NDArray[np.float64]) -> Tuple[float, int, int]:
     from scipy.spatial import cKDTree
     distance, index = cKDTree(points).query(points, k=2)
     i = int(np.argmin(distance[:, 1]))
-    j = int(index[i, 1])
-    return float(distance[i, 1]), min(i, j) + 1, max(i, j) + 1
+    j = int(index[i, 1]) if int(index[i, 1]) != i else int(index[i, 0])
+    return math.dist(points[i], points[j]), min(i, j) + 1, max(i, j) + 1
 
 
 def _start(values: Mapping[str, Any], n: int, dim: int,

@@ -94,19 +94,31 @@ def parse_params_text(text: str, source: str) -> Dict[str, Any]:
     """Parse ROS 2 parameters YAML text (``source`` names it in errors); return flat values."""
     try:
         document = yaml.load(text, Loader=_Loader)
-    except yaml.YAMLError as exc:
-        reason = str(exc).replace('\n', ' ')
-        raise ParamError([(source, f'cannot read it as YAML: {reason}')]) from None
+    except (yaml.YAMLError, ValueError, RecursionError) as exc:
+        reason = ' '.join(str(exc).split()) or type(exc).__name__
+        raise ParamError([(source, f'cannot read it as YAML: {reason[:300]}')]) from None
     section = document.get('/**') if isinstance(document, dict) else None
     if not isinstance(section, dict) or not isinstance(section.get('ros__parameters'), dict):
         raise ParamError([(source, "expected a ROS 2 parameters file with a top-level '/**:' "
                                    "section holding 'ros__parameters:'")])
-    return flatten(section['ros__parameters'])
+    try:
+        return flatten(section['ros__parameters'])
+    except RecursionError:
+        raise ParamError([(source, 'its parameters nest too deep (or contain themselves)')]) \
+            from None
+
+
+class _Dumper(yaml.SafeDumper):
+    """Safe YAML dumper that quotes a string the reader would take for a double (``'1e3'``)."""
+
+
+_Dumper.yaml_implicit_resolvers = _Loader.yaml_implicit_resolvers
 
 
 def dump_params_text(values: Mapping[str, Any]) -> str:
     """Return the ROS 2 parameters YAML (``/**: ros__parameters:``) of flat dotted values."""
-    return str(yaml.safe_dump({'/**': {'ros__parameters': nest(values)}}, sort_keys=True))
+    return str(yaml.dump({'/**': {'ros__parameters': nest(values)}}, Dumper=_Dumper,
+                         sort_keys=True))
 
 
 def write_params_file(path: PathText, values: Mapping[str, Any]) -> None:
