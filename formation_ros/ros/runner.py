@@ -15,7 +15,9 @@ puts its process id and start time into the environment (:data:`LAUNCHER_PID_ENV
 :data:`LAUNCHER_START_ENV`), and when that process is gone, even killed with SIGKILL, the spin
 loop ends the node as on SIGTERM. This works whatever started the node on the launcher's
 behalf (``ros2 run`` puts a process of its own in between). A node started by hand, without
-the variable, watches nothing.
+the variable, watches nothing. prctl(PR_SET_PDEATHSIG) is not used: it reaches only direct
+children, fires when the thread that started the child ends rather than the process, and would
+have to be set in a ``preexec_fn``, which is unsafe in a launcher whose relay threads run.
 """
 
 import os

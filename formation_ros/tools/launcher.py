@@ -52,8 +52,8 @@ in namespace /robot_<i>, all with the same parameters file, the reference node o
 simulated time (/clock). Output lines are prefixed with the node's name. Stops every
 process it started when the duration ends, on Ctrl-C, SIGTERM or SIGHUP (then still writes
 the report of --out / --record), and when the plant, the reference node or the recorder exits
-on its own; what happens when a robot exits on its own is set by --on-exit. Every node ends on
-its own within a fraction of a second if the launcher is killed (even with kill -9).
+on its own; what happens when a robot exits on its own is set by --on-exit. If the launcher
+itself is killed (even with kill -9), every node notices within 0.1 s and stops as on Ctrl-C.
 
 Options:
   --duration S   wall-clock seconds to run; 0 runs until Ctrl-C
@@ -65,7 +65,7 @@ Options:
                  MCAP; DIR must not exist yet), started before the other nodes and stopped
                  after them; at the end formation_report reads the bag and writes
                  metrics.json and the figures (into --out if given, else into DIR)
-  --on-exit MODE  what to do when a robot exits on its own (default: continue):
+  --on-exit MODE what to do when a robot exits on its own (default: continue):
                  continue: the others go on, the dead robot's body stays where it is;
                  stop:     stop every node;
                  respawn:  start the robot again (at most 5 times per robot, then as
