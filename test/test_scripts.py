@@ -5,6 +5,7 @@
 
 import os
 import subprocess
+import sys
 
 import pytest
 
@@ -70,3 +71,98 @@ def test_launcher_names_a_prefix_without_the_package(tmp_path):
     assert result.returncode == 2
     assert f"no {tmp_path / 'no install' / 'lib' / 'formation_ros' / 'plant'}" in result.stderr
     assert len(result.stderr.splitlines()) == 1
+
+
+FAKE_NODE = """#!{python}
+import os, signal, sys, time
+name = os.path.basename(sys.argv[0])
+ns = next((a[len('__ns:='):] for a in sys.argv if a.startswith('__ns:=')), '')
+me = ns.strip('/') or name
+print('up', os.environ.get('FORMATION_LAUNCHER_PID'), flush=True)
+if me == os.environ.get('FAKE_DIES'):
+    sys.exit(3)
+signal.signal(signal.SIGINT, lambda *_: (print('closing', me, flush=True), sys.exit(0)))
+while True:
+    time.sleep(1)
+"""
+
+
+@pytest.fixture
+def fake_install(tmp_path):
+    """Give the test an install prefix whose nodes are tiny Python scripts that need no ROS."""
+    prefix = tmp_path / 'fake install'
+    programs = prefix / 'lib' / 'formation_ros'
+    programs.mkdir(parents=True)
+    for name in ('plant', 'reference', 'robot', 'record'):
+        (programs / name).write_text(FAKE_NODE.format(python=sys.executable))
+        (programs / name).chmod(0o755)
+    sites = prefix / 'lib' / 'python3' / 'site-packages'
+    sites.mkdir(parents=True)
+    (sites / 'formation_ros').symlink_to(os.path.join(ROOT, 'formation_ros'))
+    return prefix
+
+
+def launch_fake(prefix, dies, *options):
+    """Run the launcher on the fake install for 3 s with FAKE_DIES=dies; return its result."""
+    env = dict(os.environ, FAKE_DIES=dies)
+    env.pop('FORMATION_PREFIX', None)
+    return subprocess.run(
+        ['bash', os.path.join(ROOT, 'scripts', 'launch_formation.sh'),
+         os.path.join(ROOT, 'config', 'square_4.yaml'), '--prefix', str(prefix),
+         '--duration', '3', *options], capture_output=True, text=True, timeout=120, env=env)
+
+
+@pytest.mark.faults
+def test_launcher_goes_on_without_a_dead_robot_by_default(fake_install):
+    result = launch_fake(fake_install, 'robot_2')
+    assert result.returncode == 1, result.stderr
+    assert 'robot_2 ended on its own (exit code 3); the others go on' in result.stderr
+    assert result.stderr.rstrip().endswith(
+        'exit code 1: robot_2 ended on its own (exit code 3)'), result.stderr
+    for name in ('plant', 'reference', 'robot_1', 'robot_3', 'robot_4'):
+        assert f'[{name}] closing {name}' in result.stdout, result.stdout
+
+
+@pytest.mark.faults
+def test_launcher_stops_everything_when_a_robot_dies_with_on_exit_stop(fake_install):
+    result = launch_fake(fake_install, 'robot_3', '--on-exit', 'stop')
+    assert result.returncode == 1
+    assert 'robot_3 ended on its own (exit code 3); stopped the others' in result.stderr
+    assert 'the others go on' not in result.stderr
+    assert '[robot_1] closing robot_1' in result.stdout
+
+
+@pytest.mark.faults
+def test_launcher_respawns_a_robot_at_most_five_times(fake_install):
+    result = launch_fake(fake_install, 'robot_2', '--on-exit', 'respawn')
+    assert result.returncode == 1, result.stderr
+    for k in range(1, 6):
+        assert result.stderr.count(f'starting it again (restart {k} of 5)') == 1, result.stderr
+    assert 'after 5 restarts; not starting it again, the others go on' in result.stderr
+    assert result.stdout.count('[robot_2] up') == 6
+    assert 'restarted 5 times' in result.stderr.splitlines()[-1]
+
+
+@pytest.mark.faults
+@pytest.mark.parametrize('essential', ['plant', 'reference'])
+def test_launcher_always_stops_when_plant_or_reference_dies(fake_install, essential):
+    result = launch_fake(fake_install, essential, '--on-exit', 'respawn')
+    assert result.returncode == 1
+    assert f'{essential} ended on its own (exit code 3); stopped the others' in result.stderr
+    assert 'starting it again' not in result.stderr
+
+
+@pytest.mark.faults
+def test_nodes_are_told_the_launcher_process(fake_install):
+    result = launch_fake(fake_install, '')
+    assert result.returncode == 0, result.stderr
+    pids = {line.split()[-1] for line in result.stdout.splitlines() if ' up ' in line}
+    assert len(pids) == 1 and pids.pop().isdigit(), result.stdout
+
+
+def test_launcher_refuses_an_unknown_on_exit_mode():
+    result = run('launch_formation.sh', os.path.join(ROOT, 'config', 'square_4.yaml'),
+                 '--on-exit', 'retry')
+    assert result.returncode == 2
+    assert '--on-exit must be one of continue, stop, respawn' in result.stderr
+    assert '--on-exit' in run('launch_formation.sh', '--help').stdout

@@ -4,6 +4,7 @@
 """Process supervision (formation_ros.tools.supervise) with tiny Python child processes."""
 
 import io
+import os
 import signal
 import sys
 import textwrap
@@ -205,3 +206,45 @@ def test_close_ends_every_process(tmp_path):
     group.close(timeout=5)
     assert not any(alive(pid) for pid in pids)
     assert all(group.exit_info(f'p{k}').stopped for k in range(3))
+
+
+def test_restart_starts_the_same_spec_again(supervisor):
+    supervisor.start(child('worker', 'import sys; print("run", sys.argv[1])', 'x y'))
+    assert supervisor.starts('worker') == 1 and supervisor.starts('other') == 0
+    first = supervisor.wait('worker', 20)
+    assert first is not None and first.returncode == 0 and not first.stopped
+    popen = supervisor.restart('worker')
+    second = supervisor.wait('worker', 20)
+    assert second is not None and second.pid == popen.pid != first.pid
+    assert supervisor.starts('worker') == 2
+    assert supervisor.log('worker') == 'run x y\nrun x y\n'
+    assert [e.name for e in supervisor.exits()] == ['worker', 'worker']
+
+
+def test_restart_refuses_a_running_process(supervisor):
+    supervisor.start(child('worker', SLEEPER))
+    with pytest.raises(ValueError):
+        supervisor.restart('worker')
+    with pytest.raises(KeyError):
+        supervisor.restart('never started')
+
+
+def test_stop_returns_after_the_last_lines(supervisor):
+    supervisor.start(child('slow', """
+        import time
+        print('ready', flush=True)
+        try:
+            time.sleep(120)
+        except KeyboardInterrupt:
+            for k in range(50):
+                print('closing', k, flush=True)
+    """))
+    assert wait_until(lambda: 'ready' in supervisor.log('slow'))
+    supervisor.stop(['slow'], timeout=10)
+    assert supervisor.echo.getvalue().endswith('[slow] closing 49\n')
+
+
+def test_a_child_has_a_session_of_its_own(supervisor):
+    popen = supervisor.start(child('alone', SLEEPER))
+    assert os.getsid(popen.pid) == popen.pid != os.getsid(0)
+    assert os.getpgid(popen.pid) == popen.pid != os.getpgid(0)

@@ -9,12 +9,22 @@ node could log its summary): the handler only records the signal, and the spin l
 wakes at least every :data:`SIGNAL_LATENCY` s even when no timer fires (a sim-time timer whose
 /clock stopped), ends between two callbacks. Then the node's ``finish()`` (if it has one) runs
 while ROS is still up, the node is destroyed and rclpy shut down.
+
+A node started by the launcher also watches the launcher (:class:`LauncherWatch`): the launcher
+puts its process id and start time into the environment (:data:`LAUNCHER_PID_ENV`,
+:data:`LAUNCHER_START_ENV`), and when that process is gone, even killed with SIGKILL, the spin
+loop ends the node as on SIGTERM. This works whatever started the node on the launcher's
+behalf (``ros2 run`` puts a process of its own in between). A node started by hand, without
+the variable, watches nothing. prctl(PR_SET_PDEATHSIG) is not used: it reaches only direct
+children, fires when the thread that started the child ends rather than the process, and would
+have to be set in a ``preexec_fn``, which is unsafe in a launcher whose relay threads run.
 """
 
 import os
 import signal
 import sys
-from typing import Any, Callable, List, Optional
+import time
+from typing import Any, Callable, List, Mapping, Optional
 
 from formation_ros.core.declarations import ParamError
 import rclpy
@@ -25,6 +35,9 @@ from rclpy.signals import SignalHandlerOptions
 SIGNAL_LATENCY = 0.1
 LOCKSTEP_POLL = 0.001
 """Period, s (steady clock), of the timer with which a lockstep node looks for a new state."""
+LAUNCHER_PID_ENV = 'FORMATION_LAUNCHER_PID'
+LAUNCHER_START_ENV = 'FORMATION_LAUNCHER_START'
+"""Process id and start time (clock ticks after boot, /proc/<pid>/stat) of the launcher."""
 
 
 def make_executor() -> Executor:
@@ -46,6 +59,72 @@ class _StopRequest:
     @classmethod
     def handler(cls, signum: int, frame: Any) -> None:
         cls.signal_name = signal.Signals(signum).name
+
+
+def process_start(pid: int) -> Optional[int]:
+    """
+    Return the start time of process ``pid`` in clock ticks after boot; None if it is gone.
+
+    A zombie (ended, not yet reaped by its parent) counts as gone. Where there is no /proc,
+    return 0 for any process that exists.
+    """
+    try:
+        with open(f'/proc/{pid}/stat', 'rb') as stream:
+            fields = stream.read().rsplit(b')', 1)[1].split()
+    except FileNotFoundError:
+        if os.path.isdir('/proc/self'):
+            return None
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return None
+        except PermissionError:
+            pass
+        return 0
+    except (OSError, IndexError):
+        return None
+    # fields[0] is field 3 of proc_pid_stat(5), the state; field 22 is the start time.
+    if fields[0] in (b'Z', b'X'):
+        return None
+    return int(fields[19])
+
+
+class LauncherWatch:
+    """
+    Tells whether the launcher that started this node still runs.
+
+    The launcher is known by its process id together with its start time: once it has ended,
+    its id may be given to an unrelated process, which has another start time. Checks
+    ``/proc`` at most every :data:`SIGNAL_LATENCY` s (a few microseconds each).
+    """
+
+    def __init__(self, pid: int, start: Optional[int]) -> None:
+        """Watch process ``pid`` started at ``start`` ticks (None: its start time now)."""
+        self.pid = pid
+        self.start = process_start(pid) if start is None else start
+        self._next_check = 0.0
+        self._gone = self.start is None
+
+    @classmethod
+    def from_environment(cls, env: Mapping[str, str]) -> Optional['LauncherWatch']:
+        """Return a watch of the launcher named in ``env``; None if there is none."""
+        pid = env.get(LAUNCHER_PID_ENV, '')
+        start = env.get(LAUNCHER_START_ENV, '')
+        if not pid:
+            return None
+        if not pid.isdigit() or (start and not start.isdigit()):
+            print(f'ignoring {LAUNCHER_PID_ENV}={pid!r} {LAUNCHER_START_ENV}={start!r} '
+                  '(not numbers)', file=sys.stderr)
+            return None
+        return cls(int(pid), int(start) if start else None)
+
+    def gone(self) -> bool:
+        """Tell whether the launcher has ended (checked at most every SIGNAL_LATENCY s)."""
+        now = time.monotonic()
+        if not self._gone and now >= self._next_check:
+            self._next_check = now + SIGNAL_LATENCY
+            self._gone = process_start(self.pid) != self.start
+        return self._gone
 
 
 def _params_files(args: List[str]) -> List[str]:
@@ -70,13 +149,15 @@ def run(node_class: Callable[[], Node], args: Optional[List[str]] = None,
     """
     Start rclpy, build the node, spin until SIGINT/SIGTERM, shut down without a traceback.
 
-    Returns the exit code: 0, or 2 for invalid parameters (one line per bad parameter) or a
-    command line rclpy cannot start from.
+    The spin also ends when the launcher named in the environment is gone (see
+    :class:`LauncherWatch`). Returns the exit code: 0, or 2 for invalid parameters (one line
+    per bad parameter) or a command line rclpy cannot start from.
     """
     if not _init(args, name):
         return 2
     signal.signal(signal.SIGINT, _StopRequest.handler)
     signal.signal(signal.SIGTERM, _StopRequest.handler)
+    launcher = LauncherWatch.from_environment(os.environ)
     node = executor = None
     code = 0
     try:
@@ -85,6 +166,10 @@ def run(node_class: Callable[[], Node], args: Optional[List[str]] = None,
         executor.add_node(node)
         while rclpy.ok() and _StopRequest.signal_name is None:
             executor.spin_once(timeout_sec=SIGNAL_LATENCY)
+            if launcher is not None and launcher.gone():
+                node.get_logger().warning(
+                    f'the launcher (process {launcher.pid}) is gone; stopping')
+                break
     except ParamError as exc:
         logger = rclpy.logging.get_logger(name)
         for line in str(exc).splitlines():

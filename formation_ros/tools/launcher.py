@@ -8,10 +8,15 @@ The formation launcher: plant, reference node, N robots and optionally the recor
 with an interpreter that can import the installed package; the options and messages are those
 of :data:`USAGE`. Every node runs under :class:`formation_ros.tools.supervise.Supervisor`, its
 output prefixed with its name. The run ends when the duration is over, on SIGINT, SIGTERM or
-SIGHUP (the terminal closed), or when a node ends on its own (exit code 1); the nodes are then
-stopped in order (robots, reference and plant together, the recorder last) and, with ``--out``
-or ``--record``, ``formation_report`` writes the metrics and figures. Exit codes: 0 done, 1 a
-node died or the report failed, 2 bad usage or parameters.
+SIGHUP (the terminal closed), when the plant, the reference node or the recorder ends on its
+own, or when a robot does with ``--on-exit stop`` (a robot that ends on its own is otherwise
+left out or restarted); the nodes are then stopped in order (robots, reference and plant
+together, the recorder last) and, with ``--out`` or ``--record``, ``formation_report`` writes
+the metrics and figures. Exit codes: 0 done, 1 a node died or the report failed, 2 bad usage
+or parameters.
+
+The nodes watch the launcher through :data:`LAUNCHER_PID_ENV` and :data:`LAUNCHER_START_ENV`
+(``formation_ros.ros.runner``), so they end on their own when it is killed with SIGKILL.
 """
 
 import dataclasses
@@ -32,17 +37,23 @@ PACKAGE = 'formation_ros'
 STOP_TIMEOUT = 10.0
 RECORDER_START_TIMEOUT = 15.0
 POLL = 0.2
+ON_EXIT = ('continue', 'stop', 'respawn')
+MAX_RESTARTS = 5
+ESSENTIAL = ('plant', 'reference', 'record')
+LAUNCHER_PID_ENV = 'FORMATION_LAUNCHER_PID'
+LAUNCHER_START_ENV = 'FORMATION_LAUNCHER_START'
 
 USAGE = """\
 Usage: scripts/launch_formation.sh PARAMS.yaml [--duration S] [--out DIR] [--record DIR]
-                                   [--prefix DIR]
+                                   [--on-exit continue|stop|respawn] [--prefix DIR]
 
 Starts the plant, the reference node and N robot nodes (N = num_robots in PARAMS.yaml), robot i
 in namespace /robot_<i>, all with the same parameters file, the reference node on the plant's
 simulated time (/clock). Output lines are prefixed with the node's name. Stops every
-process it started when the duration ends, on Ctrl-C or on SIGTERM (then still writes the
-report of --out / --record), and when any node exits on its own (then with a non-zero exit
-code).
+process it started when the duration ends, on Ctrl-C, SIGTERM or SIGHUP (then still writes
+the report of --out / --record), and when the plant, the reference node or the recorder exits
+on its own; what happens when a robot exits on its own is set by --on-exit. If the launcher
+itself is killed (even with kill -9), every node notices within 0.1 s and stops as on Ctrl-C.
 
 Options:
   --duration S   wall-clock seconds to run; 0 runs until Ctrl-C
@@ -54,12 +65,22 @@ Options:
                  MCAP; DIR must not exist yet), started before the other nodes and stopped
                  after them; at the end formation_report reads the bag and writes
                  metrics.json and the figures (into --out if given, else into DIR)
+  --on-exit MODE what to do when a robot exits on its own (default: continue):
+                 continue: the others go on, the dead robot's body stays where it is;
+                 stop:     stop every node;
+                 respawn:  start the robot again (at most 5 times per robot, then as
+                           continue); it rejoins the formation
+                 A plant, reference or recorder exit always stops the run. In every mode the
+                 exit code is 1 if any node exited on its own, with a line naming it.
   --prefix DIR   install space of formation_ros (default: found from 'ros2', AMENT_PREFIX_PATH
                  or ./install/formation_ros)
   -h, --help     show this help
 
 Executables: 'ros2 run formation_ros <exe>' where the ros2 command knows the package, else
 <prefix>/lib/formation_ros/<exe> with the install's Python path set, as 'ros2 run' would.
+
+Exit codes: 0 done, 1 a node exited on its own or the report failed, 2 bad usage or
+parameters.
 """
 
 
@@ -96,12 +117,13 @@ class Options:
     out: Optional[str] = None
     record: Optional[str] = None
     prefix: Optional[str] = None
+    on_exit: str = 'continue'
 
 
 def parse_args(argv: Sequence[str]) -> Optional[Options]:
     """Parse the command line as the shell launcher always has; None for --help."""
     needs = {'duration': 'seconds', 'out': 'a directory', 'record': 'a directory',
-             'prefix': 'a directory'}
+             'prefix': 'a directory', 'on-exit': '|'.join(ON_EXIT)}
     values: dict[str, Optional[str]] = dict.fromkeys(needs)
     params = None
     args = list(argv)
@@ -126,9 +148,12 @@ def parse_args(argv: Sequence[str]) -> Optional[Options]:
     duration = values['duration']
     if duration is not None and not re.fullmatch(r'[0-9]+([.][0-9]+)?', duration):
         raise UsageError(f"--duration must be a number of seconds >= 0, got '{duration}'")
+    on_exit = values['on-exit'] or ON_EXIT[0]
+    if on_exit not in ON_EXIT:
+        raise UsageError(f"--on-exit must be one of {', '.join(ON_EXIT)}, got '{on_exit}'")
     prefix = values['prefix'] or os.environ.get('FORMATION_PREFIX') or None
     return Options(params, None if duration is None else float(duration), values['out'],
-                   values['record'], prefix)
+                   values['record'], prefix, on_exit)
 
 
 def check_paths(options: Options) -> Options:
@@ -229,6 +254,23 @@ def recorder_spec(install: Install, options: Options, env: Mapping[str, str]) ->
         env)
 
 
+def watch_environment(pid: int) -> dict[str, str]:
+    """
+    Return the variables with which the nodes watch process ``pid`` and end when it is gone.
+
+    The process id and its start time (clock ticks after boot, field 22 of /proc/PID/stat;
+    left out where there is no /proc): together they name one process, even once the id has
+    been given to another.
+    """
+    env = {LAUNCHER_PID_ENV: str(pid)}
+    try:
+        with open(f'/proc/{pid}/stat', 'rb') as stream:
+            env[LAUNCHER_START_ENV] = stream.read().rsplit(b')', 1)[1].split()[19].decode()
+    except (OSError, IndexError):
+        pass
+    return env
+
+
 class Launch:
     """One run: starts the nodes, watches them and the clock, stops them in order."""
 
@@ -240,9 +282,11 @@ class Launch:
         self.num_robots = num_robots
         self.wall_seconds = wall_seconds
         self.env = install.environment(os.environ)
+        self.env.update(watch_environment(os.getpid()))
         self.supervisor = Supervisor(echo=sys.stdout, env=self.env)
         self.interrupted: Optional[str] = None
         self.failure: Optional[str] = None
+        self.restarts: dict[str, int] = {}
 
     def on_signal(self, signum: int, frame: object) -> None:
         """Note SIGINT, SIGTERM or SIGHUP; the main loop then stops the nodes."""
@@ -260,11 +304,30 @@ class Launch:
             if self.failure is not None:
                 say(f'{self.failure}; stopped the others')
                 return 1
-            return self.report()
+            code = self.report()
+            died = self.died_on_their_own()
+            if died:
+                say(f'exit code 1: {died}')
+                return 1
+            return code
         finally:
             self.supervisor.close()
             for sig, handler in previous.items():
                 signal.signal(sig, handler)
+
+    def died_on_their_own(self) -> str:
+        """Name the nodes that ended on their own and why ('' if none did)."""
+        deaths: dict[str, list[str]] = {}
+        for info in self.supervisor.exits():
+            if not info.stopped:
+                deaths.setdefault(info.name, []).append(info.reason)
+        parts = []
+        for name, reasons in deaths.items():
+            restarts = self.restarts.get(name, 0)
+            restarted = (', restarted once' if restarts == 1
+                         else f', restarted {restarts} times' if restarts else '')
+            parts.append(f"{name} ended on its own ({', '.join(reasons)}{restarted})")
+        return '; '.join(parts)
 
     def stop(self) -> None:
         """Stop robots, reference and plant together, then the recorder."""
@@ -300,12 +363,41 @@ class Launch:
         return True
 
     def _died(self, timeout: float) -> bool:
-        """Wait up to ``timeout`` s for a node to end on its own; True (noted) if one did."""
+        """
+        Wait up to ``timeout`` s for a node to end on its own; True if the run must stop.
+
+        A plant, reference or recorder exit stops the run, and so does a robot's with
+        ``--on-exit stop`` (noted in :attr:`failure`); otherwise the robot is left out or
+        restarted (``--on-exit respawn``, at most :data:`MAX_RESTARTS` times), saying so.
+        """
         ended = self.supervisor.wait_exit(timeout)
         if ended is None or ended.stopped:
             return False
-        self.failure = f'{ended.name} ended first ({ended.reason})'
-        return True
+        name, mode = ended.name, self.options.on_exit
+        if name in ESSENTIAL or mode == 'stop':
+            self.failure = f'{name} ended on its own ({ended.reason})'
+            return True
+        restarts = self.restarts.get(name, 0)
+        if mode == 'respawn' and restarts < MAX_RESTARTS:
+            self.restarts[name] = restarts + 1
+            say(f'{name} ended on its own ({ended.reason}); starting it again '
+                f'(restart {restarts + 1} of {MAX_RESTARTS})')
+            try:
+                self.supervisor.restart(name)
+                return False
+            except OSError as exc:
+                say(f'cannot start {name} again: {exc}')
+        elif mode == 'respawn':
+            say(f'{name} ended on its own ({ended.reason}) after {MAX_RESTARTS} restarts; '
+                'not starting it again, the others go on')
+        else:
+            say(f'{name} ended on its own ({ended.reason}); the others go on '
+                '(--on-exit continue)')
+        if not any(self.supervisor.running(other) for other in self.supervisor.names()
+                   if other not in ESSENTIAL):
+            self.failure = 'every robot has ended'
+            return True
+        return False
 
     def _wait_for_recorder(self) -> bool:
         """Wait until the recorder has created its bag directory; False if it did not."""

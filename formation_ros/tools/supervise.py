@@ -11,7 +11,12 @@ thread per process records its exit the moment it happens, so the supervisor kno
 process ended first on its own and why (exit code or signal), and at that moment kills what
 is left of its process group, so no child of a supervised process outlives it. Stopping sends
 SIGINT to whole process groups at once, waits until one deadline, then sends SIGKILL to the
-groups whose leader is still running.
+groups whose leader is still running, and returns once their last output lines are relayed.
+Because every process has a session of its own, a Ctrl-C in the supervisor's terminal reaches
+the supervisor alone, which stops the processes while it still relays their output.
+
+The supervisor cannot clean up after itself if it is killed with SIGKILL: the processes then
+have to notice on their own (the nodes watch the launcher, see ``formation_ros.ros.runner``).
 
 Commands are argv lists, never shell strings, so paths may contain spaces.
 """
@@ -131,6 +136,7 @@ class Supervisor:
         self._processes: dict[str, _Running] = {}
         self._exits: queue.Queue[ExitInfo] = queue.Queue()
         self._ended: list[ExitInfo] = []
+        self._starts: dict[str, int] = {}
         if log_dir is not None:
             os.makedirs(log_dir, exist_ok=True)
 
@@ -175,9 +181,23 @@ class Supervisor:
                                           name=f'wait {spec.name}', daemon=True)
         with self._state_lock:
             self._processes[spec.name] = running
+            self._starts[spec.name] = self._starts.get(spec.name, 0) + 1
         running.reader.start()
         running.waiter.start()
         return popen
+
+    def restart(self, name: str) -> 'subprocess.Popen[bytes]':
+        """
+        Start process ``name`` again with the spec it was last started with; return its Popen.
+
+        Raises ValueError while it is still running.
+        """
+        return self.start(self._get(name).spec)
+
+    def starts(self, name: str) -> int:
+        """Return how many times a process named ``name`` has been started (0: never)."""
+        with self._state_lock:
+            return self._starts.get(name, 0)
 
     def log_path(self, name: str) -> str:
         """Return the log file of process ``name``; raises ValueError without a log_dir."""
@@ -255,6 +275,7 @@ class Supervisor:
 
         Sends ``sig`` to every one's process group at once, waits until ``timeout`` seconds
         from now for them to end, then sends SIGKILL to the groups of those still running.
+        Returns once their last output lines have been relayed (or after a short wait).
         """
         stage = [self._get(name) for name in names]
         for running in stage:
@@ -266,6 +287,10 @@ class Supervisor:
             if not running.ended.wait(max(0.0, deadline - time.monotonic())):
                 _signal_group(running.popen.pid, signal.SIGKILL)
                 running.ended.wait(KILL_WAIT)
+        relay_deadline = time.monotonic() + READER_JOIN
+        for running in stage:
+            if running.ended.is_set() and running.reader is not None:
+                running.reader.join(max(0.0, relay_deadline - time.monotonic()))
         return [running.exit for running in stage if running.exit is not None]
 
     def stop_all(self, order: Sequence[Sequence[str]] = (), timeout: float = 10.0) -> None:
