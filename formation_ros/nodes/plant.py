@@ -50,6 +50,7 @@ from visualization_msgs.msg import MarkerArray
 RESEND_AFTER = 0.05
 PATH_LENGTH = 100
 CHUNK_PERIOD = 1.0
+DUPLICATE_GRACE = 25.0
 
 
 class PlantNode(Node):
@@ -79,6 +80,7 @@ class PlantNode(Node):
         self.closest = self.model.closest_pair_distance()
         self.largest_u_hat = 0.0
         self.command_subs = []
+        self.shared_since: Dict[int, float] = {}
         self.last_publish_wall = 0.0
         self.started_wall: Optional[float] = None
         self.waiting = settings.wait_for_robots or self.lockstep
@@ -253,8 +255,7 @@ class PlantNode(Node):
             if robots:
                 values[f'robots with {status.name.lower().replace("_", "-")} commands'] = \
                     ', '.join(f'{robot}: {steps}' for robot, steps in robots.items())
-        shared = [i + 1 for i, sub in enumerate(self.command_subs)
-                  if sub.get_publisher_count() > 1]
+        shared = self._shared_command_topics(now)
         for robot in shared:
             self.once.start(f'publishers-{robot}', f'robot {robot}: its cmd_vel has more than '
                                                    'one publisher (a second node with this '
@@ -272,6 +273,21 @@ class PlantNode(Node):
         else:
             level, message = 'ok', 'running'
         self.diagnostics_pub.publish(diagnostics('formation_ros/plant', level, message, values))
+
+    def _shared_command_topics(self, now: float) -> List[int]:
+        """
+        Return the robots whose cmd_vel has had more than one publisher for DUPLICATE_GRACE s.
+
+        A robot restarted after a hard kill shares its topic with the dead process's publisher
+        until DDS lets go of it (about 20 s with Fast DDS's default lease): not a duplicate.
+        """
+        for i, subscription in enumerate(self.command_subs):
+            if subscription.get_publisher_count() > 1:
+                self.shared_since.setdefault(i + 1, now)
+            else:
+                self.shared_since.pop(i + 1, None)
+        return [robot for robot, since in sorted(self.shared_since.items())
+                if now - since >= DUPLICATE_GRACE]
 
     def on_markers(self) -> None:
         """Publish the RViz picture: robots, sensing and repulsion zones, formation, paths."""

@@ -243,7 +243,8 @@ def node_specs(install: Install, options: Options, num_robots: int,
     for i in range(1, num_robots + 1):
         specs.append(ProcessSpec(f'robot_{i}', install.command('robot') + [
             '--ros-args', '-r', f'__ns:=/robot_{i}', '-p', f'robot_id:={i}',
-            '--params-file', options.params, '-p', f'wait_for_subscribers:={waits}'], env))
+            '--params-file', options.params, '-p', f'wait_for_subscribers:={waits}',
+            '-p', 'use_sim_time:=true'], env))
     return specs
 
 
