@@ -31,6 +31,7 @@ import rclpy
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
+import yaml
 
 SIGNAL_LATENCY = 0.1
 LOCKSTEP_POLL = 0.001
@@ -131,8 +132,33 @@ def _params_files(args: List[str]) -> List[str]:
     return [args[k + 1] for k, arg in enumerate(args[:-1]) if arg == '--params-file']
 
 
+def params_file_problem(path: str) -> Optional[str]:
+    """Return what keeps ``path`` from being a parameters file (missing, empty, not YAML)."""
+    try:
+        with open(path, encoding='utf-8') as stream:
+            text = stream.read()
+    except FileNotFoundError:
+        return 'not found'
+    except (OSError, UnicodeDecodeError) as exc:
+        return f'cannot be read ({exc})'
+    if not text.strip():
+        return 'is empty'
+    try:
+        document = yaml.safe_load(text)
+    except (yaml.YAMLError, ValueError, RecursionError) as exc:
+        return 'is not YAML: ' + ' '.join(str(exc).split())[:200]
+    if not isinstance(document, dict):
+        return 'is not a ROS 2 parameters file (no mapping of node names to ros__parameters)'
+    return None
+
+
 def _init(args: Optional[List[str]], name: str) -> bool:
     """Start rclpy; on a bad command line or parameters file say so in one line, False."""
+    for path in _params_files(sys.argv if args is None else args):
+        problem = params_file_problem(path)
+        if problem:
+            print(f'{name}: parameters file {path} {problem}', file=sys.stderr)
+            return False
     try:
         rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)
     except Exception as exc:  # noqa: B902 - rclpy raises its C layer's RCLError here

@@ -5,13 +5,14 @@
 
 import json
 import math
+import subprocess
 
 from formation_ros.core.law import robot_command
 from formation_ros.core.params import load_config
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.ros import fields, messages, qos
 from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
-from helpers import node, SimClock, SQUARE, wait_exit, watch_commands
+from helpers import exe, node, SimClock, SQUARE, wait_exit, watch_commands
 from nav_msgs.msg import Odometry
 import numpy as np
 import pytest
@@ -148,3 +149,16 @@ def test_two_publishers_on_one_cmd_vel_are_reported(processes, install, probe):
                             START_UP), processes.log('plant')
     assert processes.log('plant').count('more than one publisher') == 1
     assert not math.isnan(BOUND)
+
+
+@pytest.mark.parametrize('content', [None, '', 'garbage: [\n', '- a list\n'])
+def test_a_bad_parameters_file_is_one_line_and_exit_2(install, ros_env, tmp_path, content):
+    path = tmp_path / 'params.yaml'
+    if content is not None:
+        path.write_text(content)
+    for name in ('plant', 'robot', 'reference', 'record'):
+        result = subprocess.run([exe(install, name), '--ros-args', '--params-file', str(path)],
+                                env=ros_env, capture_output=True, text=True, timeout=60)
+        assert result.returncode == 2, (name, result.stderr)
+        lines = [line for line in (result.stdout + result.stderr).splitlines() if line]
+        assert len(lines) == 1 and str(path) in lines[0], (name, lines)
