@@ -31,7 +31,7 @@ from formation_ros.core.declarations import ParamError
 from formation_ros.core.params import FormationConfig, load_config, validate
 from formation_ros.core.params_file import parse_params_text
 from formation_ros.core.plant import PLANT_STATS_FILE
-from formation_ros.core.trajectory import Trajectory
+from formation_ros.core.trajectory import CHUNKS_DIR, read_chunks, Trajectory
 from formation_ros.ros import topics as names
 from formation_ros.ros.bag_writer import BagError, PARAMS_FILE
 from formation_ros.tools.bag import (bag_params_text, mcap_files, METADATA, plant_status,
@@ -87,6 +87,27 @@ def _is_bag(path: str) -> bool:
     return os.path.isfile(os.path.join(path, METADATA)) or bool(mcap_files(path))
 
 
+def _load_chunks(path: str, params: str, chunks: str, notes: Optional[List[str]]) -> Loaded:
+    """A run whose plant was cut short: its trajectory from the chunks it wrote as it ran."""
+    try:
+        config = load_config(params)
+        t, q, u = read_chunks(chunks)
+    except ParamError as exc:
+        raise ReportError(_one_line(str(exc))) from None
+    except ValueError as exc:
+        raise ReportError(_one_line(str(exc))) from None
+    if q.shape[1:] != (config.num_robots, config.dim):
+        raise ReportError(f'{chunks}: {q.shape[1]} robots in {q.shape[2]}D, but params.yaml '
+                          f'says {config.num_robots} in {config.dim}D')
+    reference = config.reference()
+    trajectory = Trajectory.from_frames(t, q, u, [reference.sample(s) for s in t],
+                                        config.vertices)
+    if notes is not None:
+        notes.append(f'{path}: no trajectory.npz (the plant did not finish): rebuilt '
+                     f'{len(t)} samples up to t = {t[-1]:.2f} s from {CHUNKS_DIR}/')
+    return trajectory, config, {'recovered_samples': int(len(t))}
+
+
 def load_run(path: str, notes: Optional[List[str]] = None) -> Loaded:
     """Return (Trajectory, FormationConfig, extra metrics) of a bag or a run directory."""
     if not os.path.exists(path):
@@ -103,6 +124,9 @@ def load_run(path: str, notes: Optional[List[str]] = None) -> Loaded:
         raise ReportError(f'{path}: cannot list it: {exc.strerror}') from None
     params = os.path.join(path, 'params.yaml')
     arrays = os.path.join(path, 'trajectory.npz')
+    chunks = os.path.join(path, CHUNKS_DIR)
+    if not os.path.exists(arrays) and os.path.isdir(chunks) and os.path.exists(params):
+        return _load_chunks(path, params, chunks, notes)
     if not os.path.exists(params) and not os.path.exists(arrays):
         raise ReportError(f'{path}: neither a bag ({METADATA} or an .mcap file) nor a run '
                           'directory (trajectory.npz and params.yaml)')

@@ -5,6 +5,7 @@
 
 import json
 import math
+import signal
 import subprocess
 
 from formation_ros.core.law import robot_command
@@ -162,3 +163,27 @@ def test_a_bad_parameters_file_is_one_line_and_exit_2(install, ros_env, tmp_path
         assert result.returncode == 2, (name, result.stderr)
         lines = [line for line in (result.stdout + result.stderr).splitlines() if line]
         assert len(lines) == 1 and str(path) in lines[0], (name, lines)
+
+
+def test_a_killed_plant_loses_at_most_its_last_second(processes, install, probe, tmp_path):
+    """SIGKILL of the plant: formation_report rebuilds the run from the chunks it wrote."""
+    out = tmp_path / 'run'
+    out.mkdir()
+    (out / 'params.yaml').write_text(open(SQUARE).read())
+    clock = SimClock(probe)
+    processes.start(node(install, 'plant', SQUARE, '-p', f'plant.output_dir:={out}'))
+    processes.start(node(install, 'reference', SQUARE, '-p', 'use_sim_time:=true'))
+    start_robots(processes, install, 4)
+    assert probe.spin_until(lambda: clock.seconds >= 4.0, START_UP), processes.log('plant')
+    [killed] = processes.stop(['plant'], sig=signal.SIGKILL)
+    assert killed.signal_name == 'SIGKILL'
+    reached = clock.seconds
+    assert not (out / 'trajectory.npz').exists()
+    result = subprocess.run([exe(install, 'formation_report'), str(out), '--out',
+                             str(tmp_path / 'report'), '--no-plots'], env=processes.env,
+                            capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert 'rebuilt' in result.stderr and 'Traceback' not in result.stderr
+    metrics = json.loads((tmp_path / 'report' / 'metrics.json').read_text())
+    assert metrics['duration'] >= reached - 1.5, (metrics['duration'], reached)
+    assert metrics['max_abs_u_hat_component'] <= BOUND
