@@ -88,7 +88,7 @@ def _is_bag(path: str) -> bool:
 
 
 def _load_chunks(path: str, params: str, chunks: str, notes: Optional[List[str]]) -> Loaded:
-    """A run whose plant was cut short: its trajectory from the chunks it wrote as it ran."""
+    """Load a run whose plant was cut short: its trajectory from the chunks it wrote."""
     try:
         config = load_config(params)
         t, q, u = read_chunks(chunks)
