@@ -46,14 +46,15 @@ def write_params(folder, source, changes, name='params.yaml'):
 
 
 def launch(processes, install, params, out=None, record=None, duration=0, env=None,
-           name='launcher'):
+           name='launcher', options=()):
     """
     Start ``scripts/launch_formation.sh`` as process ``name``; return its Popen.
 
     install: passed as ``--prefix`` (None: the launcher finds the executables itself).
     duration: the launcher's ``--duration``; the default 0 runs until :func:`stop_when`.
+    options: more launcher options, e.g. ``('--on-exit', 'respawn')``.
     """
-    args = ['bash', LAUNCHER, str(params), '--duration', str(duration)]
+    args = ['bash', LAUNCHER, str(params), '--duration', str(duration), *options]
     if install is not None:
         args += ['--prefix', str(install)]
     if out is not None:

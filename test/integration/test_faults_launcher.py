@@ -20,8 +20,7 @@ from formation_ros.core.declarations import Exe
 from formation_ros.core.params import load_config
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.ros.runner import LauncherWatch, process_start
-from formation_ros.tools.supervise import ProcessSpec
-from helpers import (exe, LAUNCHER, project_processes, SimClock, SQUARE, START_UP, stop_when,
+from helpers import (exe, launch, project_processes, SimClock, SQUARE, START_UP, stop_when,
                      wait_exit, watch_commands)
 import numpy as np
 import pytest
@@ -34,14 +33,7 @@ GONE_WITHIN = 10.0
 
 def launch_with(processes, install, *options, out=None, record=None, env=None):
     """Start the launcher on the square formation until Ctrl-C with ``options``; its Popen."""
-    args = ['bash', LAUNCHER, SQUARE, '--duration', '0', *options]
-    if install is not None:
-        args += ['--prefix', str(install)]
-    if out is not None:
-        args += ['--out', str(out)]
-    if record is not None:
-        args += ['--record', str(record)]
-    return processes.start(ProcessSpec('launcher', args, env))
+    return launch(processes, install, SQUARE, out=out, record=record, env=env, options=options)
 
 
 def robot_pids(install, robot):
