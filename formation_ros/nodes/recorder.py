@@ -7,8 +7,8 @@ Recorder node (executable ``record``): every formation topic into a rosbag2 (MCA
 Subscribes with ``raw=True`` (the serialized CDR bytes, no deserialise/serialise round trip) and
 with the reliability and durability of each publisher (best effort for poses and neighbours,
 transient local for the reference) but a deep history, stores the bytes in its callbacks and
-writes them to the bag from a timer, every 0.2 s, each time as a complete MCAP chunk handed to
-the operating system: a recorder killed with SIGKILL loses at most the last 0.2 s, and
+writes them to the bag from a timer, every second, each time as a complete MCAP chunk handed
+to the operating system: a recorder killed with SIGKILL loses at most the last second, and
 ``formation_report`` recovers the rest (``--repair`` makes the bag whole again). Robot i's
 ``cmd_vel`` is subscribed only once the recorder's own readers of its ``pose`` and
 ``neighbors`` have matched a publisher: a robot that waits for the recorder on ``cmd_vel``
@@ -39,7 +39,9 @@ from rclpy.qos import QoSProfile
 from rosgraph_msgs.msg import Clock as ClockMsg
 from visualization_msgs.msg import MarkerArray
 
-FLUSH_PERIOD = 0.2
+FLUSH_PERIOD = 1.0
+"""Seconds between chunks. Each chunk's index stays in memory until the bag is closed (about 3 KB
+with every topic in it): shorter periods grow the recorder faster (0.2 s: 19 % in 30 minutes)."""
 MATCH_PERIOD = 0.02
 MESSAGE_CLASSES = {
     'geometry_msgs/msg/PoseStamped': PoseStamped,
