@@ -98,7 +98,7 @@ def test_cli_writes_trajectory_metrics_and_figures(tmp_path):
     out = tmp_path / 'run'
     result = run_cli(SECTION5, '--out', str(out), '--duration', '8')
     assert result.returncode == 0, result.stderr
-    assert 'settle time' in result.stdout
+    assert 'settle time' in result.stdout and 'reference fixed' in result.stdout
     trajectory = Trajectory.load(str(out / 'trajectory.npz'))
     assert trajectory.q.shape == (801, 10, 2) and trajectory.t[-1] == pytest.approx(8.0)
     metrics = json.loads((out / 'metrics.json').read_text())

@@ -47,21 +47,33 @@ class Exe(enum.Enum):
     RECORD = 'record'
 
 
-class PsiKind(str, enum.Enum):
+class Choice(str, enum.Enum):
+    """A string parameter's allowed value: compares, prints and formats as that string."""
+
+    def __str__(self) -> str:
+        """Return the value, e.g. 'arctan'."""
+        return str(self.value)
+
+    def __format__(self, spec: str) -> str:
+        """Format the value, e.g. f'{kind}' gives 'circle'."""
+        return format(str(self.value), spec)
+
+
+class PsiKind(Choice):
     """Bounded function psi of eq. (14): ``controller.psi``."""
 
     ARCTAN = 'arctan'
     TANH = 'tanh'
 
 
-class JumpKind(str, enum.Enum):
+class JumpKind(Choice):
     """Jump function of Lemma 1: ``jump.kind``."""
 
     POLY = 'poly'
     SMOOTH = 'smooth'
 
 
-class ReferenceKind(str, enum.Enum):
+class ReferenceKind(Choice):
     """Desired formation trajectory: ``reference.kind``."""
 
     FIXED = 'fixed'

@@ -164,7 +164,7 @@ def simulate_fixed_step(config: FormationConfig, duration: float, dt: float,
 
 def run_metrics(trajectory: Trajectory, config: FormationConfig, integrator: str) -> dict:
     """metrics.json content for a simulated trajectory."""
-    extra = {'reference_kind': config.reference_kind, 'integrator': integrator}
+    extra = {'reference_kind': config.reference_kind.value, 'integrator': integrator}
     return compute_metrics(trajectory.t, trajectory.q, trajectory.u, trajectory.u_hat,
                            trajectory.q_desired, config.law().u_bound, extra)
 
