@@ -78,13 +78,19 @@ import os, signal, sys, time
 name = os.path.basename(sys.argv[0])
 ns = next((a[len('__ns:='):] for a in sys.argv if a.startswith('__ns:=')), '')
 me = ns.strip('/') or name
+signal.signal(signal.SIGINT, lambda *_: (print('closing', me, flush=True), sys.exit(0)))
+up = os.environ['FAKE_UP_DIR']
+open(os.path.join(up, me), 'w').close()
 print('up', os.environ.get('FORMATION_LAUNCHER_PID'), flush=True)
 if me == os.environ.get('FAKE_DIES'):
+    deadline = time.monotonic() + 60.0
+    while len(os.listdir(up)) < 6 and time.monotonic() < deadline:
+        time.sleep(0.01)
     sys.exit(3)
-signal.signal(signal.SIGINT, lambda *_: (print('closing', me, flush=True), sys.exit(0)))
 while True:
     time.sleep(1)
 """
+"""A fake node: ready for Ctrl-C before it says it is up; the one that dies waits for all six."""
 
 
 @pytest.fixture
@@ -103,13 +109,15 @@ def fake_install(tmp_path):
 
 
 def launch_fake(prefix, dies, *options):
-    """Run the launcher on the fake install for 3 s with FAKE_DIES=dies; return its result."""
-    env = dict(os.environ, FAKE_DIES=dies)
+    """Run the launcher on the fake install for 10 s with FAKE_DIES=dies; return its result."""
+    up = prefix.parent / 'up'
+    up.mkdir(exist_ok=True)
+    env = dict(os.environ, FAKE_DIES=dies, FAKE_UP_DIR=str(up))
     env.pop('FORMATION_PREFIX', None)
     return subprocess.run(
         ['bash', os.path.join(ROOT, 'scripts', 'launch_formation.sh'),
          os.path.join(ROOT, 'config', 'square_4.yaml'), '--prefix', str(prefix),
-         '--duration', '3', *options], capture_output=True, text=True, timeout=120, env=env)
+         '--duration', '10', *options], capture_output=True, text=True, timeout=120, env=env)
 
 
 @pytest.mark.faults
