@@ -5,6 +5,7 @@
 
 import json
 import os
+import shutil
 import subprocess
 import sys
 
@@ -79,15 +80,16 @@ def odometry_msg(stamp_ns, frame, dim):
 
 
 def write_run_as_bag(path, config, trajectory, with_params=True, flush_every=0,
-                     on_flush=None):
+                     on_flush=None, flushes_per_file=0):
     """
     Write a simulated run as the recorder would record it.
 
     flush_every: flush the bag after every that many samples, as the recorder's timer does,
     calling ``on_flush(bag)`` after each flush (the bag is still open: what SIGKILL would leave).
+    flushes_per_file: start a new MCAP file after that many flushes (0: one file).
     """
     reference = config.reference()
-    with BagWriter(path) as bag:
+    with BagWriter(path, flushes_per_file=flushes_per_file) as bag:
         for i in range(1, config.num_robots + 1):
             bag.add_topic(f'/robot_{i}/pose', 'geometry_msgs/msg/PoseStamped')
             bag.add_topic(f'/robot_{i}/cmd_vel', 'geometry_msgs/msg/TwistStamped')
@@ -139,6 +141,61 @@ def test_metadata_counts_equal_messages_read(tmp_path):
         metadata = yaml.safe_load(stream)['rosbag2_bagfile_information']
     assert metadata['storage_identifier'] == 'mcap'
     assert metadata['message_count'] == sum(counts.values())
+
+
+def test_a_split_bag_lists_its_files_and_reads_as_one(tmp_path):
+    config = load_config(os.path.join(CONFIG, 'square_4.yaml'))
+    trajectory = simulate(config, duration=2.0, dt=0.01, sample_dt=0.02)
+    whole, split = tmp_path / 'whole', tmp_path / 'split'
+    write_run_as_bag(str(whole), config, trajectory, flush_every=10)
+    bag = write_run_as_bag(str(split), config, trajectory, flush_every=10, flushes_per_file=3)
+    names = sorted(name for name in os.listdir(split) if name.endswith('.mcap'))
+    assert len(names) == 4 and 'split.mcap' in names and 'split_3.mcap' in names
+    with open(split / 'metadata.yaml') as stream:
+        metadata = yaml.safe_load(stream)['rosbag2_bagfile_information']
+    assert sorted(metadata['relative_file_paths']) == names
+    assert [entry['path'] for entry in metadata['files']] == metadata['relative_file_paths']
+    assert sum(entry['message_count'] for entry in metadata['files']) == \
+        metadata['message_count'] == sum(bag.counts.values())
+    starts = [entry['starting_time']['nanoseconds_since_epoch'] for entry in metadata['files']]
+    assert starts == sorted(starts)
+    from mcap.reader import make_reader
+    for name in names:
+        with open(split / name, 'rb') as stream:
+            statistics = make_reader(stream).get_summary().statistics
+        entry = next(e for e in metadata['files'] if e['path'] == name)
+        assert statistics.message_count == entry['message_count'] > 0
+        assert statistics.channel_count == 2 * config.num_robots + 2
+    whole_topics, whole_counts = read_messages(str(whole))
+    split_topics, split_counts = read_messages(str(split))
+    assert split_counts == whole_counts
+    for topic, messages in whole_topics.items():
+        assert [stamp for stamp, _ in split_topics[topic]] == [stamp for stamp, _ in messages]
+    assert recover_bag(str(split)).count == sum(whole_counts.values())
+
+
+def test_a_split_bag_cut_by_sigkill_is_recovered_and_repaired(tmp_path):
+    config = load_config(os.path.join(CONFIG, 'square_4.yaml'))
+    trajectory = simulate(config, duration=2.0, dt=0.01, sample_dt=0.02)
+    folder = tmp_path / 'bag'
+    kept = tmp_path / 'kept'
+    written = []
+
+    def snapshot(bag):
+        if len(written) == 7:
+            shutil.copytree(folder, kept)
+        written.append(sum(bag.counts.values()))
+
+    write_run_as_bag(str(folder), config, trajectory, flush_every=10, on_flush=snapshot,
+                     flushes_per_file=3)
+    assert len([name for name in os.listdir(kept) if name.endswith('.mcap')]) == 3
+    assert not (kept / 'metadata.yaml').exists()
+    recorded, counts, note = read_or_recover(str(kept))
+    assert sum(counts.values()) == written[7]
+    assert f'recovered {written[7]} messages' in note
+    assert 'repaired' in repair_bag(str(kept))
+    topics, counts = read_messages(str(kept))
+    assert sum(counts.values()) == written[7]
 
 
 def test_independent_mcap_reader_decodes_every_message(tmp_path):

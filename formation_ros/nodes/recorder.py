@@ -8,13 +8,14 @@ Subscribes with ``raw=True`` (the serialized CDR bytes, no deserialise/serialise
 with the reliability and durability of each publisher (best effort for poses and neighbours,
 transient local for the reference) but a deep history, stores the bytes in its callbacks and
 writes them to the bag from a timer, every second, each time as a complete MCAP chunk handed
-to the operating system: a recorder killed with SIGKILL loses at most the last second, and
-``formation_report`` recovers the rest (``--repair`` makes the bag whole again). Robot i's
-``cmd_vel`` is subscribed only once the recorder's own readers of its ``pose`` and
-``neighbors`` have matched a publisher: a robot that waits for the recorder on ``cmd_vel``
-(``wait_for_subscribers``) then cannot start before its states are recorded, whichever side of
-the DDS discovery finishes first. The bag is finished (metadata.yaml written) when the node
-stops, on Ctrl-C or SIGTERM too. It carries the run's
+to the operating system (and a new MCAP file every five minutes, as rosbag2 splits a bag, so
+that the recorder's memory stays flat however long it runs): a recorder killed with SIGKILL
+loses at most the last second, and ``formation_report`` recovers the rest (``--repair`` makes
+the bag whole again). Robot i's ``cmd_vel`` is subscribed only once the recorder's own readers
+of its ``pose`` and ``neighbors`` have matched a publisher: a robot that waits for the recorder
+on ``cmd_vel`` (``wait_for_subscribers``) then cannot start before its states are recorded,
+whichever side of the DDS discovery finishes first. The bag is finished (metadata.yaml written)
+when the node stops, on Ctrl-C or SIGTERM too. It carries the run's
 parameters on /formation/params and in params.yaml, for ``formation_report``::
 
     ros2 run formation_ros record --ros-args --params-file config/paper_section5.yaml \\
@@ -27,7 +28,7 @@ from typing import Any, Dict, List, Optional, Tuple
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.declarations import Exe, ParamError, RECORDER_ONLY
 from formation_ros.ros import qos, topics
-from formation_ros.ros.bag_writer import BagError, BagWriter, qos_of
+from formation_ros.ros.bag_writer import BagError, BagWriter, FLUSHES_PER_FILE, qos_of
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
 from formation_ros.ros.runner import run
@@ -40,8 +41,8 @@ from rosgraph_msgs.msg import Clock as ClockMsg
 from visualization_msgs.msg import MarkerArray
 
 FLUSH_PERIOD = 1.0
-"""Seconds between chunks. Each chunk's index stays in memory until the bag is closed (about 3 KB
-with every topic in it): shorter periods grow the recorder faster (0.2 s: 19 % in 30 minutes)."""
+"""Seconds between chunks. Each chunk's index stays in memory until its MCAP file is finished
+(about 3 KB with every topic in it); a new file is started every FLUSHES_PER_FILE flushes."""
 MATCH_PERIOD = 0.02
 MESSAGE_CLASSES = {
     'geometry_msgs/msg/PoseStamped': PoseStamped,
@@ -71,7 +72,8 @@ class RecorderNode(Node):
         assert settings is not None
         self.path = os.path.abspath(settings.path)
         try:
-            self.bag = BagWriter(self.path, overwrite=settings.overwrite)
+            self.bag = BagWriter(self.path, overwrite=settings.overwrite,
+                                 flushes_per_file=FLUSHES_PER_FILE)
         except BagError as exc:
             raise ParamError([('record.path', str(exc))]) from None
         self.pending: List[Tuple[str, int, bytes]] = []

@@ -19,10 +19,11 @@ operating system, so a recorder killed with SIGKILL leaves an MCAP whose complet
 with its CRC) hold everything up to its last flush; ``formation_ros.tools.bag`` recovers them.
 """
 
+from dataclasses import dataclass
 import os
 from pathlib import Path
 import shutil
-from typing import Dict, Union
+from typing import Any, BinaryIO, Dict, List, Optional, Tuple, Union
 
 from formation_ros.core.params_file import dump_params_text
 from formation_ros.ros import topics
@@ -32,10 +33,13 @@ from rosbags.interfaces import Connection, MessageDefinitionFormat, Qos, QosDura
 from rosbags.interfaces import QosHistory, QosLiveliness, QosReliability, QosTime
 from rosbags.rosbag2 import CompressionMode, StoragePlugin, Writer
 from rosbags.typesys import get_typestore, Stores
+import yaml
 
 PARAMS_FILE = 'params.yaml'
 TYPESTORE = get_typestore(Stores.ROS2_JAZZY)
 CHUNK_SIZE = 1 << 20
+FLUSHES_PER_FILE = 300
+"""Flushes after which the recorder starts a new MCAP file (5 minutes at one flush a second)."""
 SCHEMA_ENCODINGS = {MessageDefinitionFormat.MSG: 'ros2msg',
                     MessageDefinitionFormat.IDL: 'ros2idl'}
 
@@ -61,60 +65,141 @@ def _looks_like_bag(path):
     return 'metadata.yaml' in names or any(name.endswith('.mcap') for name in names)
 
 
+@dataclass
+class FileStats:
+    """One MCAP file of a bag: its name and the messages in it (for metadata.yaml's ``files``)."""
+
+    name: str
+    first_ns: int = 0
+    last_ns: int = 0
+    count: int = 0
+
+    def add(self, timestamp: int) -> None:
+        """Count a message written at ``timestamp`` (ns)."""
+        self.first_ns = timestamp if not self.count else min(self.first_ns, timestamp)
+        self.last_ns = timestamp if not self.count else max(self.last_ns, timestamp)
+        self.count += 1
+
+    def entry(self) -> Dict[str, Any]:
+        """Return this file's entry in metadata.yaml (rosbag2 format 9)."""
+        return {'path': self.name,
+                'starting_time': {'nanoseconds_since_epoch': self.first_ns},
+                'duration': {'nanoseconds': self.last_ns - self.first_ns},
+                'message_count': self.count}
+
+
 class McapStorage:
     """
-    rosbags storage plugin: the bag's MCAP file, written with the ``mcap`` library.
+    rosbags storage plugin: the bag's MCAP files, written with the ``mcap`` library.
 
     The records are the ones rosbag2's own MCAP storage writes: profile ``ros2``, one schema
     (``ros2msg`` text) per message type, one channel per topic with ``offered_qos_profiles`` and
     ``topic_type_hash`` metadata, CDR messages in CRC-checked chunks, the ``rosbag2`` metadata
     record and a full summary (statistics, chunk and message indexes) when it is closed.
+
+    The bag is split as rosbag2 splits by duration: after ``flushes_per_file`` flushes the file
+    is finished (summary and footer written, its indexes freed) and the next message starts a
+    new one, ``<name>_1.mcap``, ``<name>_2.mcap`` and so on, with every schema and channel
+    again. The chunk indexes of one file stay in memory until it is finished: splitting keeps
+    the writer's memory flat however long it records.
     """
 
     def __init__(self, path: Path, compression: CompressionMode) -> None:
         """Create ``<path>/<path.name>.mcap`` (it must not exist) and write its header."""
         if compression != CompressionMode.NONE:
             raise BagError(f'{path}: only uncompressed bags are written here')
+        self.folder = path
         self.path = path / f'{path.name}.mcap'
-        self._stream = self.path.open('xb')
+        self.flushes_per_file = 0
+        self.files: List[FileStats] = []
+        self._msgtypes: Dict[str, Connection] = {}
+        self._connections: List[Tuple[Connection, str]] = []
+        self._stream: Optional[BinaryIO] = None
+        self._mcap: Optional[McapWriter] = None
+        self._schemas: Dict[str, int] = {}
+        self._channels: Dict[int, int] = {}
+        self._flushes = 0
+        self._open(self.path)
+
+    def _open(self, path: Path) -> McapWriter:
+        self._stream = path.open('xb')
         self._mcap = McapWriter(self._stream, chunk_size=CHUNK_SIZE,
                                 compression=CompressionType.NONE)
         self._mcap.start(profile='ros2', library=f'formation_ros (mcap-python {MCAP_VERSION})')
-        self._schemas: Dict[str, int] = {}
-        self._channels: Dict[int, int] = {}
+        self.files.append(FileStats(path.name))
+        self._schemas, self._channels, self._flushes = {}, {}, 0
+        for connection in self._msgtypes.values():
+            self._register_schema(self._mcap, connection)
+        for connection, profiles in self._connections:
+            self._register_channel(self._mcap, connection, profiles)
+        return self._mcap
 
-    def add_msgtype(self, connection: Connection) -> None:
-        """Store the message definition of ``connection``'s type as a schema."""
-        self._schemas[connection.msgtype] = self._mcap.register_schema(
+    def _writer(self) -> McapWriter:
+        """Return the file being written; after a split, the next one, opened now."""
+        if self._mcap is not None:
+            return self._mcap
+        return self._open(self.folder / f'{self.folder.name}_{len(self.files)}.mcap')
+
+    def _register_schema(self, mcap: McapWriter, connection: Connection) -> None:
+        self._schemas[connection.msgtype] = mcap.register_schema(
             connection.msgtype, SCHEMA_ENCODINGS[connection.msgdef.format],
             connection.msgdef.data.encode())
 
-    def add_connection(self, connection: Connection, offered_qos_profiles: str) -> None:
-        """Store ``connection`` as a channel (topic, encoding, QoS and type hash)."""
-        self._channels[connection.id] = self._mcap.register_channel(
+    def _register_channel(self, mcap: McapWriter, connection: Connection,
+                          offered_qos_profiles: str) -> None:
+        self._channels[connection.id] = mcap.register_channel(
             connection.topic, connection.ext.serialization_format,
             self._schemas[connection.msgtype],
             {'offered_qos_profiles': offered_qos_profiles, 'topic_type_hash': connection.digest})
 
+    def add_msgtype(self, connection: Connection) -> None:
+        """Store the message definition of ``connection``'s type as a schema."""
+        self._msgtypes[connection.msgtype] = connection
+        if self._mcap is not None:
+            self._register_schema(self._mcap, connection)
+
+    def add_connection(self, connection: Connection, offered_qos_profiles: str) -> None:
+        """Store ``connection`` as a channel (topic, encoding, QoS and type hash)."""
+        self._connections.append((connection, offered_qos_profiles))
+        if self._mcap is not None:
+            self._register_channel(self._mcap, connection, offered_qos_profiles)
+
     def write(self, connection: Connection, timestamp: int,
               data: Union[bytes, memoryview]) -> None:
         """Add one serialized message to the chunk in progress."""
-        self._mcap.add_message(self._channels[connection.id], timestamp, bytes(data), timestamp)
+        mcap = self._writer()
+        mcap.add_message(self._channels[connection.id], timestamp, bytes(data), timestamp)
+        self.files[-1].add(timestamp)
 
     def flush(self) -> None:
-        """End the chunk in progress (if it holds messages) and hand the file to the OS."""
+        """End the chunk in progress and hand it to the OS; finish the file when it is due."""
+        if self._mcap is None:
+            return
         self._mcap.flush()
+        self._flushes += 1
+        if self.flushes_per_file and self._flushes >= self.flushes_per_file \
+                and self.files[-1].count:
+            self._finish_file()
 
-    def close(self, version: int, metadata: str) -> None:
-        """Write the last chunk, the ``rosbag2`` metadata record and the summary."""
+    def _finish_file(self, metadata: Optional[str] = None) -> None:
+        assert self._mcap is not None and self._stream is not None
         self._mcap.flush()
-        self._mcap.add_metadata('rosbag2', {'serialized_metadata': metadata})
+        if metadata is not None:
+            self._mcap.add_metadata('rosbag2', {'serialized_metadata': metadata})
         self._mcap.finish()
         self._stream.close()
+        self._mcap = self._stream = None
+
+    def close(self, version: int, metadata: str) -> None:
+        """Finish the file being written, with the ``rosbag2`` metadata record."""
+        if self._mcap is not None:
+            self._finish_file(metadata)
 
     def abort(self) -> None:
         """Close the file as it is (no summary)."""
-        self._stream.close()
+        if self._stream is not None:
+            self._stream.close()
+        self._mcap = self._stream = None
 
 
 class _Rosbag2Writer(Writer):
@@ -122,12 +207,34 @@ class _Rosbag2Writer(Writer):
 
     STORAGE_PLUGINS = {StoragePlugin.MCAP: McapStorage}
 
+    def close(self) -> None:
+        """Close as rosbags does, then list every MCAP file of the bag in metadata.yaml."""
+        storage = self.storage
+        assert isinstance(storage, McapStorage)
+        super().close()
+        if len(storage.files) == 1:
+            return
+        with self.metapath.open(encoding='utf-8') as stream:
+            document = yaml.safe_load(stream)
+        information = document['rosbag2_bagfile_information']
+        information['relative_file_paths'] = [stats.name for stats in storage.files]
+        information['files'] = [stats.entry() for stats in storage.files]
+        temporary = self.metapath.with_suffix('.yaml.tmp')
+        with temporary.open('w', encoding='utf-8') as stream:
+            yaml.safe_dump(document, stream, default_flow_style=False, sort_keys=False)
+        temporary.replace(self.metapath)
+
 
 class BagWriter:
     """A rosbag2 (MCAP) being written; close it (or use ``with``) to write metadata.yaml."""
 
-    def __init__(self, path, overwrite=False):
-        """Open a new bag at ``path``; an existing bag there is replaced only with overwrite."""
+    def __init__(self, path, overwrite=False, flushes_per_file=0):
+        """
+        Open a new bag at ``path``; an existing bag there is replaced only with overwrite.
+
+        flushes_per_file: start a new MCAP file after this many :meth:`flush` calls (0: one
+        file); the recorder passes :data:`FLUSHES_PER_FILE`.
+        """
         self.path = os.path.abspath(path)
         if os.path.exists(self.path):
             if not os.path.isdir(self.path):
@@ -143,6 +250,7 @@ class BagWriter:
         storage = self._writer.storage
         assert isinstance(storage, McapStorage)
         self._storage = storage
+        storage.flushes_per_file = flushes_per_file
         self._connections = {}
         self.counts = {}
 
