@@ -34,6 +34,7 @@ setup(
             'plant = formation_ros.nodes.plant:main',
             'reference = formation_ros.nodes.reference:main',
             'record = formation_ros.nodes.recorder:main',
+            'fleet = formation_ros.nodes.fleet:main',
         ],
     },
 )

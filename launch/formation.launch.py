@@ -5,11 +5,13 @@
 Start a whole formation with ``ros2 launch``: the system that scripts/launch_formation.sh starts.
 
 The plant, the reference node on the plant's simulated time, and one ``robot`` node per robot
-(namespace ``/robot_<i>``, ``robot_id`` i), all with one parameters file; ``num_robots`` is read
+(namespace ``/robot_<i>``, ``robot_id`` i; with ``robots_per_process`` above 1, ``fleet``
+processes of that many robot nodes each), all with one parameters file; ``num_robots`` is read
 from that file. The first node to exit ends the launch::
 
     ros2 launch formation_ros formation.launch.py params_file:=my.yaml
     ros2 launch formation_ros formation.launch.py record:=runs/bag output_dir:=runs/out
+    ros2 launch formation_ros formation.launch.py robots_per_process:=10   # fleet processes
 
 It runs until Ctrl-C; ``formation_report`` reads the bag or the output directory afterwards.
 """
@@ -31,12 +33,16 @@ def formation_nodes(context):
     params_file = LaunchConfiguration('params_file').perform(context)
     record = LaunchConfiguration('record').perform(context)
     output_dir = LaunchConfiguration('output_dir').perform(context)
+    per_process = int(LaunchConfiguration('robots_per_process').perform(context))
+    if per_process < 1:
+        raise ValueError(f'robots_per_process must be >= 1, got {per_process}')
     with open(params_file) as stream:
         num_robots = yaml.safe_load(stream)['/**']['ros__parameters']['num_robots']
     subscribers = 2 if record else 1
 
-    def node(executable, *overrides, namespace=None):
+    def node(executable, *overrides, namespace=None, arguments=None):
         return Node(package=PACKAGE, executable=executable, namespace=namespace,
+                    arguments=arguments,
                     parameters=[params_file, *filter(None, overrides)], output='screen',
                     on_exit=Shutdown(reason=f'{executable} exited'))
 
@@ -47,9 +53,14 @@ def formation_nodes(context):
                       {'plant.wait_for_subscribers': 2} if record else {},
                       {'plant.output_dir': output_dir} if output_dir else {}))
     nodes.append(node('reference', {'use_sim_time': True}))
-    nodes += [node('robot', {'robot_id': i, 'wait_for_subscribers': subscribers,
-                             'use_sim_time': True}, namespace=f'robot_{i}')
-              for i in range(1, num_robots + 1)]
+    robot_params = {'wait_for_subscribers': subscribers, 'use_sim_time': True}
+    if per_process == 1:
+        nodes += [node('robot', {'robot_id': i, **robot_params}, namespace=f'robot_{i}')
+                  for i in range(1, num_robots + 1)]
+        return nodes
+    for first in range(1, num_robots + 1, per_process):
+        last = min(first + per_process - 1, num_robots)
+        nodes.append(node('fleet', robot_params, arguments=['--robots', f'{first}-{last}']))
     return nodes
 
 
@@ -65,5 +76,7 @@ def generate_launch_description():
         DeclareLaunchArgument('output_dir', default_value='',
                               description='where the plant writes trajectory.npz and '
                                           'plant_stats.json (empty: nowhere)'),
+        DeclareLaunchArgument('robots_per_process', default_value='1',
+                              description="robots per process (above 1: 'fleet' processes)"),
         OpaqueFunction(function=formation_nodes),
     ])

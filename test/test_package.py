@@ -213,7 +213,22 @@ def test_launch_file_declares_its_arguments_and_defaults_to_section5(launch_file
                 for action in description.args[0] if action.args}
     assert declared == {
         'params_file': os.path.join(ROOT, 'config', 'paper_section5.yaml'),
-        'record': '', 'output_dir': ''}
+        'record': '', 'output_dir': '', 'robots_per_process': '1'}
+
+
+def test_launch_file_spreads_robots_over_fleet_processes(launch_file):
+    params = os.path.join(ROOT, 'config', 'square_4.yaml')
+    nodes = launched_nodes(launch_file, params_file=params, record='', output_dir='',
+                           robots_per_process='3')
+    fleets = [node for node in nodes if node.kwargs['executable'] == 'fleet']
+    assert sorted(node.kwargs['executable'] for node in nodes) == \
+        ['fleet', 'fleet', 'plant', 'reference']
+    assert [node.kwargs['arguments'] for node in fleets] == [['--robots', '1-3'],
+                                                             ['--robots', '4-4']]
+    for fleet in fleets:
+        assert fleet.kwargs['namespace'] is None
+        assert node_parameters(fleet) == (params, {'wait_for_subscribers': 1,
+                                                   'use_sim_time': True})
 
 
 @pytest.mark.parametrize('record', ['', '/tmp/formation_bag'])

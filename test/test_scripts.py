@@ -174,3 +174,49 @@ def test_launcher_refuses_an_unknown_on_exit_mode():
     assert result.returncode == 2
     assert '--on-exit must be one of continue, stop, respawn' in result.stderr
     assert '--on-exit' in run('launch_formation.sh', '--help').stdout
+
+
+@pytest.mark.parametrize('value', ['0', '-1', 'two', '2.5'])
+def test_launcher_refuses_a_bad_robots_per_process(value):
+    result = run('launch_formation.sh', os.path.join(ROOT, 'config', 'square_4.yaml'),
+                 '--robots-per-process', value)
+    assert result.returncode == 2
+    assert '--robots-per-process must be a whole number >= 1' in result.stderr
+
+
+@pytest.mark.parametrize('per_process, expected', [
+    (1, [('robot_1', None), ('robot_2', None), ('robot_3', None), ('robot_4', None)]),
+    (3, [('fleet_1', '1-3'), ('fleet_2', '4-4')]),
+    (4, [('fleet_1', '1-4')]),
+    (10, [('fleet_1', '1-4')]),
+])
+def test_launcher_spreads_the_robots_over_processes(per_process, expected):
+    from formation_ros.tools.launcher import Install, node_specs, Options
+    options = Options(os.path.join(ROOT, 'config', 'square_4.yaml'),
+                      robots_per_process=per_process)
+    specs = node_specs(Install('/opt/x'), options, 4, {})[2:]
+    got = []
+    for spec in specs:
+        args = list(spec.argv)
+        executable = os.path.basename(args[0])
+        assert executable == ('robot' if per_process == 1 else 'fleet'), args
+        assert args[args.index('--ros-args'):].count('use_sim_time:=true') == 1, args
+        got.append((spec.name, args[args.index('--robots') + 1] if '--robots' in args
+                    else None))
+    assert got == expected
+
+
+def test_fleet_command_line():
+    from formation_ros.nodes.fleet import parse_command_line, parse_ids, UsageError
+    assert parse_ids('1-3,7, 9 - 10') == [1, 2, 3, 7, 9, 10]
+    assert parse_command_line(['fleet', '--robots', '2-4', '--ros-args', '-p', 'x:=1']) == \
+        [2, 3, 4]
+    assert parse_command_line(['fleet', '--help']) is None
+    for bad, says in (('0-2', 'below 1'), ('3-1', 'empty'), ('1,1', 'robot 1 is given twice'),
+                      ('a', 'neither an id nor a range'), ('1-200000', 'more than')):
+        with pytest.raises(UsageError, match=says):
+            parse_ids(bad)
+    with pytest.raises(UsageError, match='give the robots as --robots IDS'):
+        parse_command_line(['fleet', '--ros-args', '-p', 'x:=1'])
+    with pytest.raises(UsageError, match="'__ns:=/a' cannot be used"):
+        parse_command_line(['fleet', '--robots', '1', '--ros-args', '-r', '__ns:=/a'])

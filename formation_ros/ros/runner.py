@@ -26,7 +26,7 @@ import os
 import signal
 import sys
 import time
-from typing import Any, Callable, List, Mapping, Optional
+from typing import Any, Callable, List, Mapping, Optional, Sequence, Union
 
 from formation_ros.core.declarations import ParamError
 import rclpy
@@ -190,31 +190,38 @@ def _exit_now(code: int) -> None:
     os._exit(code)
 
 
-def run(node_class: Callable[[], Node], args: Optional[List[str]] = None,
-        name: str = 'node') -> int:
-    """
-    Start rclpy, build the node, spin until SIGINT/SIGTERM, shut down without a traceback.
+NodeFactory = Callable[[], Union[Node, Sequence[Node]]]
+"""Builds the process's node, or its nodes (a fleet of robots): a node class, for one."""
 
-    The spin also ends when the launcher named in the environment is gone (see
-    :class:`LauncherWatch`). Returns the exit code: 0, or 2 for invalid parameters (one line
-    per bad parameter) or a command line rclpy cannot start from.
+
+def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = 'node') -> int:
+    """
+    Start rclpy, build the node(s), spin until SIGINT/SIGTERM, shut down without a traceback.
+
+    ``make_nodes`` returns one node or several, which then share one executor (and the one
+    thread of this process). The spin also ends when the launcher named in the environment is
+    gone (see :class:`LauncherWatch`). Returns the exit code: 0, or 2 for invalid parameters
+    (one line per bad parameter) or a command line rclpy cannot start from.
     """
     if not _init(args, name):
         return 2
     signal.signal(signal.SIGINT, _StopRequest.handler)
     signal.signal(signal.SIGTERM, _StopRequest.handler)
     launcher = LauncherWatch.from_environment(os.environ)
-    node = executor = None
+    nodes: List[Node] = []
+    executor = None
     code = 0
     orphaned = False
     try:
-        node = node_class()
+        made = make_nodes()
+        nodes = [made] if isinstance(made, Node) else list(made)
         executor = make_executor()
-        executor.add_node(node)
+        for node in nodes:
+            executor.add_node(node)
         while rclpy.ok() and _StopRequest.signal_name is None:
             executor.spin_once(timeout_sec=SIGNAL_LATENCY)
             if launcher is not None and launcher.gone():
-                node.get_logger().warning(
+                nodes[0].get_logger().warning(
                     f'the launcher (process {launcher.pid}) is gone; stopping')
                 orphaned = True
                 break
@@ -228,10 +235,11 @@ def run(node_class: Callable[[], Node], args: Optional[List[str]] = None,
     finally:
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         signal.signal(signal.SIGTERM, signal.SIG_IGN)
-        if node is not None:
+        for node in nodes:
             finish = getattr(node, 'finish', None)
             if finish is not None:
                 finish()
+        for node in nodes:
             node.destroy_node()
         if executor is not None:
             executor.shutdown()

@@ -45,7 +45,8 @@ LAUNCHER_START_ENV = 'FORMATION_LAUNCHER_START'
 
 USAGE = """\
 Usage: scripts/launch_formation.sh PARAMS.yaml [--duration S] [--out DIR] [--record DIR]
-                                   [--on-exit continue|stop|respawn] [--prefix DIR]
+                                   [--on-exit continue|stop|respawn]
+                                   [--robots-per-process K] [--prefix DIR]
 
 Starts the plant, the reference node and N robot nodes (N = num_robots in PARAMS.yaml), robot i
 in namespace /robot_<i>, all with the same parameters file, the reference node on the plant's
@@ -72,6 +73,11 @@ Options:
                            continue); it rejoins the formation
                  A plant, reference or recorder exit always stops the run. In every mode the
                  exit code is 1 if any node exited on its own, with a line naming it.
+  --robots-per-process K
+                 run the robots K to a process (executable 'fleet', processes fleet_1,
+                 fleet_2, ...; each robot still its own node in /robot_<i>): ceil(N/K)
+                 processes instead of N (default 1: one 'robot' process per robot). With
+                 --on-exit, a fleet process counts as its robots: respawn restarts all of them
   --prefix DIR   install space of formation_ros (default: found from 'ros2', AMENT_PREFIX_PATH
                  or ./install/formation_ros)
   -h, --help     show this help
@@ -118,12 +124,14 @@ class Options:
     record: Optional[str] = None
     prefix: Optional[str] = None
     on_exit: str = 'continue'
+    robots_per_process: int = 1
 
 
 def parse_args(argv: Sequence[str]) -> Optional[Options]:
     """Parse the command line as the shell launcher always has; None for --help."""
     needs = {'duration': 'seconds', 'out': 'a directory', 'record': 'a directory',
-             'prefix': 'a directory', 'on-exit': '|'.join(ON_EXIT)}
+             'prefix': 'a directory', 'on-exit': '|'.join(ON_EXIT),
+             'robots-per-process': 'a number of robots'}
     values: dict[str, Optional[str]] = dict.fromkeys(needs)
     params = None
     args = list(argv)
@@ -151,9 +159,13 @@ def parse_args(argv: Sequence[str]) -> Optional[Options]:
     on_exit = values['on-exit'] or ON_EXIT[0]
     if on_exit not in ON_EXIT:
         raise UsageError(f"--on-exit must be one of {', '.join(ON_EXIT)}, got '{on_exit}'")
+    per_process = values['robots-per-process'] or '1'
+    if not re.fullmatch(r'[1-9][0-9]*', per_process):
+        raise UsageError('--robots-per-process must be a whole number >= 1, '
+                         f"got '{per_process}'")
     prefix = values['prefix'] or os.environ.get('FORMATION_PREFIX') or None
     return Options(params, None if duration is None else float(duration), values['out'],
-                   values['record'], prefix, on_exit)
+                   values['record'], prefix, on_exit, int(per_process))
 
 
 def check_paths(options: Options) -> Options:
@@ -240,11 +252,19 @@ def node_specs(install: Install, options: Options, num_robots: int,
     specs = [ProcessSpec('plant', install.command('plant') + plant, env),
              ProcessSpec('reference', install.command('reference') + params +
                          ['-p', 'use_sim_time:=true'], env)]
-    for i in range(1, num_robots + 1):
-        specs.append(ProcessSpec(f'robot_{i}', install.command('robot') + [
-            '--ros-args', '-r', f'__ns:=/robot_{i}', '-p', f'robot_id:={i}',
-            '--params-file', options.params, '-p', f'wait_for_subscribers:={waits}',
-            '-p', 'use_sim_time:=true'], env))
+    robot_params = ['--params-file', options.params, '-p', f'wait_for_subscribers:={waits}',
+                    '-p', 'use_sim_time:=true']
+    per_process = options.robots_per_process
+    if per_process == 1:
+        for i in range(1, num_robots + 1):
+            specs.append(ProcessSpec(f'robot_{i}', install.command('robot') + [
+                '--ros-args', '-r', f'__ns:=/robot_{i}', '-p', f'robot_id:={i}'] + robot_params,
+                env))
+        return specs
+    for k, first in enumerate(range(1, num_robots + 1, per_process)):
+        last = min(first + per_process - 1, num_robots)
+        specs.append(ProcessSpec(f'fleet_{k + 1}', install.command('fleet') + [
+            '--robots', f'{first}-{last}', '--ros-args'] + robot_params, env))
     return specs
 
 
@@ -469,7 +489,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
             os.rmdir(options.record)
         os.makedirs(os.path.dirname(options.record), exist_ok=True)
     span = 'until Ctrl-C' if wall_seconds == 0 else f'for {wall_seconds:g} s'
-    say(f'{num_robots} robots from {options.params} ({install.describe()}), {span}',
+    per_process = options.robots_per_process
+    processes = ('' if per_process == 1 else
+                 f' in {-(-num_robots // per_process)} fleet processes of up to {per_process}')
+    say(f'{num_robots} robots{processes} from {options.params} ({install.describe()}), {span}',
         sys.stdout)
     return Launch(options, install, num_robots, wall_seconds).run()
 

@@ -1,0 +1,105 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+r"""
+Fleet process (executable ``fleet``): several robot nodes in one process.
+
+Each robot is the same :class:`formation_ros.nodes.robot.RobotNode` as ``ros2 run formation_ros
+robot`` starts, in its own namespace ``/robot_<i>``, with its own parameters, hearing only its
+own topics: the control stays decentralised, only the process (its memory, its one executor
+thread) is shared. A process per robot costs about 100 MB and its own DDS participant; a fleet
+of K robots costs one of each, which is what lets a hundred robots run on one small computer::
+
+    ros2 run formation_ros fleet --robots 1-5 --ros-args \\
+        --params-file config/paper_section5.yaml -p use_sim_time:=true
+
+Parameters given on the command line (``-p``) or in a parameters file apply to every robot of
+the fleet; a file's ``/robot_3/robot:`` section applies to robot 3 alone, as it would to a
+robot process. The namespace of each robot is set by the fleet: ``-r __ns:=...`` and
+``robot_id`` are refused.
+"""
+
+import re
+import sys
+from typing import List, Optional, Sequence
+
+from formation_ros.nodes.robot import RobotNode
+from formation_ros.ros.runner import run
+from formation_ros.ros.topics import robot_namespace
+from rclpy.utilities import remove_ros_args
+
+PROG = 'fleet'
+USAGE = f"""\
+usage: {PROG} --robots IDS [--ros-args ...]
+
+Runs robot nodes i in IDS (e.g. 1-5 or 1,3,7-9), robot i in namespace /robot_<i>, in this one
+process; the ROS arguments (parameters files, -p) apply to every robot.
+"""
+MAX_ROBOTS = 100_000
+RESERVED_REMAPS = ('__ns:=', '__node:=', '__name:=')
+
+
+class UsageError(ValueError):
+    """A bad fleet command line: the fleet exits 2 with this message."""
+
+
+def parse_ids(text: str) -> List[int]:
+    """Return the robot ids of ``text``: comma-separated ids and ranges ``a-b`` (ids >= 1)."""
+    ids: List[int] = []
+    for part in text.split(','):
+        match = re.fullmatch(r'\s*([0-9]+)\s*(?:-\s*([0-9]+)\s*)?', part)
+        if match is None:
+            raise UsageError(f"--robots: '{part}' is neither an id nor a range a-b")
+        first = int(match.group(1))
+        last = int(match.group(2)) if match.group(2) else first
+        if first < 1 or last < first:
+            raise UsageError(f"--robots: '{part.strip()}' is empty or has an id below 1")
+        if last - first >= MAX_ROBOTS or len(ids) + last - first >= MAX_ROBOTS:
+            raise UsageError(f'--robots: more than {MAX_ROBOTS} robots')
+        ids.extend(range(first, last + 1))
+    seen = set()
+    for i in ids:
+        if i in seen:
+            raise UsageError(f'--robots: robot {i} is given twice')
+        seen.add(i)
+    return ids
+
+
+def parse_command_line(argv: Sequence[str]) -> Optional[List[int]]:
+    """Return the robot ids of a fleet command line (None for --help); UsageError if bad."""
+    own = remove_ros_args(list(argv))[1:]
+    ros = argv[list(argv).index('--ros-args') + 1:] if '--ros-args' in argv else []
+    reserved = [arg for arg in ros if arg.startswith(RESERVED_REMAPS)]
+    if reserved:
+        raise UsageError(f"'{reserved[0]}' cannot be used: the fleet puts robot i in "
+                         '/robot_<i> and names it robot itself')
+    if any(arg in ('-h', '--help') for arg in own):
+        return None
+    if len(own) != 2 or own[0] != '--robots':
+        raise UsageError('give the robots as --robots IDS (e.g. --robots 1-5)'
+                         + (f", not {' '.join(own)}" if own else ''))
+    return parse_ids(own[1])
+
+
+def make_fleet(ids: Sequence[int]) -> List[RobotNode]:
+    """
+    Build one robot node per id, robot i in ``/robot_<i>``.
+
+    Each node checks its parameters as a robot process does (a ``robot_id`` given to the fleet
+    disagrees with every namespace but one and is refused there).
+    """
+    return [RobotNode(namespace=robot_namespace(i)) for i in ids]
+
+
+def main(args: Optional[List[str]] = None) -> int:
+    """Entry point of ``ros2 run formation_ros fleet``."""
+    argv = sys.argv if args is None else args
+    try:
+        ids = parse_command_line(argv)
+    except UsageError as exc:
+        print(f'{PROG}: {exc}', file=sys.stderr)
+        return 2
+    if ids is None:
+        print(USAGE, end='')
+        return 0
+    return run(lambda: make_fleet(ids), args, name=PROG)

@@ -1,0 +1,101 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+Fleet processes: several robot nodes in one process, each still its own node.
+
+Real executables over DDS: the launcher with ``--robots-per-process``, or the ``fleet``
+executable started directly; outcomes from the probe, the launcher's output and the plant's
+``trajectory.npz`` / ``metrics.json``.
+"""
+
+import json
+import os
+import signal
+
+from formation_ros.core.trajectory import Trajectory
+from formation_ros.tools.supervise import ProcessSpec
+from helpers import (CONFIG, exe, launch, project_processes, SimClock, SQUARE, START_UP,
+                     stop_when, watch_commands)
+import numpy as np
+from rcl_interfaces.srv import GetParameters
+from test_parameters import call
+import yaml
+
+SIX = os.path.join(CONFIG, 'circle_2d.yaml')
+
+
+def fleet_pids(install, name_part):
+    """Process ids of the running fleet processes whose command line holds ``name_part``."""
+    return [int(line.split()[0]) for line in project_processes(install)
+            if exe(install, 'fleet') in line and name_part in line]
+
+
+def test_six_robots_in_two_fleet_processes_converge(processes, install, probe, tmp_path):
+    clock = SimClock(probe)
+    out = tmp_path / 'run'
+    launch(processes, install, SIX, out=out, options=('--robots-per-process', '3'))
+    info = stop_when(probe, processes, lambda: clock.seconds > 20.0)
+    log = processes.log('launcher')
+    assert info.returncode == 0, log
+    assert '6 robots in 2 fleet processes of up to 3' in log, log
+    assert '[fleet_1] ' in log and '[fleet_2] ' in log and '[robot_1] ' not in log, log
+    metrics = json.loads((out / 'metrics.json').read_text())
+    assert metrics['num_robots'] == 6 and metrics['collisions'] == 0, metrics
+    assert metrics['final_max_error'] < 0.05, metrics
+    assert metrics['bound_violations'] == 0, metrics
+    assert project_processes(install) == []
+
+
+def test_each_robot_of_a_fleet_is_its_own_node_with_its_parameters(
+        processes, install, probe, tmp_path):
+    own = tmp_path / 'robot_2.yaml'
+    own.write_text(yaml.safe_dump({'/robot_2/robot': {'ros__parameters': {
+        'control_rate': 25.0}}}))
+    processes.start(ProcessSpec('fleet', [exe(install, 'fleet'), '--robots', '1-3', '--ros-args',
+                                          '--params-file', SQUARE, '--params-file', str(own)]))
+    assert probe.spin_until(
+        lambda: {('robot', f'/robot_{i}') for i in (1, 2, 3)}
+        <= set(probe.get_node_names_and_namespaces()), START_UP), processes.log('fleet')
+    rates = {}
+    for i in (1, 2, 3):
+        answer = call(probe, probe.create_client(GetParameters, f'/robot_{i}/robot/'
+                                                 'get_parameters'),
+                      GetParameters.Request(names=['robot_id', 'control_rate']))
+        assert answer.values[0].integer_value == i
+        rates[i] = answer.values[1].double_value
+    assert rates == {1: 50.0, 2: 25.0, 3: 50.0}
+    names = [name for name, namespace in probe.get_node_names_and_namespaces()
+             if namespace.startswith('/robot_')]
+    assert sorted(names) == ['robot'] * 3, names
+    assert len(fleet_pids(install, '--robots 1-3')) == 1
+
+
+def test_killing_one_fleet_process_stops_only_its_robots(processes, install, probe, tmp_path):
+    heard, _ = watch_commands(probe, 4)
+    clock = SimClock(probe)
+    out = tmp_path / 'run'
+    launch(processes, install, SQUARE, out=out, options=('--robots-per-process', '2'))
+    assert probe.spin_until(lambda: clock.seconds > 0.5 and {i for i, _ in heard} >= {1, 2, 3, 4},
+                            START_UP), processes.log('launcher')
+    [pid] = fleet_pids(install, '--robots 3-4')
+    os.kill(pid, signal.SIGKILL)
+    killed_at = clock.seconds
+    counted = len(heard)
+
+    def others_go_on():
+        later = [i for i, _ in heard[counted:]]
+        return clock.seconds > killed_at + 3.0 and all(later.count(i) > 50 for i in (1, 2))
+
+    assert probe.spin_until(others_go_on, 60), processes.log('launcher')
+    info = stop_when(probe, processes, lambda: True)
+    log = processes.log('launcher')
+    assert info.returncode == 1, log
+    assert 'fleet_2 ended on its own (signal SIGKILL); the others go on' in log, log
+    assert project_processes(install) == []
+    trajectory = Trajectory.load(str(out / 'trajectory.npz'))
+    after = trajectory.t > killed_at + 1.0
+    assert after.sum() > 50
+    for robot in (2, 3):
+        assert np.all(trajectory.q[after, robot] == trajectory.q[after, robot][0]), robot
+    assert np.ptp(trajectory.q[after][:, [0, 1]], axis=0).max() > 1e-3, 'robots 1, 2 stopped'
