@@ -26,6 +26,8 @@ from typing import List, Optional, Sequence
 from formation_ros.nodes.robot import RobotNode
 from formation_ros.ros.runner import run
 from formation_ros.ros.topics import robot_namespace
+from rclpy.clock import ROSClock
+from rclpy.node import Node
 from rclpy.utilities import remove_ros_args
 
 PROG = 'fleet'
@@ -81,14 +83,43 @@ def parse_command_line(argv: Sequence[str]) -> Optional[List[int]]:
     return parse_ids(own[1])
 
 
+def share_sim_clock(nodes: Sequence[Node]) -> int:
+    """
+    Drive the clocks of all ``nodes`` from the first one's ``/clock``; return how many shared.
+
+    With ``use_sim_time`` every rclpy node subscribes to ``/clock`` and runs a Python callback
+    per tick (the plant publishes one per step, 100 Hz by default): K robots in a process would
+    take K callbacks per tick for one and the same time. The others' time sources are detached
+    from their nodes (their subscriptions destroyed) and their clocks attached to the first
+    node's time source, which then sets all of them at each tick. ``use_sim_time`` keeps its
+    value on every node. Nodes on wall time, and rclpy versions without the node's time source
+    attribute, are left as they are.
+    """
+    first = getattr(nodes[0], '_time_source', None) if nodes else None
+    if first is None or not first.ros_time_is_active:
+        return 0
+    shared = 0
+    for node in nodes[1:]:
+        source = getattr(node, '_time_source', None)
+        clock = node.get_clock()
+        if source is None or not source.ros_time_is_active or not isinstance(clock, ROSClock):
+            continue
+        source.detach_node()
+        first.attach_clock(clock)
+        shared += 1
+    return shared
+
+
 def make_fleet(ids: Sequence[int]) -> List[RobotNode]:
     """
-    Build one robot node per id, robot i in ``/robot_<i>``.
+    Build one robot node per id, robot i in ``/robot_<i>``, sharing one ``/clock`` subscription.
 
     Each node checks its parameters as a robot process does (a ``robot_id`` given to the fleet
     disagrees with every namespace but one and is refused there).
     """
-    return [RobotNode(namespace=robot_namespace(i)) for i in ids]
+    nodes = [RobotNode(namespace=robot_namespace(i)) for i in ids]
+    share_sim_clock(nodes)
+    return nodes
 
 
 def main(args: Optional[List[str]] = None) -> int:

@@ -21,7 +21,6 @@ With ``plant.lockstep`` it steps only when every robot has answered the latest s
 makes a run reproduce ``formation_sim --dt 1/plant.rate``.
 """
 
-from collections import deque
 import json
 import os
 import shutil
@@ -36,7 +35,7 @@ from formation_ros.core.plant import (Commands, CommandStatus, NS_PER_S, PLANT_S
 from formation_ros.core.trajectory import CHUNKS_DIR, ChunkWriter, read_chunks, Trajectory
 from formation_ros.ros import fields, messages, qos, topics
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
-from formation_ros.ros.markers import formation_markers
+from formation_ros.ros.markers import formation_markers, Paths
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
 from formation_ros.ros.runner import LOCKSTEP_POLL, run
@@ -84,9 +83,10 @@ class PlantNode(Node):
         self.last_publish_wall = 0.0
         self.started_wall: Optional[float] = None
         self.waiting = settings.wait_for_robots or self.lockstep
-        self.paths: deque = deque(maxlen=PATH_LENGTH)
+        self.paths = Paths(self.n, PATH_LENGTH)
         self.rate_window = (time.monotonic(), 0)
 
+        self.state_messages = messages.StateMessages(self.n, self.dim)
         self.pose_pubs, self.neighbour_pubs = [], []
         for i in range(1, self.n + 1):
             self.pose_pubs.append(self.create_publisher(
@@ -205,10 +205,12 @@ class PlantNode(Node):
     def _publish(self) -> None:
         """Publish /clock, then every robot's pose and what its range sensor sees."""
         self._publish_clock()
-        stamp, q = self.model.t_ns, self.model.q
-        for i, seen in enumerate(self.model.neighbours()):
-            self.pose_pubs[i].publish(messages.pose_stamped(q[i], stamp, self.dim))
-            self.neighbour_pubs[i].publish(messages.pose_array(q[seen], stamp, self.dim))
+        poses, arrays = self.state_messages.fill(self.model.q, self.model.neighbours(),
+                                                 self.model.t_ns)
+        for publisher, message in zip(self.pose_pubs, poses):
+            publisher.publish(message)
+        for publisher, message in zip(self.neighbour_pubs, arrays):
+            publisher.publish(message)
         self.last_publish_wall = time.monotonic()
 
     def _resend_if_due(self) -> None:
@@ -295,7 +297,7 @@ class PlantNode(Node):
         desired = desired_positions(self.config.vertices, self.reference.sample(self.model.t))
         self.marker_pub.publish(formation_markers(
             self.model.q, self.config.sensing_radii, self.law.repulsion_radius, desired,
-            np.array(self.paths), self.model.t_ns))
+            self.paths, self.model.t_ns))
 
     def trajectory(self) -> Optional[Trajectory]:
         """Return the run written so far (``plant.output_dir``): a sample per published state."""

@@ -18,6 +18,8 @@ how old it is (and, in lockstep, which state it answers).
 
 from collections import deque
 import enum
+import math
+import time
 from typing import Dict, List, Optional, Tuple
 
 from builtin_interfaces.msg import Time
@@ -101,8 +103,10 @@ class RobotNode(Node):
             f'bound c*M1 = {self.law.u_bound:.4g} m/s, '
             + ('lockstep' if self.lockstep else f'{settings.control_rate:g} Hz'))
 
-    def _now_ns(self) -> int:
-        return self.steady.now().nanoseconds
+    @staticmethod
+    def _now_ns() -> int:
+        """Steady time, ns: the clock of the timers (CLOCK_MONOTONIC), read without rclpy."""
+        return time.monotonic_ns()
 
     def _reject(self, name: str, reason: Reason, detail: str = '') -> bool:
         """Count and (once per input and reason) log a message ignored; return False."""
@@ -124,7 +128,7 @@ class RobotNode(Node):
         """Accept a state message only in the world frame, finite, stamped on this clock."""
         if header.frame_id != messages.WORLD_FRAME:
             return self._reject(name, Reason.FRAME, f' (got {header.frame_id!r})')
-        if not np.all(np.isfinite(values)):
+        if not all(map(math.isfinite, values)):
             return self._reject(name, Reason.NON_FINITE)
         gap = self._clock_gap_s(header.stamp)
         if abs(gap) * fields.NS_PER_S > self.timeout_ns:
@@ -167,9 +171,9 @@ class RobotNode(Node):
 
     def _plausible(self, msg: Odometry) -> bool:
         """Whether a reference sample's speed and turn rate fit the configured reference."""
-        twist = msg.twist.twist
-        speed = float(np.linalg.norm([twist.linear.x, twist.linear.y, twist.linear.z]))
-        turn = float(np.linalg.norm([twist.angular.x, twist.angular.y, twist.angular.z]))
+        linear, angular = msg.twist.twist.linear, msg.twist.twist.angular
+        speed = math.sqrt(linear.x ** 2 + linear.y ** 2 + linear.z ** 2)
+        turn = math.sqrt(angular.x ** 2 + angular.y ** 2 + angular.z ** 2)
         return (speed <= self.speed_limit * (1.0 + RATE_TOLERANCE) + RATE_TOLERANCE
                 and turn <= self.turn_limit * (1.0 + RATE_TOLERANCE) + RATE_TOLERANCE)
 
@@ -200,7 +204,12 @@ class RobotNode(Node):
         return self.last.u
 
     def on_timer(self) -> None:
-        """Compute and publish the command (or zero when inputs are stale)."""
+        """
+        Answer the newest state once: compute and publish its command (zero if inputs are stale).
+
+        A tick that finds no new pose since the last answer publishes nothing: the plant holds
+        the last command until it is ``plant.input_timeout`` old.
+        """
         if self.lockstep:
             self._lockstep_answer()
             return
@@ -216,10 +225,13 @@ class RobotNode(Node):
                                      f'{self.timeout_ns / 1e9:g} s: publishing zero')
             return
         self.once.end('stale', 'inputs fresh again: controlling')
+        if self.pose_count == self.answered_count:
+            return
         stamp = fields.stamp_to_ns(self.pose.header.stamp)
         command = self._command(stamp, False)
         self.cmd_pub.publish(messages.twist_stamped(
             np.zeros(self.dim) if command is None else command, stamp, self.dim))
+        self.answered_count = self.pose_count
 
     def _ready(self) -> bool:
         """Start-up: every input heard once and cmd_vel has its subscribers (plant, recorder)."""

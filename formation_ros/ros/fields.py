@@ -9,6 +9,8 @@ so they serve rclpy's messages in the nodes and the messages that ``rosbags`` de
 a bag alike.
 """
 
+import math
+
 from formation_ros.core.frames import frame_from_pose
 import numpy as np
 
@@ -56,4 +58,4 @@ def odometry_is_finite(msg):
     values = [pose.position.x, pose.position.y, pose.position.z, o.x, o.y, o.z, o.w,
               twist.linear.x, twist.linear.y, twist.linear.z,
               twist.angular.x, twist.angular.y, twist.angular.z]
-    return bool(np.all(np.isfinite(values))) and (o.x ** 2 + o.y ** 2 + o.z ** 2 + o.w ** 2) > 0
+    return all(map(math.isfinite, values)) and (o.x ** 2 + o.y ** 2 + o.z ** 2 + o.w ** 2) > 0

@@ -4,13 +4,19 @@
 """
 RViz markers of the formation (``/formation/markers``, visualization_msgs/MarkerArray).
 
-Namespaces: ``robots`` (spheres), ``sensing`` (discs in 2D, balls in 3D, radius R_i),
-``repulsion`` (radius b), ``desired`` (the desired formation polygon), ``paths`` (recent paths).
-Every marker is in frame 'world'; the arrays come from the plant.
+Namespaces: ``robots`` (spheres), ``sensing`` (discs in 2D, balls in 3D, radius R_i: a sphere
+list per distinct radius), ``repulsion`` (radius b, one sphere list), ``desired`` (the desired
+formation polygon), ``paths`` (recent paths, one line list). Every marker is in frame 'world';
+the arrays come from the plant. The number of markers does not grow with the team: a marker is
+a Python message of some forty fields, and building one per robot cost the plant most of its
+time at 50 robots.
 """
+
+from collections import deque
 
 from formation_ros.ros.messages import ns_to_stamp, WORLD_FRAME
 from geometry_msgs.msg import Point
+import numpy as np
 from std_msgs.msg import ColorRGBA
 from visualization_msgs.msg import Marker, MarkerArray
 
@@ -36,13 +42,42 @@ def _marker(ns, marker_id, kind, stamp_ns, rgba):
     return marker
 
 
-def _zone(ns, marker_id, centre, radius, dim, stamp_ns, rgba):
-    kind = Marker.CYLINDER if dim == 2 else Marker.SPHERE
-    marker = _marker(ns, marker_id, kind, stamp_ns, rgba)
-    marker.pose.position = _point(centre)
-    marker.scale.x = marker.scale.y = 2.0 * float(radius)
-    marker.scale.z = DISC_THICKNESS if dim == 2 else 2.0 * float(radius)
-    return marker
+def _zones(ns, first_id, centres, radii, dim, stamp_ns, rgba):
+    """
+    One SPHERE_LIST per distinct radius: discs (flattened spheres) in 2D, balls in 3D.
+
+    A marker per robot costs a Python message each; a list marker costs one per radius.
+    """
+    markers = []
+    for k, radius in enumerate(np.unique(radii)):
+        marker = _marker(ns, first_id + k, Marker.SPHERE_LIST, stamp_ns, rgba)
+        marker.scale.x = marker.scale.y = 2.0 * float(radius)
+        marker.scale.z = DISC_THICKNESS if dim == 2 else 2.0 * float(radius)
+        marker.points = [_point(centre) for centre in centres[radii == radius]]
+        markers.append(marker)
+    return markers
+
+
+class Paths:
+    """
+    The recent positions of every robot as marker points, oldest first.
+
+    Each position is made into a ``Point`` once, when it is added, so a marker of paths K long
+    costs N points per update rather than K * N.
+    """
+
+    def __init__(self, num_robots: int, length: int) -> None:
+        """Keep the last ``length`` positions of ``num_robots`` robots."""
+        self.points = [deque(maxlen=length) for _ in range(num_robots)]
+
+    def append(self, q) -> None:
+        """Add the positions ``q`` ((N, dim), m) of one moment."""
+        for path, row in zip(self.points, q):
+            path.append(_point(row))
+
+    def __len__(self) -> int:
+        """Return the number of moments kept."""
+        return len(self.points[0]) if self.points else 0
 
 
 def formation_markers(q, sensing_radii, repulsion_radius, desired, paths, stamp_ns):
@@ -50,7 +85,7 @@ def formation_markers(q, sensing_radii, repulsion_radius, desired, paths, stamp_
     Build the MarkerArray of one moment.
 
     q: (N, dim) positions; sensing_radii: (N,); repulsion_radius: b; desired: (N, dim) desired
-    positions; paths: (K, N, dim) recent positions, oldest first (K may be 0); stamp_ns: time.
+    positions; paths: the robots' recent positions (:class:`Paths`); stamp_ns: time.
     """
     dim = q.shape[1]
     array = MarkerArray()
@@ -58,18 +93,18 @@ def formation_markers(q, sensing_radii, repulsion_radius, desired, paths, stamp_
     robots.scale.x = robots.scale.y = robots.scale.z = ROBOT_DIAMETER
     robots.points = [_point(row) for row in q]
     array.markers.append(robots)
-    for i, (centre, radius) in enumerate(zip(q, sensing_radii)):
-        array.markers.append(_zone('sensing', i, centre, radius, dim, stamp_ns,
-                                   (0.2, 0.7, 0.2, 0.08)))
-        array.markers.append(_zone('repulsion', i, centre, repulsion_radius, dim, stamp_ns,
-                                   (0.9, 0.2, 0.1, 0.2)))
+    radii = np.asarray(sensing_radii, dtype=float)
+    array.markers.extend(_zones('sensing', 0, q, radii, dim, stamp_ns, (0.2, 0.7, 0.2, 0.08)))
+    array.markers.extend(_zones('repulsion', 0, q, np.full(len(q), float(repulsion_radius)),
+                                dim, stamp_ns, (0.9, 0.2, 0.1, 0.2)))
     polygon = _marker('desired', 0, Marker.LINE_STRIP, stamp_ns, (0.9, 0.1, 0.1, 0.9))
     polygon.scale.x = 0.04
     polygon.points = [_point(row) for row in desired] + [_point(desired[0])]
     array.markers.append(polygon)
-    for i in range(q.shape[0] if len(paths) > 1 else 0):
-        path = _marker('paths', i, Marker.LINE_STRIP, stamp_ns, (0.3, 0.3, 0.3, 0.7))
-        path.scale.x = 0.02
-        path.points = [_point(row) for row in paths[:, i]]
-        array.markers.append(path)
+    if len(paths) > 1:
+        lines = _marker('paths', 0, Marker.LINE_LIST, stamp_ns, (0.3, 0.3, 0.3, 0.7))
+        lines.scale.x = 0.02
+        lines.points = [point for path in paths.points
+                        for segment in zip(list(path)[:-1], list(path)[1:]) for point in segment]
+        array.markers.append(lines)
     return array
