@@ -46,6 +46,8 @@ BOUND_TOLERANCE_MOVING = 1e-3
 MAX_STATES_KEPT = 512
 MAX_START_TRIES = 20000
 PLANT_STATS_FILE = 'plant_stats.json'
+AGE_BINS = 64
+"""Command ages counted step by step in :attr:`PlantCounts.age_steps` (one more bin: none)."""
 
 
 class CommandStatus(enum.IntEnum):
@@ -134,6 +136,19 @@ class PlantCounts:
     oldest_counted_ns: int = 0
     """Age of the oldest command that counted for a step (how late commands arrive), ns."""
     status_steps: NDArray[np.int64] = field(default_factory=lambda: np.zeros((4, 0), np.int64))
+    age_steps: NDArray[np.int64] = field(
+        default_factory=lambda: np.zeros(AGE_BINS + 1, np.int64))
+    """Steps by the age of the oldest command held over them, in steps: bin k counts the steps
+    whose every robot held a command answering a state at most k steps old (and older than
+    k - 1); the last bin the steps at which some robot's command was older than AGE_BINS - 1
+    steps or did not count at all (missing, stale, future, non-finite)."""
+
+    def fresh_fraction(self, max_age_steps: int) -> float:
+        """Fraction of steps at which every robot's command answered a state <= that old."""
+        if self.steps == 0:
+            return 0.0
+        kept = int(np.clip(max_age_steps, -1, AGE_BINS - 1))
+        return float(self.age_steps[:kept + 1].sum()) / self.steps
 
     def steps_with(self, status: CommandStatus) -> int:
         """Robot-steps whose command had ``status`` (e.g. STALE), summed over robots."""
@@ -153,6 +168,43 @@ class PlantCounts:
         """Robot-steps with ``status`` per robot (1-based), for the robots that had any."""
         row = self.status_steps[status]
         return {int(i) + 1: int(row[i]) for i in np.flatnonzero(row)}
+
+
+class DurationHistogram:
+    """
+    Durations counted in bins of ``bin_ns`` up to ``limit_ns`` (longer ones in one more bin).
+
+    Percentiles are read back as the upper edge of their bin; the largest duration is kept
+    exactly. Memory is fixed however many durations are added.
+    """
+
+    def __init__(self, bin_ns: int = 100_000, limit_ns: int = 2 * NS_PER_S) -> None:
+        """Count durations of 0 to ``limit_ns`` in bins ``bin_ns`` wide (default 0.1 ms, 2 s)."""
+        self.bin_ns = int(bin_ns)
+        self.bins = np.zeros(-(-int(limit_ns) // self.bin_ns) + 1, dtype=np.int64)
+        self.largest_ns = 0
+
+    def add(self, durations_ns: ArrayLike) -> None:
+        """Count each of ``durations_ns`` (negative ones count as 0)."""
+        values = np.maximum(np.asarray(durations_ns, dtype=np.int64).ravel(), 0)
+        if values.size:
+            np.add.at(self.bins, np.minimum(values // self.bin_ns, len(self.bins) - 1), 1)
+            self.largest_ns = max(self.largest_ns, int(values.max()))
+
+    @property
+    def count(self) -> int:
+        """Return how many durations were added."""
+        return int(self.bins.sum())
+
+    def percentile_ns(self, percent: float) -> Optional[int]:
+        """Return the duration below which ``percent`` % of them fall (bin edge), or None."""
+        total = self.count
+        if total == 0:
+            return None
+        index = int(np.searchsorted(np.cumsum(self.bins), percent / 100.0 * total))
+        if index >= len(self.bins) - 1:
+            return self.largest_ns
+        return min((index + 1) * self.bin_ns, self.largest_ns)
 
 
 @dataclass(frozen=True)
@@ -349,9 +401,10 @@ class PlantModel:
         np.add.at(counts.status_steps, (admission.status, np.arange(self.num_robots)), 1)
         counts.bound_violations += len(violations)
         counted = np.isin(admission.status, (CommandStatus.APPLIED, CommandStatus.SATURATED))
-        if np.any(counted):
-            counts.oldest_counted_ns = max(counts.oldest_counted_ns,
-                                           int(np.max(t_ns - commands.stamp_ns[counted])))
+        oldest = int(np.max(t_ns - commands.stamp_ns[counted])) if np.any(counted) else 0
+        counts.oldest_counted_ns = max(counts.oldest_counted_ns, oldest)
+        age_bin = min(-(-oldest // self.step_ns), AGE_BINS) if np.all(counted) else AGE_BINS
+        counts.age_steps[age_bin] += 1
         collisions = self._new_collisions()
         counts.collisions += len(collisions)
         return StepReport(t_ns, q, admission, violations, collisions)

@@ -21,6 +21,7 @@ With ``plant.lockstep`` it steps only when every robot has answered the latest s
 makes a run reproduce ``formation_sim --dt 1/plant.rate``.
 """
 
+from collections import OrderedDict
 import json
 import os
 import shutil
@@ -30,8 +31,8 @@ from typing import Any, Dict, List, Optional
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.declarations import Exe
 from formation_ros.core.frames import desired_positions
-from formation_ros.core.plant import (Commands, CommandStatus, NS_PER_S, PLANT_STATS_FILE,
-                                      PlantModel, StepReport)
+from formation_ros.core.plant import (Commands, CommandStatus, DurationHistogram, NS_PER_S,
+                                      PLANT_STATS_FILE, PlantModel, StepReport)
 from formation_ros.core.trajectory import CHUNKS_DIR, ChunkWriter, read_chunks, Trajectory
 from formation_ros.ros import fields, messages, qos, topics
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
@@ -47,6 +48,7 @@ from rosgraph_msgs.msg import Clock as ClockMsg
 from visualization_msgs.msg import MarkerArray
 
 RESEND_AFTER = 0.05
+PUBLISHES_TIMED = 256
 PATH_LENGTH = 100
 CHUNK_PERIOD = 1.0
 DUPLICATE_GRACE = 25.0
@@ -84,6 +86,10 @@ class PlantNode(Node):
         self.started_wall: Optional[float] = None
         self.waiting = settings.wait_for_robots or self.lockstep
         self.paths = Paths(self.n, PATH_LENGTH)
+        self.published_ns: 'OrderedDict[int, int]' = OrderedDict()
+        self.arrived_ns = np.zeros(self.n, dtype=np.int64)
+        self.timed_stamp = np.full(self.n, -1, dtype=np.int64)
+        self.latency = DurationHistogram()
         self.rate_window = (time.monotonic(), 0)
 
         self.state_messages = messages.StateMessages(self.n, self.dim)
@@ -118,9 +124,19 @@ class PlantNode(Node):
                else f'realtime factor {settings.realtime_factor:g}'))
 
     def on_command(self, index: int, msg: TwistStamped) -> None:
-        """Store robot ``index``'s latest command."""
+        """Store robot ``index``'s latest command and when it arrived."""
         self.commands.store(index, fields.velocity_of(msg, self.dim),
                             fields.stamp_to_ns(msg.header.stamp))
+        self.arrived_ns[index] = time.monotonic_ns()
+
+    def _time_answers(self) -> None:
+        """Count how long each new command took: from its state's publish to its arrival."""
+        stamps = self.commands.stamp_ns
+        new = np.flatnonzero(self.commands.present & (stamps != self.timed_stamp))
+        sent = [self.published_ns.get(int(stamps[i]), -1) for i in new]
+        known = [k for k, when in enumerate(sent) if when >= 0]
+        self.latency.add(self.arrived_ns[new[known]] - np.array(sent, dtype=np.int64)[known])
+        self.timed_stamp[new] = stamps[new]
 
     def on_timer(self) -> None:
         """Free-running: one step per tick. Lockstep: step when every robot has answered."""
@@ -152,6 +168,7 @@ class PlantNode(Node):
             self._resend_if_due()
 
     def _step(self) -> None:
+        self._time_answers()
         report = self.model.advance(self.commands)
         self.largest_u_hat = max(self.largest_u_hat,
                                  float(np.max(report.admission.largest_u_hat)))
@@ -205,6 +222,9 @@ class PlantNode(Node):
     def _publish(self) -> None:
         """Publish /clock, then every robot's pose and what its range sensor sees."""
         self._publish_clock()
+        self.published_ns[self.model.t_ns] = time.monotonic_ns()
+        while len(self.published_ns) > PUBLISHES_TIMED:
+            self.published_ns.popitem(last=False)
         poses, arrays = self.state_messages.fill(self.model.q, self.model.neighbours(),
                                                  self.model.t_ns)
         for publisher, message in zip(self.pose_pubs, poses):
@@ -337,6 +357,12 @@ class PlantNode(Node):
             'achieved_step_rate': totals['steps'] / wall if wall > 0 else None}
         stats.update(totals)
         stats['oldest_command_counted'] = counts.oldest_counted_ns / NS_PER_S
+        stats['command_age_steps'] = counts.age_steps.tolist()
+        stats['answer_latency'] = {
+            'count': self.latency.count,
+            **{f'p{p}_ms': (None if self.latency.percentile_ns(p) is None
+                            else self.latency.percentile_ns(p) / 1e6) for p in (50, 99)},
+            'max_ms': self.latency.largest_ns / 1e6}
         stats['by_robot'] = {status.name.lower(): counts.by_robot(status)
                              for status in CommandStatus if status is not CommandStatus.APPLIED}
         with open(os.path.join(output_dir, PLANT_STATS_FILE), 'w', encoding='utf-8') as stream:

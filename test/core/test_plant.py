@@ -58,6 +58,27 @@ def test_admission_names_why_a_command_does_not_count():
     assert totals['missing_command_steps'] == 5 * 4 + 1 and totals['steps'] == 6
 
 
+def test_steps_are_counted_by_the_age_of_their_oldest_command():
+    plant = model([[0.0, 0.0], [3.0, 0.0]], timeout_ns=3 * MS)
+    plant.advance(Commands.empty(2, 2))
+    for lag_1, lag_2 in [(0, 0), (1, 0), (2, 1), (0, 3), (0, 4)]:
+        commands = Commands.empty(2, 2)
+        commands.store(0, [0.0, 0.0], plant.t_ns - lag_1 * MS)
+        commands.store(1, [0.0, 0.0], plant.t_ns - lag_2 * MS)
+        plant.advance(commands)
+    counts = plant.counts
+    expected = np.zeros_like(counts.age_steps)
+    for age in (0, 1, 2, 3):
+        expected[age] = 1
+    expected[-1] = 2
+    assert counts.age_steps.tolist() == expected.tolist() and counts.steps == 6
+    assert counts.fresh_fraction(0) == pytest.approx(1 / 6)
+    assert counts.fresh_fraction(2) == pytest.approx(3 / 6)
+    assert counts.fresh_fraction(3) == pytest.approx(4 / 6)
+    assert counts.fresh_fraction(10 ** 6) == pytest.approx(4 / 6)
+    assert counts.age_steps.sum() == counts.steps
+
+
 def test_a_collision_is_counted_once_per_approach():
     plant = model([[0.0, 0.0], [0.01, 0.0], [5.0, 5.0]], collision=0.005)
     commands = Commands.empty(3, 2)
@@ -145,3 +166,20 @@ def test_formation_sim_fixed_step_is_the_plant_model_answered_every_step(name):
         report = plant.advance(commands)
         assert (report.admission.status == CommandStatus.APPLIED).all()
     assert np.array_equal(plant.q, trajectory.q[50])
+
+
+def test_duration_histogram_percentiles_against_numpy():
+    from formation_ros.core.plant import DurationHistogram
+    rng = np.random.default_rng(3)
+    values = rng.exponential(2_000_000, 5000).astype(np.int64)
+    histogram = DurationHistogram(bin_ns=100_000, limit_ns=10_000_000)
+    assert histogram.percentile_ns(50) is None
+    histogram.add(values[:2500])
+    histogram.add(values[2500:])
+    assert histogram.count == 5000 and histogram.largest_ns == values.max()
+    for percent in (50, 90, 99):
+        exact = np.percentile(values, percent)
+        assert exact - 100_000 <= histogram.percentile_ns(percent) <= exact + 100_000, percent
+    assert histogram.percentile_ns(100) == values.max()
+    histogram.add([-5, 0])
+    assert histogram.bins[0] >= 2
