@@ -37,7 +37,7 @@ sys.path[:0] = [ROOT, BENCH]
 from bench_system import params_for  # noqa: E402
 from formation_ros.core.params_file import write_params_file  # noqa: E402, I100
 
-NODES = ('plant', 'reference', 'robot', 'record')
+NODES = ('plant', 'reference', 'robot', 'record', 'fleet')
 LAUNCHER = 'launcher'
 DEFAULT_DURATION = 1800.0
 DEFAULT_INTERVAL = 5.0
@@ -127,13 +127,17 @@ def node_name(args: Sequence[str], prefix: str) -> Optional[str]:
     """
     Name the formation node started with command line ``args`` from install ``prefix``.
 
-    Returns 'plant', 'reference', 'record' or 'robot_<id>' (from ``robot_id:=<id>``, else the
-    ``/robot_<id>`` namespace), or None for any other process.
+    Returns 'plant', 'reference', 'record', 'robot_<id>' (from ``robot_id:=<id>``, else the
+    ``/robot_<id>`` namespace) or 'fleet_<ids>' (from ``--robots <ids>``), or None for any
+    other process.
     """
     base = os.path.join(prefix, 'lib', 'formation_ros') + os.sep
     executable = next((arg[len(base):] for arg in args if arg.startswith(base)), None)
     if executable not in NODES:
         return None
+    if executable == 'fleet':
+        ids = next((b for a, b in zip(args, args[1:]) if a == '--robots'), '')
+        return f'fleet_{ids}' if ids else 'fleet'
     if executable != 'robot':
         return executable
     for arg in args:

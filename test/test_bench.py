@@ -78,6 +78,8 @@ def test_node_names_from_command_lines(soak):
     assert soak.node_name(['python3', exe + 'robot', '--ros-args', '-r', '__ns:=/robot_7',
                            '-p', 'robot_id:=7'], prefix) == 'robot_7'
     assert soak.node_name(['python3', exe + 'record'], prefix) == 'record'
+    assert soak.node_name(['python3', exe + 'fleet', '--robots', '1-5', '--ros-args'],
+                          prefix) == 'fleet_1-5'
     assert soak.node_name(['python3', exe + 'formation_report', 'bag'], prefix) is None
     assert soak.node_name(['python3', '/other/lib/formation_ros/plant'], prefix) is None
 

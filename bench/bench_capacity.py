@@ -1,0 +1,279 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+Capacity benchmark: how many robots, at what rate, on this machine (on demand, not in CI).
+
+Usage: python bench/bench_capacity.py [--sizes 10 20 50 100] [--rates 20 50]
+[--modes process fleet] [--robots-per-process 25] [--measure 20] [--lockstep]
+[--prefix INSTALL] [--out DIR]
+
+For each mode, team size N and control rate it runs scripts/launch_formation.sh on the Section 5
+constants with N robots (random start at about 10 robots per m^2, lattice goal 2 m apart),
+control_rate and plant.publish_rate = RATE, plant.rate 100 Hz, one process per robot
+('process') or --robots-per-process robots per 'fleet' process ('fleet'). It measures the
+start-up (launch until the plant starts its clock: every robot has answered), then for MEASURE
+wall seconds the CPU time and resident memory of every process of the run, then stops the run
+with Ctrl-C and reads the plant's plant_stats.json: the achieved step rate, the fraction of
+steps at which every robot's applied command answered a state at most two control periods old
+('fresh'), and the latency from the plant publishing a state to the answer arriving (p50, p99,
+max). With --lockstep it runs lockstep instead (plant.lockstep, as fast as the robots answer)
+and reports steps per second. Prints a Markdown table, writes OUT/capacity.json and a figure of
+the fresh fraction against N (OUT/capacity_fresh.png).
+"""
+
+import argparse
+import datetime
+import json
+import os
+import platform
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
+
+BENCH = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(BENCH)
+sys.path[:0] = [ROOT, BENCH]
+
+from bench_soak import find_run_processes, LAUNCHER, read_rss_kib  # noqa: E402
+from bench_system import params_for  # noqa: E402
+from formation_ros.core.params_file import write_params_file  # noqa: E402, I100
+
+PLANT_RATE = 100.0
+MODES = ('process', 'fleet')
+CLOCK_STARTED = 'starting the clock'
+STOP_TIMEOUT = 120.0
+TICKS = os.sysconf('SC_CLK_TCK')
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """Command line of the capacity benchmark."""
+    parser = argparse.ArgumentParser(
+        prog='bench_capacity.py', description=__doc__.split('\n\n')[2].strip(),
+        epilog='Quick check: python bench/bench_capacity.py --sizes 4 --rates 20 --measure 5')
+    parser.add_argument('--sizes', type=int, nargs='+', default=[10, 20, 50, 100],
+                        help='team sizes N (default: %(default)s)')
+    parser.add_argument('--rates', type=float, nargs='+', default=[20.0, 50.0],
+                        help='control rates, Hz (default: %(default)s)')
+    parser.add_argument('--modes', nargs='+', choices=MODES, default=list(MODES),
+                        help='process: one per robot; fleet: --robots-per-process per process')
+    parser.add_argument('--robots-per-process', type=int, default=25,
+                        help='robots per fleet process (default: %(default)s)')
+    parser.add_argument('--measure', type=float, default=20.0,
+                        help='wall seconds measured after the clock starts (default %(default)g)')
+    parser.add_argument('--startup-timeout', type=float, default=600.0,
+                        help='wall seconds to wait for the clock to start (default %(default)g)')
+    parser.add_argument('--lockstep', action='store_true',
+                        help='run the plant in lockstep and report steps per second')
+    parser.add_argument('--prefix', default=os.path.join(ROOT, 'install', 'formation_ros'),
+                        help='install space of formation_ros (default: %(default)s)')
+    parser.add_argument('--out', help='output directory (default: runs/capacity-<date>-<time>)')
+    return parser
+
+
+def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
+    """Parse and check the command line (argparse exits 2 on a bad one)."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if min(args.sizes) < 1 or args.robots_per_process < 1:
+        parser.error('--sizes and --robots-per-process must be >= 1')
+    if min(args.rates) <= 0.0 or max(args.rates) > PLANT_RATE:
+        parser.error(f'--rates must be > 0 and at most the plant rate, {PLANT_RATE:g} Hz')
+    if not args.measure > 0.0 or not args.startup_timeout > 0.0:
+        parser.error('--measure and --startup-timeout must be > 0')
+    if not os.access(os.path.join(args.prefix, 'lib', 'formation_ros', 'plant'), os.X_OK):
+        parser.error(f"no formation_ros install at --prefix '{args.prefix}' (build one with "
+                     'colcon, see README)')
+    args.prefix = os.path.abspath(args.prefix)
+    if args.out is None:
+        stamp = datetime.datetime.now().strftime('%Y%m%d-%H%M%S')
+        args.out = os.path.join(ROOT, 'runs', f'capacity-{stamp}')
+    return args
+
+
+def cpu_seconds(pid: int) -> Optional[float]:
+    """Return the CPU time (user + system) of process ``pid`` so far, s; None if it is gone."""
+    try:
+        with open(f'/proc/{pid}/stat', 'rb') as stream:
+            fields = stream.read().rsplit(b')', 1)[1].split()
+    except OSError:
+        return None
+    return (int(fields[11]) + int(fields[12])) / TICKS
+
+
+def fresh_fraction(age_steps: Sequence[int], max_age: int) -> Optional[float]:
+    """Fraction of steps whose oldest command was at most ``max_age`` steps old."""
+    total = sum(age_steps)
+    return sum(age_steps[:max_age + 1]) / total if total else None
+
+
+def case_params(n: int, rate: float, lockstep: bool) -> Dict[str, Any]:
+    """Parameters of one case (Section 5 constants, N robots, control and publish at RATE)."""
+    params = params_for(n)
+    params.update({'control_rate': float(rate), 'plant.publish_rate': float(rate),
+                   'plant.rate': PLANT_RATE, 'duration': 1e4})
+    if lockstep:
+        params.update({'plant.lockstep': True, 'plant.realtime_factor': 1e3})
+    return params
+
+
+def wait_for_text(path: str, text: str, process: 'subprocess.Popen[bytes]',
+                  timeout: float) -> bool:
+    """Wait until the file ``path`` holds ``text``; False if the process ends or time is up."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and process.poll() is None:
+        with open(path, 'rb') as stream:
+            if text.encode() in stream.read():
+                return True
+        time.sleep(0.1)
+    return False
+
+
+def snapshot(pids: Mapping[str, int]) -> Dict[str, Tuple[Optional[float], Optional[int]]]:
+    """Return {name: (CPU seconds, RSS KiB)} of the processes."""
+    return {name: (cpu_seconds(pid), read_rss_kib(pid)) for name, pid in pids.items()}
+
+
+def stop(process: 'subprocess.Popen[bytes]') -> None:
+    """Ctrl-C the launcher (it stops its nodes and writes the run), SIGKILL if it hangs."""
+    if process.poll() is None:
+        process.send_signal(signal.SIGINT)
+    try:
+        process.wait(STOP_TIMEOUT)
+    except subprocess.TimeoutExpired:
+        os.killpg(process.pid, signal.SIGKILL)
+        process.wait()
+
+
+def run_case(args: argparse.Namespace, mode: str, n: int, rate: float,
+             folder: str) -> Dict[str, Any]:
+    """Run one case and return its row."""
+    params = os.path.join(folder, 'params.yaml')
+    write_params_file(params, case_params(n, rate, args.lockstep))
+    run_dir = os.path.join(folder, 'run')
+    log = os.path.join(folder, 'launcher.txt')
+    command = ['bash', os.path.join(ROOT, 'scripts', 'launch_formation.sh'), params,
+               '--duration', '0', '--out', run_dir, '--prefix', args.prefix]
+    if mode == 'fleet':
+        command += ['--robots-per-process', str(args.robots_per_process)]
+    row: Dict[str, Any] = {'mode': mode, 'robots': n, 'rate_hz': rate, 'lockstep': args.lockstep}
+    with open(log, 'wb') as output:
+        started = time.monotonic()
+        process = subprocess.Popen(command, stdout=output, stderr=subprocess.STDOUT,
+                                   start_new_session=True)
+    try:
+        if not wait_for_text(log, CLOCK_STARTED, process, args.startup_timeout):
+            row['error'] = 'the clock did not start (see launcher.txt)'
+            return row
+        row['startup_s'] = time.monotonic() - started
+        pids = find_run_processes(process.pid, args.prefix)
+        pids[LAUNCHER] = process.pid
+        before, t0 = snapshot(pids), time.monotonic()
+        time.sleep(args.measure)
+        after, t1 = snapshot(pids), time.monotonic()
+    finally:
+        stop(process)
+    row['processes'] = len(pids) - 1
+    row['cpu_percent'] = {name: 100.0 * (after[name][0] - before[name][0]) / (t1 - t0)
+                          for name in pids
+                          if before[name][0] is not None and after[name][0] is not None}
+    row['rss_mib'] = {name: after[name][1] / 1024.0 for name in pids
+                      if after[name][1] is not None}
+    stats_path = os.path.join(run_dir, 'plant_stats.json')
+    if not os.path.isfile(stats_path):
+        row['error'] = 'no plant_stats.json (see launcher.txt)'
+        return row
+    with open(stats_path, encoding='utf-8') as stream:
+        stats = json.load(stream)
+    row['step_rate'] = stats['achieved_step_rate']
+    row['steps'] = stats['steps']
+    two_periods = int(round(2.0 * PLANT_RATE / rate))
+    row['fresh_fraction'] = fresh_fraction(stats['command_age_steps'], two_periods)
+    row['latency_ms'] = stats['answer_latency']
+    return row
+
+
+def _sum_where(values: Mapping[str, float], robots: bool) -> float:
+    return sum(v for name, v in values.items()
+               if name.startswith(('robot', 'fleet')) == robots and name != LAUNCHER)
+
+
+def format_row(row: Mapping[str, Any]) -> str:
+    """One Markdown table row."""
+    head = f"| {row['mode']} | {row['robots']} | {row['rate_hz']:g} |"
+    if 'error' in row:
+        return head + f" {row['error']} |" + ' |' * 8
+    latency = row['latency_ms']
+    fresh = row['fresh_fraction']
+    cpu, rss = row['cpu_percent'], row['rss_mib']
+    return (head + f" {row['processes']} | {row['startup_s']:.1f} | {row['step_rate']:.1f} | "
+            f"{'-' if fresh is None else f'{100.0 * fresh:.1f}'} | "
+            f"{latency['p50_ms'] or 0:.1f} / {latency['p99_ms'] or 0:.1f} / "
+            f"{latency['max_ms']:.0f} | {cpu.get('plant', 0.0):.0f} | "
+            f'{_sum_where(cpu, True):.0f} | {rss.get("plant", 0.0):.0f} | '
+            f'{sum(rss.values()) / 1024.0:.2f} |')
+
+
+HEADER = ('| mode | N | rate (Hz) | processes | start-up (s) | plant steps/s | fresh (%) | '
+          'latency p50 / p99 / max (ms) | plant CPU (%) | robots CPU (%) | plant RSS (MiB) | '
+          'all RSS (GiB) |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|')
+
+
+def write_figure(path: str, rows: Sequence[Mapping[str, Any]]) -> None:
+    """Plot the fresh fraction against N per mode and rate into the PNG file ``path``."""
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    figure, axes = plt.subplots(figsize=(7, 4.5))
+    keys = sorted({(row['mode'], row['rate_hz']) for row in rows})
+    for mode, rate in keys:
+        points = sorted((row['robots'], 100.0 * row['fresh_fraction']) for row in rows
+                        if (row['mode'], row['rate_hz']) == (mode, rate)
+                        and row.get('fresh_fraction') is not None)
+        if points:
+            axes.plot(*zip(*points), marker='o', label=f'{mode}, {rate:g} Hz')
+    axes.axhline(99.0, color='grey', linestyle='--', linewidth=0.8)
+    axes.set_xscale('log')
+    axes.set_xlabel('robots N')
+    axes.set_ylabel('fresh steps [%] (every command <= 2 control periods old)')
+    axes.set_ylim(0, 101)
+    axes.grid(True, alpha=0.3)
+    axes.legend()
+    figure.tight_layout()
+    figure.savefig(path, dpi=110)
+    plt.close(figure)
+
+
+def main(argv: Optional[Sequence[str]] = None) -> int:
+    """Run every case, print the table, write JSON and the figure; 0 if every case ran."""
+    args = parse_args(argv)
+    os.makedirs(args.out, exist_ok=True)
+    machine = {'machine': platform.machine(), 'cores': os.cpu_count(),
+               'python': platform.python_version(), 'load_before': os.getloadavg()}
+    print(f"machine: {machine['machine']}, {machine['cores']} cores, Python "
+          f"{machine['python']}; plant.rate {PLANT_RATE:g} Hz, {args.measure:g} s measured"
+          + (', lockstep' if args.lockstep else '') + '\n')
+    print(HEADER, flush=True)
+    rows: List[Dict[str, Any]] = []
+    os.environ.setdefault('ROS_AUTOMATIC_DISCOVERY_RANGE', 'LOCALHOST')
+    for mode in args.modes:
+        for rate in args.rates:
+            for n in args.sizes:
+                with tempfile.TemporaryDirectory(dir=args.out) as folder:
+                    row = run_case(args, mode, n, rate, folder)
+                rows.append(row)
+                print(format_row(row), flush=True)
+    result = {**machine, 'load_after': os.getloadavg(), 'arguments': vars(args), 'rows': rows}
+    with open(os.path.join(args.out, 'capacity.json'), 'w', encoding='utf-8') as stream:
+        json.dump(result, stream, indent=2, default=str)
+        stream.write('\n')
+    write_figure(os.path.join(args.out, 'capacity_fresh.png'), rows)
+    print(f'\nwrote {os.path.join(args.out, "capacity.json")} and capacity_fresh.png')
+    return 0 if all('error' not in row for row in rows) else 1
+
+
+if __name__ == '__main__':
+    sys.exit(main())
