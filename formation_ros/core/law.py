@@ -171,15 +171,23 @@ def robot_command(q_i: ArrayLike, vertex_i: ArrayLike, neighbours: ArrayLike,
     return Command(u=u, u_hat=u_hat, omega=omega_hat)
 
 
-def neighbour_pairs(q: ArrayLike, radius: float) -> NDArray[np.intp]:
-    """Pairs (i, j), i < j, with ||q_i - q_j|| <= radius, from a k-d tree: (P, 2) int array."""
-    tree = cKDTree(np.asarray(q, dtype=float))
+def neighbour_pairs(q: ArrayLike, radius: float,
+                    tree: Optional[cKDTree] = None) -> NDArray[np.intp]:
+    """
+    Pairs (i, j), i < j, with ||q_i - q_j|| <= radius, from a k-d tree: (P, 2) int array.
+
+    tree: a k-d tree of ``q`` already built (the plant model keeps one per step), else one is
+    built here.
+    """
+    if tree is None:
+        tree = cKDTree(np.asarray(q, dtype=float))
     pairs: NDArray[np.intp] = tree.query_pairs(r=radius, output_type='ndarray').reshape(-1, 2)
     return pairs
 
 
 def team_command(q: ArrayLike, vertices: ArrayLike, sensing_radii: ArrayLike, law: LawParams,
-                 frame: Optional[FrameSample] = STATIONARY) -> Command:
+                 frame: Optional[FrameSample] = STATIONARY,
+                 tree: Optional[cKDTree] = None) -> Command:
     """
     Control of every robot at once (the vectorised form of :func:`robot_command`).
 
@@ -187,13 +195,14 @@ def team_command(q: ArrayLike, vertices: ArrayLike, sensing_radii: ArrayLike, la
     Neighbours are found with a k-d tree within b (betabar' vanishes beyond b and b <= R_i), then
     each robot keeps only those within its own R_i, so a step costs O(N log N).
     Returns a :class:`Command` with (N, dim) arrays. Raises ValueError for a non-finite position
-    or robots farther apart than about 1e150 m (the k-d tree cannot search them).
+    or robots farther apart than about 1e150 m (the k-d tree cannot search them). tree: a k-d
+    tree of ``q`` (world frame) if the caller has one, so a step builds one tree, not two.
     """
     q = np.asarray(q, dtype=float)
     radii = np.asarray(sensing_radii, dtype=float)
     n, dim = q.shape
     q_hat = to_frame(q, frame)
-    pairs = neighbour_pairs(q, law.repulsion_radius)
+    pairs = neighbour_pairs(q, law.repulsion_radius, tree)
     i, j = pairs[:, 0], pairs[:, 1]
     q_hat_ij = q_hat[i] - q_hat[j]
     d2 = np.einsum('kd,kd->k', q_hat_ij, q_hat_ij)

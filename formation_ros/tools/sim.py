@@ -145,7 +145,7 @@ def simulate_fixed_step(config: FormationConfig, duration: float, dt: float,
     for k in range(steps + 1):
         frame = reference.sample(model.t)
         commands.store_all(team_command(model.q, config.vertices, config.sensing_radii, law,
-                                        frame).u, model.t_ns)
+                                        frame, model.tree).u, model.t_ns)
         if k == steps:
             times.append(model.t)
             states.append(model.q)

@@ -160,3 +160,15 @@ def test_potential_is_zero_only_at_the_formation_and_infinite_at_collision():
     assert potential(close, vertices, law) > potential(moved, vertices, law)
     collided = np.array([[0.0, 0.0], [0.0, 0.0], [0.0, 2.0]])
     assert potential(collided, vertices, law) == np.inf
+
+
+def test_team_command_with_the_callers_tree_is_the_same_command():
+    from scipy.spatial import cKDTree
+    rng = np.random.default_rng(11)
+    q = rng.uniform(-3.0, 3.0, (60, 2))
+    vertices = rng.uniform(-3.0, 3.0, (60, 2))
+    radii = np.full(60, 2.0)
+    law = make_law(2.0, 1.0, 'arctan', 'poly', 2, 1.0)
+    alone = team_command(q, vertices, radii, law)
+    shared = team_command(q, vertices, radii, law, tree=cKDTree(q))
+    assert np.array_equal(alone.u, shared.u) and np.array_equal(alone.omega, shared.omega)
