@@ -15,17 +15,21 @@ has started its clock (its 'starting the clock' line in the launcher's output, w
 prints once every robot has sent a command). After HOLD more seconds of running formation it
 sends SIGKILL to the launcher process alone (not its group) and reads /proc/<pid>/stat of every
 node every 5 ms until each has ended (gone, or a zombie): the seconds from the kill to each
-node's end. A node still there TIMEOUT s after the kill is killed and counts as a failure, as
-does any process of the run left afterwards (a process whose environment names the killed
-launcher in FORMATION_LAUNCHER_PID) and, with --record, a bag without metadata.yaml. BUSY busy
-loops (sh -c 'while :; do :; done') run during the whole measurement and are killed at the end.
-Prints a table (per run the load, the slowest node and every node's time) and a summary, and
+node's end (the clock is read after each look, so a time is an upper bound). The benchmark
+adopts the orphaned nodes (PR_SET_CHILD_SUBREAPER) and reads how each ended: anything but
+exit code 0 counts as a failure. So does a node still there TIMEOUT s after the kill (it is
+killed), any process of the run left afterwards (a process whose environment names the
+killed launcher in FORMATION_LAUNCHER_PID) and, with --record, a bag without metadata.yaml.
+BUSY busy loops (sh -c 'while :; do :; done') run during the whole measurement and are killed
+at the end. Prints a table (per run the load, the slowest node and every node's time) and a summary, and
 writes the times, the machine and the load averages as JSON (--json, default
 OUT/orphans.json). Exit code: 0 when every node of every run ended within LIMIT s and nothing
 failed, 1 otherwise.
 """
 
 import argparse
+import collections
+import ctypes
 import datetime
 import os
 import platform
@@ -58,6 +62,7 @@ CLOCK_LINE = 'starting the clock'
 LAUNCHER_PID_ENV = 'FORMATION_LAUNCHER_PID'
 LAUNCHER_START_ENV = 'FORMATION_LAUNCHER_START'
 BUSY_LOOP = ['sh', '-c', 'while :; do :; done']
+PR_SET_CHILD_SUBREAPER = 36
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -165,6 +170,40 @@ def launched_by(pid: int) -> Tuple[Optional[str], Optional[str]]:
     return env.get(LAUNCHER_PID_ENV), env.get(LAUNCHER_START_ENV)
 
 
+def become_subreaper() -> bool:
+    """
+    Adopt the orphans among this process's descendants (Linux); True if it worked.
+
+    The nodes of a killed launcher then become this benchmark's children, so it can read how
+    each one ended (exit code or signal) when it reaps them.
+    """
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        return libc.prctl(PR_SET_CHILD_SUBREAPER, 1, 0, 0, 0) == 0
+    except (OSError, AttributeError):
+        return False
+
+
+def describe_status(status: int) -> str:
+    """Describe a wait status: 'exit N' or the signal's name."""
+    if os.WIFSIGNALED(status):
+        number = os.WTERMSIG(status)
+        try:
+            return signal.Signals(number).name
+        except ValueError:
+            return f'signal {number}'
+    return f'exit {os.WEXITSTATUS(status)}'
+
+
+def reap(pid: int) -> Optional[str]:
+    """Wait for child ``pid`` and describe how it ended; None if it is not this one's child."""
+    try:
+        _, status = os.waitpid(pid, 0)
+    except ChildProcessError:
+        return None
+    return describe_status(status)
+
+
 def run_processes_left(launcher_pid: int, launcher_start: Optional[int]) -> List[int]:
     """Pids of the live processes whose environment names this launcher (its nodes, theirs)."""
     left = []
@@ -184,19 +223,20 @@ def watch_ends(nodes: Mapping[str, Tuple[int, int]], since: float, poll: float,
     """
     Poll ``nodes`` {name: (pid, start)} every ``poll`` s until each has ended.
 
-    Returns {name: seconds from ``since`` (monotonic clock) to the first poll that found it
-    gone}, None for a node still there ``timeout`` s after ``since``. ``tick`` (optional) is
-    called once per poll (the benchmark reaps the killed launcher there).
+    Returns {name: seconds from ``since`` (monotonic clock) to the moment a look at /proc found
+    it gone}, None for a node still there ``timeout`` s after ``since``. The clock is read
+    after each look, so a benchmark descheduled between two looks (a busy machine) makes a
+    time longer, never shorter: each time is an upper bound of when the node ended. ``tick``
+    (optional) is called once per poll (the benchmark reaps the killed launcher there).
     """
     ends: Dict[str, Optional[float]] = {}
     waiting = dict(nodes)
     while waiting:
-        now = time.monotonic()
         for name, (pid, start) in list(waiting.items()):
             if not alive(pid, start):
-                ends[name] = now - since
+                ends[name] = time.monotonic() - since
                 del waiting[name]
-        if not waiting or now - since > timeout:
+        if not waiting or time.monotonic() - since > timeout:
             break
         if tick is not None:
             tick()
@@ -363,6 +403,11 @@ def one_run(number: int, args: argparse.Namespace, names: Sequence[str],
         left = sorted(set(run_processes_left(process.pid, launcher_start)) |
                       {pid for pid, start in nodes.values() if alive(pid, start)})
         _kill_pids(left)
+        exits = {name: reap(pid) for name, (pid, _) in nodes.items()}
+        result['exits'] = exits
+        for name, how in exits.items():
+            if how is not None and how != 'exit 0' and result['ends'].get(name) is not None:
+                result['failures'].append(f'{name} ended with {how}')
         if left:
             result['left_over'] = left
             result['failures'].append(f'{len(left)} processes of the run left (killed): {left}')
@@ -404,6 +449,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     load_start = list(os.getloadavg())
     runs: List[Dict[str, Any]] = []
     previous = signal.signal(signal.SIGTERM, _terminate)
+    subreaper = become_subreaper()
     loops = start_busy(args.busy)
     try:
         for number in range(1, args.runs + 1):
@@ -422,7 +468,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         'load_average_start': load_start, 'load_average_end': list(os.getloadavg()),
         'params': args.params, 'prefix': args.prefix, 'record': args.record,
         'busy_loops': args.busy, 'hold_s': args.hold, 'poll_s': POLL, 'ros_domain_id': domain,
-        'nodes': names, 'summary': summary, 'runs': runs,
+        'nodes': names, 'subreaper': subreaper, 'summary': summary, 'runs': runs,
     }
     write_json(args.json, result)
     print(format_table(runs, names))
@@ -432,6 +478,9 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
               f"{args.limit:g} s: {summary['over_limit']}; failures: {summary['failures']}")
     else:
         print(f"orphans: no node end measured; failures: {summary['failures']}")
+    exits = collections.Counter(str(how) for run in runs for how in run.get('exits', {}).values())
+    ended = ', '.join(f'{how} x{count}' for how, count in sorted(exits.items()))
+    print(f'orphans: how the nodes ended: {ended}')
     print(f'orphans: load average (1, 5, 15 min) at the start {load_start[0]:.2f} '
           f'{load_start[1]:.2f} {load_start[2]:.2f}, at the end '
           f"{' '.join(f'{v:.2f}' for v in result['load_average_end'])}; wrote {args.json}")

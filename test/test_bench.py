@@ -219,3 +219,13 @@ def test_orphans_summary_and_table(orphans):
     assert lines[0] == '| run | load | slowest (s) | plant | robot_1 |'
     assert lines[2] == '| 1 | 3.0 | 0.400 | 0.200 | 0.400 |'
     assert lines[3] == '| 2 | 4.2 | not ended | 2.500 | not ended |'
+
+
+def test_orphans_reads_how_a_child_ended(orphans):
+    code = subprocess.Popen([sys.executable, '-c', 'raise SystemExit(3)'])
+    killed = subprocess.Popen([sys.executable, '-c', 'import time; time.sleep(30)'])
+    killed.kill()
+    assert orphans.reap(code.pid) == 'exit 3'
+    assert orphans.reap(killed.pid) == 'SIGKILL'
+    assert orphans.reap(os.getpid()) is None  # not a child
+    assert orphans.describe_status(0) == 'exit 0'
