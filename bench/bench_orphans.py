@@ -21,8 +21,8 @@ exit code 0 counts as a failure. So does a node still there TIMEOUT s after the 
 killed), any process of the run left afterwards (a process whose environment names the
 killed launcher in FORMATION_LAUNCHER_PID) and, with --record, a bag without metadata.yaml.
 BUSY busy loops (sh -c 'while :; do :; done') run during the whole measurement and are killed
-at the end. Prints a table (per run the load, the slowest node and every node's time) and a summary, and
-writes the times, the machine and the load averages as JSON (--json, default
+at the end. Prints a table (per run the load, the slowest node and every node's time) and a
+summary, and writes the times, the machine and the load averages as JSON (--json, default
 OUT/orphans.json). Exit code: 0 when every node of every run ended within LIMIT s and nothing
 failed, 1 otherwise.
 """

@@ -179,9 +179,11 @@ def test_orphans_expected_nodes_and_clock_line(orphans):
 
 
 def test_orphans_follows_a_process_until_it_ends(orphans):
-    child = subprocess.Popen([sys.executable, '-c', 'import time; time.sleep(0.3)'],
+    child = subprocess.Popen([sys.executable, '-c', 'import sys; print(1, flush=True); '
+                              'sys.stdin.read()'], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                              env=dict(os.environ, FORMATION_LAUNCHER_PID='999999999',
                                       FORMATION_LAUNCHER_START='42'))
+    assert child.stdout.readline() == b'1\n'  # it runs Python: its environment is the new one
     start = orphans.process_start(child.pid)
     assert start is not None and orphans.alive(child.pid, start)
     assert not orphans.alive(child.pid, start + 1)
@@ -189,10 +191,12 @@ def test_orphans_follows_a_process_until_it_ends(orphans):
     assert orphans.run_processes_left(999999999, 42) == [child.pid]
     assert orphans.run_processes_left(999999999, 43) == []
     since = time.monotonic()
+    child.stdin.close()
     ends = orphans.watch_ends({'robot_1': (child.pid, start)}, since, 0.005, 30.0)
     assert 0.0 < ends['robot_1'] < 30.0
     assert orphans.process_start(child.pid) is None  # a zombie counts as ended
     child.wait(timeout=30)
+    child.stdout.close()
     assert orphans.run_processes_left(999999999, 42) == []
     stuck = subprocess.Popen([sys.executable, '-c', 'import time; time.sleep(30)'])
     try:
