@@ -141,3 +141,97 @@ def test_sampling_ends_with_the_launcher(soak, fake_install):
     assert set(samples) == {'launcher'} and pids == {'launcher': [process.pid]}
     times = [t for t, _ in samples['launcher']]
     assert times == sorted(times) and all(kib > 0 for _, kib in samples['launcher'])
+
+
+ORPHANS = os.path.join(ROOT, 'bench', 'bench_orphans.py')
+
+
+@pytest.fixture(scope='module')
+def orphans():
+    spec = importlib.util.spec_from_file_location('bench_orphans', ORPHANS)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_orphans_help_and_arguments(orphans, fake_install, tmp_path):
+    result = subprocess.run([sys.executable, ORPHANS, '--help'], capture_output=True, text=True,
+                            timeout=120)
+    assert result.returncode == 0, result.stderr
+    for option in ('--runs', '--busy', '--record', '--prefix', '--params', '--json', 'SIGKILL'):
+        assert option in result.stdout
+    args = orphans.parse_args(['--prefix', str(fake_install), '--out', str(tmp_path / 'o')])
+    assert args.runs == 10 and args.busy == 2 and not args.record and args.limit == 2.0
+    assert args.params.endswith(os.path.join('config', 'square_4.yaml'))
+    assert args.json == os.path.join(str(tmp_path / 'o'), 'orphans.json')
+    for bad in (['--runs', '0'], ['--busy', '-1'], ['--limit', '0'], ['--params', '/no/file']):
+        with pytest.raises(SystemExit) as info:
+            orphans.parse_args(['--prefix', str(fake_install), '--out', str(tmp_path / 'o'),
+                                *bad])
+        assert info.value.code == 2
+
+
+def test_orphans_expected_nodes_and_clock_line(orphans):
+    assert orphans.expected_nodes(2, False) == ['plant', 'reference', 'robot_1', 'robot_2']
+    assert orphans.expected_nodes(1, True) == ['record', 'plant', 'reference', 'robot_1']
+    line = '[plant] [INFO] [1.5] [plant]: all 4 robots are up: starting the clock'
+    assert orphans.clock_started('[robot_1] [INFO] waiting\n' + line + '\n')
+    assert not orphans.clock_started('[robot_1] [INFO] waiting for reference\n')
+    assert not orphans.clock_started('[robot_1] starting the clock\n')
+
+
+def test_orphans_follows_a_process_until_it_ends(orphans):
+    child = subprocess.Popen([sys.executable, '-c', 'import sys; print(1, flush=True); '
+                              'sys.stdin.read()'], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                             env=dict(os.environ, FORMATION_LAUNCHER_PID='999999999',
+                                      FORMATION_LAUNCHER_START='42'))
+    assert child.stdout.readline() == b'1\n'  # it runs Python: its environment is the new one
+    start = orphans.process_start(child.pid)
+    assert start is not None and orphans.alive(child.pid, start)
+    assert not orphans.alive(child.pid, start + 1)
+    assert orphans.launched_by(child.pid) == ('999999999', '42')
+    assert orphans.run_processes_left(999999999, 42) == [child.pid]
+    assert orphans.run_processes_left(999999999, 43) == []
+    since = time.monotonic()
+    child.stdin.close()
+    ends = orphans.watch_ends({'robot_1': (child.pid, start)}, since, 0.005, 30.0)
+    assert 0.0 < ends['robot_1'] < 30.0
+    assert orphans.process_start(child.pid) is None  # a zombie counts as ended
+    child.wait(timeout=30)
+    child.stdout.close()
+    assert orphans.run_processes_left(999999999, 42) == []
+    stuck = subprocess.Popen([sys.executable, '-c', 'import time; time.sleep(30)'])
+    try:
+        ends = orphans.watch_ends({'plant': (stuck.pid, orphans.process_start(stuck.pid))},
+                                  time.monotonic(), 0.005, 0.05)
+        assert ends == {'plant': None}
+    finally:
+        stuck.kill()
+        stuck.wait(timeout=30)
+
+
+def test_orphans_summary_and_table(orphans):
+    runs = [{'run': 1, 'ends': {'plant': 0.2, 'robot_1': 0.4}, 'failures': [],
+             'load_at_kill': [3.0, 2.0, 1.0]},
+            {'run': 2, 'ends': {'plant': 2.5, 'robot_1': None}, 'failures': ['robot_1 ...'],
+             'load_at_kill': [4.25, 2.0, 1.0]}]
+    summary = orphans.summarise_runs(runs, 2.0)
+    assert summary['max_s'] == 2.5 and summary['median_s'] == pytest.approx(0.4)
+    assert summary['node_ends'] == 3 and summary['not_ended'] == 1
+    assert summary['over_limit'] == 2 and summary['failures'] == 1
+    assert summary['max_per_node_s'] == {'plant': 2.5, 'robot_1': 0.4}
+    text = orphans.format_table(runs, ['plant', 'robot_1'])
+    lines = text.splitlines()
+    assert lines[0] == '| run | load | slowest (s) | plant | robot_1 |'
+    assert lines[2] == '| 1 | 3.0 | 0.400 | 0.200 | 0.400 |'
+    assert lines[3] == '| 2 | 4.2 | not ended | 2.500 | not ended |'
+
+
+def test_orphans_reads_how_a_child_ended(orphans):
+    code = subprocess.Popen([sys.executable, '-c', 'raise SystemExit(3)'])
+    killed = subprocess.Popen([sys.executable, '-c', 'import time; time.sleep(30)'])
+    killed.kill()
+    assert orphans.reap(code.pid) == 'exit 3'
+    assert orphans.reap(killed.pid) == 'SIGKILL'
+    assert orphans.reap(os.getpid()) is None  # not a child
+    assert orphans.describe_status(0) == 'exit 0'
