@@ -229,8 +229,8 @@ DECLARATIONS = (
           'A command whose state stamp is older than this counts as zero, s (simulated time).',
           low=above(0.0), users=PLANT),
     Param('plant.publish_rate', Kind.DOUBLE, 50.0,
-          'Rate of /robot_<i>/pose and /robot_<i>/neighbors, Hz of simulated time (at most '
-          'plant.rate; every step in lockstep).', low=above(0.0), high=at_least(100000.0),
+          'Rate of /robot_<i>/pose, /robot_<i>/neighbors and /clock, Hz of simulated time '
+          '(at most plant.rate; every step in lockstep).', low=above(0.0), high=at_least(100000.0),
           users=PLANT),
     Param('plant.realtime_factor', Kind.DOUBLE, 1.0,
           'Simulated seconds per wall-clock second (an upper bound in lockstep).',

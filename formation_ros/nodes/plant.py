@@ -12,7 +12,8 @@ the collision check. This node only moves messages in and out:
 * it stores each robot's latest ``robot_<i>/cmd_vel`` (TwistStamped) in its callback;
 * its timer steps the model and publishes ``robot_<i>/pose`` (PoseStamped) and
   ``robot_<i>/neighbors`` (PoseArray: what robot i's range sensor sees) at
-  ``plant.publish_rate``, and ``/clock``, the simulated time starting at 0;
+  ``plant.publish_rate``, each time after ``/clock`` (the simulated time, from 0): the clock
+  advances with the states, so nodes on simulated time wake once per state, not per step;
 * it logs what the model reports (once per condition), publishes ``/diagnostics`` and
   ``/formation/markers``, and with ``plant.output_dir`` writes ``trajectory.npz`` and
   ``plant_stats.json`` when it stops.
@@ -152,8 +153,6 @@ class PlantNode(Node):
         self._step()
         if self.model.counts.steps % self.publish_every == 0:
             self._publish()
-        else:
-            self._publish_clock()
 
     def _lockstep_tick(self) -> None:
         answered = bool(np.all(self.commands.present
