@@ -10,7 +10,7 @@ Usage: python bench/bench_capacity.py [--sizes 10 20 50 100] [--rates 20 50]
 
 For each mode, team size N and control rate it runs scripts/launch_formation.sh on the Section 5
 constants with N robots (random start at about 10 robots per m^2, lattice goal 2 m apart),
-control_rate and plant.publish_rate = RATE, plant.rate 100 Hz, one process per robot
+control_rate, plant.publish_rate and reference.rate = RATE, plant.rate 100 Hz, one process per robot
 ('process') or --robots-per-process robots per 'fleet' process ('fleet'). It measures the
 start-up (launch until the plant starts its clock: every robot has answered), then for MEASURE
 wall seconds the CPU time and resident memory of every process of the run, then stops the run
@@ -114,7 +114,7 @@ def case_params(n: int, rate: float, lockstep: bool) -> Dict[str, Any]:
     """Parameters of one case (Section 5 constants, N robots, control and publish at RATE)."""
     params = params_for(n)
     params.update({'control_rate': float(rate), 'plant.publish_rate': float(rate),
-                   'plant.rate': PLANT_RATE, 'duration': 1e4})
+                   'reference.rate': float(rate), 'plant.rate': PLANT_RATE, 'duration': 1e4})
     if lockstep:
         params.update({'plant.lockstep': True, 'plant.realtime_factor': 1e3})
     return params
