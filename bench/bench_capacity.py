@@ -10,8 +10,8 @@ Usage: python bench/bench_capacity.py [--sizes 10 20 50 100] [--rates 20 50]
 
 For each mode, team size N and control rate it runs scripts/launch_formation.sh on the Section 5
 constants with N robots (random start at about 10 robots per m^2, lattice goal 2 m apart),
-control_rate, plant.publish_rate and reference.rate = RATE, plant.rate 100 Hz, one process per robot
-('process') or --robots-per-process robots per 'fleet' process ('fleet'). It measures the
+control_rate, plant.publish_rate and reference.rate = RATE, plant.rate 100 Hz, one process per
+robot ('process') or --robots-per-process robots per 'fleet' process ('fleet'). It measures the
 start-up (launch until the plant starts its clock: every robot has answered), then for MEASURE
 wall seconds the CPU time and resident memory of every process of the run, then stops the run
 with Ctrl-C and reads the plant's plant_stats.json: the achieved step rate, the fraction of
@@ -38,8 +38,8 @@ BENCH = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(BENCH)
 sys.path[:0] = [ROOT, BENCH]
 
+from bench_core import params_for  # noqa: E402
 from bench_soak import find_run_processes, LAUNCHER, read_rss_kib  # noqa: E402
-from bench_system import params_for  # noqa: E402
 from formation_ros.core.params_file import write_params_file  # noqa: E402, I100
 
 PLANT_RATE = 100.0

@@ -31,15 +31,24 @@ def lattice(n, spacing):
     return grid - grid.mean(axis=0)
 
 
-def config_for(n, duration):
-    """Section 5 constants with N robots: random start at density ~10 per m^2, lattice goal."""
-    raw = {
+def params_for(n, duration=20.0):
+    """
+    Parameters of N robots, flat dotted names: Section 5 constants, lattice goal 2 m apart.
+
+    The start is random in a disc holding about 10 robots per m^2 (at least 1 m across), at
+    least 0.1 m apart. Every benchmark uses these.
+    """
+    return {
         'num_robots': n, 'dim': 2, 'sensing_radius': 2.0, 'repulsion_radius': 1.0,
         'formation.vertices': [float(v) for v in lattice(n, 2.0).ravel()],
         'start.random_radius': float(max(1.0, math.sqrt(n / (10.0 * math.pi)))),
         'start.min_separation': 0.1, 'start.seed': 1, 'duration': float(duration),
     }
-    return validate(raw)
+
+
+def config_for(n, duration):
+    """Return the validated configuration of :func:`params_for`."""
+    return validate(params_for(n, duration))
 
 
 def time_law(config, repeats):

@@ -29,7 +29,7 @@ BENCH = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(BENCH)
 sys.path[:0] = [ROOT, BENCH]
 
-from bench_system import params_for  # noqa: E402
+from bench_core import params_for  # noqa: E402
 from formation_ros.core.params_file import write_params_file  # noqa: E402, I100
 
 

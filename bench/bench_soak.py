@@ -7,7 +7,7 @@ Soak benchmark: resident memory of every process of a long recorded run (on dema
 Usage: python bench/bench_soak.py [--duration 1800] [--interval 5] [--prefix INSTALL]
 [--params FILE] [--out DIR] [--json PATH] [--window 60]
 
-Runs scripts/launch_formation.sh with 10 robots (Section 5 constants, as bench_system.py's
+Runs scripts/launch_formation.sh with 10 robots (Section 5 constants, as bench_core.py's
 params_for(10), unless --params is given) and --record for DURATION wall-clock seconds. Every
 INTERVAL seconds it reads VmRSS from /proc/<pid>/status of each process of the run: the
 launcher and its plant, reference, robot and record processes (the descendants of the launcher
@@ -34,7 +34,7 @@ BENCH = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(BENCH)
 sys.path[:0] = [ROOT, BENCH]
 
-from bench_system import params_for  # noqa: E402
+from bench_core import params_for  # noqa: E402
 from formation_ros.core.params_file import write_params_file  # noqa: E402, I100
 
 NODES = ('plant', 'reference', 'robot', 'record', 'fleet')

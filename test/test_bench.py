@@ -1,7 +1,7 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""The soak benchmark's command line, process discovery, summary and JSON (no long run)."""
+"""The benchmarks' command lines and helpers (soak, orphans, capacity), and a tiny offline run."""
 
 import importlib.util
 import json
@@ -235,3 +235,26 @@ def test_orphans_reads_how_a_child_ended(orphans):
     assert orphans.reap(killed.pid) == 'SIGKILL'
     assert orphans.reap(os.getpid()) is None  # not a child
     assert orphans.describe_status(0) == 'exit 0'
+
+
+def test_offline_benchmark_runs_a_tiny_size_and_writes_its_json(tmp_path):
+    result = subprocess.run([sys.executable, os.path.join(ROOT, 'bench', 'bench_offline.py'),
+                             '--sizes', '3', '5', '--duration', '0.2', '--out',
+                             str(tmp_path / 'out')], capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stdout + result.stderr
+    rows = json.loads((tmp_path / 'out' / 'offline.json').read_text())['rows']
+    assert [row['robots'] for row in rows] == [3, 5]
+    for row in rows:
+        assert row['steps'] == 20 and row['wall_s'] > 0.0 and row['peak_rss_mib'] > 10.0
+        assert row['max_abs_u_hat_component'] <= row['u_bound'] + 1e-9
+    assert '| 5 |' in result.stdout
+
+
+def test_capacity_benchmark_refuses_bad_arguments(tmp_path):
+    script = os.path.join(ROOT, 'bench', 'bench_capacity.py')
+    for args in (['--rates', '0'], ['--rates', '500'], ['--sizes', '0'], ['--measure', '0']):
+        result = subprocess.run([sys.executable, script, *args, '--prefix', str(tmp_path)],
+                                capture_output=True, text=True, timeout=120)
+        assert result.returncode == 2, (args, result.stderr)
+    assert 'fresh' in subprocess.run([sys.executable, script, '--help'], capture_output=True,
+                                     text=True, timeout=120).stdout

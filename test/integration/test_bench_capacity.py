@@ -1,0 +1,30 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""The capacity benchmark on a tiny size against the real install: it runs and writes its JSON."""
+
+import json
+import os
+import subprocess
+import sys
+
+from helpers import ROOT
+
+
+def test_capacity_benchmark_runs_both_modes_on_two_robots(install, ros_env, tmp_path):
+    out = tmp_path / 'capacity'
+    result = subprocess.run(
+        [sys.executable, os.path.join(ROOT, 'bench', 'bench_capacity.py'), '--sizes', '2',
+         '--rates', '20', '--modes', 'process', 'fleet', '--robots-per-process', '2',
+         '--measure', '1', '--prefix', str(install), '--out', str(out)],
+        capture_output=True, text=True, env=ros_env, timeout=600)
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    rows = json.loads((out / 'capacity.json').read_text())['rows']
+    assert [(row['mode'], row['robots'], row['processes']) for row in rows] == \
+        [('process', 2, 4), ('fleet', 2, 3)]
+    for row in rows:
+        assert row['steps'] > 0 and row['step_rate'] > 0.0, row
+        assert 0.0 < row['fresh_fraction'] <= 1.0, row
+        assert row['latency_ms']['count'] > 0 and row['startup_s'] > 0.0, row
+        assert row['rss_mib']['plant'] > 10.0 and 'launcher' in row['cpu_percent'], row
+    assert (out / 'capacity_fresh.png').exists()
