@@ -13,7 +13,9 @@ one per robot, each in its namespace::
         --params-file config/paper_section5.yaml
 
 The command is stamped with the stamp of the state it was computed from, so the plant can tell
-how old it is (and, in lockstep, which state it answers).
+how old it is (and, in lockstep, which state it answers). The neighbours are read from the
+serialized PoseArray (``formation_ros.ros.cdr``): rclpy's own conversion builds three Python
+objects per neighbour, which was most of a robot's time in a dense formation.
 """
 
 from collections import deque
@@ -22,12 +24,12 @@ import math
 import time
 from typing import Dict, List, Optional, Tuple
 
-from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.declarations import Exe
 from formation_ros.core.frames import advance, FrameSample
 from formation_ros.core.law import Command, robot_command
 from formation_ros.ros import fields, messages, qos, topics
+from formation_ros.ros.cdr import CdrError, PoseArrayData, read_pose_array, TooManyPoses
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
@@ -37,7 +39,6 @@ from nav_msgs.msg import Odometry
 import numpy as np
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
-from std_msgs.msg import Header
 
 REFERENCE_BUFFER = 64
 RATE_TOLERANCE = 1e-3
@@ -51,6 +52,7 @@ class Reason(enum.Enum):
     FRAME = f"a frame other than '{messages.WORLD_FRAME}'"
     CLOCK = 'stamps from another clock'
     TOO_MANY = 'more neighbours than there are robots'
+    MALFORMED = 'bytes that are not a whole PoseArray'
     TOO_FAST = 'a speed or turn rate its reference kind cannot have'
 
 
@@ -77,7 +79,7 @@ class RobotNode(Node):
         self.steady = Clock(clock_type=ClockType.STEADY_TIME)
 
         self.pose: Optional[PoseStamped] = None
-        self.neighbours: Optional[PoseArray] = None
+        self.neighbours: Optional[PoseArrayData] = None
         self.references: deque = deque(maxlen=REFERENCE_BUFFER)
         self.received_ns = dict.fromkeys(INPUTS)
         self.pose_count = 0
@@ -88,7 +90,8 @@ class RobotNode(Node):
         self.wait_subscribers = settings.wait_for_subscribers
 
         self.create_subscription(PoseStamped, topics.POSE, self.on_pose, qos.STATE)
-        self.create_subscription(PoseArray, topics.NEIGHBOURS, self.on_neighbours, qos.STATE)
+        self.create_subscription(PoseArray, topics.NEIGHBOURS, self.on_neighbours, qos.STATE,
+                                 raw=True)
         self.create_subscription(Odometry, topics.REFERENCE, self.on_reference, qos.REFERENCE)
         self.cmd_pub = self.create_publisher(TwistStamped, topics.CMD_VEL, qos.COMMAND)
         self.diagnostics_pub = self.create_publisher(DiagnosticArray, topics.DIAGNOSTICS,
@@ -117,20 +120,20 @@ class RobotNode(Node):
                                                  'diagnostics count them)', 'error')
         return False
 
-    def _clock_gap_s(self, stamp: Time) -> float:
-        """Return how far a stamp is from this node's clock, s (0 before sim time has come)."""
+    def _clock_gap_s(self, stamp_ns: int) -> float:
+        """Return how far a stamp (ns) is from this node's clock, s (0 before sim time starts)."""
         now = self.get_clock().now().nanoseconds
         if self.sim_time and now == 0:
             return 0.0
-        return (fields.stamp_to_ns(stamp) - now) / fields.NS_PER_S
+        return (stamp_ns - now) / fields.NS_PER_S
 
-    def _check(self, name: str, header: Header, values: List[float]) -> bool:
+    def _check(self, name: str, frame_id: str, stamp_ns: int, finite: bool) -> bool:
         """Accept a state message only in the world frame, finite, stamped on this clock."""
-        if header.frame_id != messages.WORLD_FRAME:
-            return self._reject(name, Reason.FRAME, f' (got {header.frame_id!r})')
-        if not all(map(math.isfinite, values)):
+        if frame_id != messages.WORLD_FRAME:
+            return self._reject(name, Reason.FRAME, f' (got {frame_id!r})')
+        if not finite:
             return self._reject(name, Reason.NON_FINITE)
-        gap = self._clock_gap_s(header.stamp)
+        gap = self._clock_gap_s(stamp_ns)
         if abs(gap) * fields.NS_PER_S > self.timeout_ns:
             clock = 'simulated' if self.sim_time else 'wall-clock'
             return self._reject(name, Reason.CLOCK, f' ({gap:+.3g} s from the {clock} time '
@@ -142,19 +145,25 @@ class RobotNode(Node):
     def on_pose(self, msg: PoseStamped) -> None:
         """Store the latest own pose."""
         p = msg.pose.position
-        if self._check('pose', msg.header, [p.x, p.y, p.z]):
+        if self._check('pose', msg.header.frame_id, fields.stamp_to_ns(msg.header.stamp),
+                       all(map(math.isfinite, (p.x, p.y, p.z)))):
             self.pose = msg
             self.pose_count += 1
             self.received_ns['pose'] = self._now_ns()
 
-    def on_neighbours(self, msg: PoseArray) -> None:
-        """Store the latest sensed neighbour positions."""
-        if len(msg.poses) > self.num_robots - 1:
-            self._reject('neighbour', Reason.TOO_MANY, f' ({len(msg.poses)})')
+    def on_neighbours(self, data: bytes) -> None:
+        """Store the latest sensed neighbour positions, read from the serialized PoseArray."""
+        try:
+            heard = read_pose_array(data, self.num_robots - 1)
+        except TooManyPoses as exc:
+            self._reject('neighbour', Reason.TOO_MANY, f' ({exc})')
             return
-        values = [v for p in msg.poses for v in (p.position.x, p.position.y, p.position.z)]
-        if self._check('neighbour', msg.header, values):
-            self.neighbours = msg
+        except CdrError as exc:
+            self._reject('neighbour', Reason.MALFORMED, f' ({exc})')
+            return
+        if self._check('neighbour', heard.frame_id, heard.stamp_ns,
+                       bool(np.all(np.isfinite(heard.positions)))):
+            self.neighbours = heard
             self.received_ns['neighbour'] = self._now_ns()
 
     def on_reference(self, msg: Odometry) -> None:
@@ -197,7 +206,7 @@ class RobotNode(Node):
         frame = self._reference_for(stamp_ns, exact)
         if frame is None:
             return None
-        neighbours = fields.points_of(self.neighbours, self.dim)
+        neighbours = self.neighbours.positions[:, :self.dim]
         own = fields.position_of(self.pose, self.dim)
         self.last = robot_command(own, self.vertex, neighbours, self.sensing_radius, self.law,
                                   frame)
@@ -253,7 +262,7 @@ class RobotNode(Node):
         if self.waiting and not self._ready():
             return
         stamp = fields.stamp_to_ns(self.pose.header.stamp)
-        if fields.stamp_to_ns(self.neighbours.header.stamp) != stamp:
+        if self.neighbours.stamp_ns != stamp:
             return
         command = self._command(stamp, True)
         if command is None:
@@ -268,7 +277,7 @@ class RobotNode(Node):
                                               else (now - self.received_ns[name]) / 1e9)
                   for name in INPUTS}
         if self.neighbours is not None and self.pose is not None:
-            gaps = np.linalg.norm(fields.points_of(self.neighbours, self.dim)
+            gaps = np.linalg.norm(self.neighbours.positions[:, :self.dim]
                                   - fields.position_of(self.pose, self.dim), axis=1)
             values['neighbours heard'] = len(gaps)
             values['neighbours within R_i'] = int(np.count_nonzero(gaps < self.sensing_radius))
