@@ -105,9 +105,14 @@ def cpu_seconds(pid: int) -> Optional[float]:
 
 
 def fresh_fraction(age_steps: Sequence[int], max_age: int) -> Optional[float]:
-    """Fraction of steps whose oldest command was at most ``max_age`` steps old."""
+    """
+    Fraction of steps whose oldest command was at most ``max_age`` steps old.
+
+    The last entry of ``age_steps`` counts steps without a usable command: never fresh.
+    """
     total = sum(age_steps)
-    return sum(age_steps[:max_age + 1]) / total if total else None
+    kept = min(max_age, len(age_steps) - 2)
+    return sum(age_steps[:kept + 1]) / total if total else None
 
 
 def case_params(n: int, rate: float, lockstep: bool) -> Dict[str, Any]:

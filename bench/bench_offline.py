@@ -72,12 +72,15 @@ def run_case(args: argparse.Namespace, n: int, folder: str) -> Dict[str, Any]:
     command = [sys.executable, '-m', 'formation_ros.tools.sim', params, '--out',
                os.path.join(folder, 'run'), '--dt', repr(args.dt), '--sample-dt',
                repr(args.sample_dt), '--no-plots', '--quiet']
-    started = time.monotonic()
-    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
-    _, status, usage = os.wait4(process.pid, 0)
-    wall = time.monotonic() - started
-    output = process.stdout.read().decode(errors='replace') if process.stdout else ''
+    log = os.path.join(folder, 'formation_sim.txt')
+    with open(log, 'wb') as stream:
+        started = time.monotonic()
+        process = subprocess.Popen(command, stdout=stream, stderr=subprocess.STDOUT)
+        _, status, usage = os.wait4(process.pid, 0)
+        wall = time.monotonic() - started
     process.returncode = os.waitstatus_to_exitcode(status)
+    with open(log, encoding='utf-8', errors='replace') as stream:
+        output = stream.read()
     steps = int(round(args.duration / args.dt))
     row: Dict[str, Any] = {'robots': n, 'wall_s': wall, 'peak_rss_mib': usage.ru_maxrss / 1024.0,
                            'steps': steps, 'ms_per_step': 1e3 * wall / steps,

@@ -174,6 +174,30 @@ def test_a_split_bag_lists_its_files_and_reads_as_one(tmp_path):
     assert recover_bag(str(split)).count == sum(whole_counts.values())
 
 
+def test_a_split_bag_whose_metadata_names_one_file_is_not_read_as_whole(tmp_path):
+    config = load_config(os.path.join(CONFIG, 'square_4.yaml'))
+    trajectory = simulate(config, duration=1.0, dt=0.01, sample_dt=0.02)
+    folder = tmp_path / 'bag'
+    bag = write_run_as_bag(str(folder), config, trajectory, flush_every=10, flushes_per_file=2)
+    total = sum(bag.counts.values())
+    from mcap.reader import make_reader
+    names = sorted(name for name in os.listdir(folder) if name.endswith('.mcap'))
+    with open(folder / names[-1], 'rb') as stream:
+        (record,) = [m for m in make_reader(stream).iter_metadata() if m.name == 'rosbag2']
+    embedded = yaml.safe_load(record.metadata['serialized_metadata'])
+    assert sorted(embedded['relative_file_paths']) == names and len(names) > 2
+    metadata_path = folder / 'metadata.yaml'
+    document = yaml.safe_load(metadata_path.read_text())
+    information = document['rosbag2_bagfile_information']
+    information['relative_file_paths'] = information['relative_file_paths'][:1]
+    information['files'] = information['files'][:1]
+    metadata_path.write_text(yaml.safe_dump(document))
+    with pytest.raises(BagError, match=f'counts {total} messages, its files hold'):
+        read_messages(str(folder))
+    recorded, counts, note = read_or_recover(str(folder))
+    assert sum(counts.values()) == total and 'recovered' in note
+
+
 def test_a_split_bag_cut_by_sigkill_is_recovered_and_repaired(tmp_path):
     config = load_config(os.path.join(CONFIG, 'square_4.yaml'))
     trajectory = simulate(config, duration=2.0, dt=0.01, sample_dt=0.02)

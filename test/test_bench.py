@@ -250,11 +250,17 @@ def test_offline_benchmark_runs_a_tiny_size_and_writes_its_json(tmp_path):
     assert '| 5 |' in result.stdout
 
 
-def test_capacity_benchmark_refuses_bad_arguments(tmp_path):
+def test_capacity_benchmark_refuses_bad_arguments(fake_install, tmp_path):
     script = os.path.join(ROOT, 'bench', 'bench_capacity.py')
-    for args in (['--rates', '0'], ['--rates', '500'], ['--sizes', '0'], ['--measure', '0']):
-        result = subprocess.run([sys.executable, script, *args, '--prefix', str(tmp_path)],
+    lib = fake_install / 'lib' / 'formation_ros'
+    (lib / 'plant').chmod(0o755)
+    for args, says in ((['--rates', '0'], '--rates must be > 0'),
+                       (['--rates', '500'], '--rates must be > 0'),
+                       (['--sizes', '0'], '--sizes and --robots-per-process must be >= 1'),
+                       (['--measure', '0'], '--measure and --startup-timeout must be > 0')):
+        result = subprocess.run([sys.executable, script, *args, '--prefix', str(fake_install),
+                                 '--out', str(tmp_path / 'out')],
                                 capture_output=True, text=True, timeout=120)
-        assert result.returncode == 2, (args, result.stderr)
+        assert result.returncode == 2 and says in result.stderr, (args, result.stderr)
     assert 'fresh' in subprocess.run([sys.executable, script, '--help'], capture_output=True,
                                      text=True, timeout=120).stdout

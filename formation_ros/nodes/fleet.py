@@ -15,8 +15,9 @@ of K robots costs one of each, which is what lets a hundred robots run on one sm
 
 Parameters given on the command line (``-p``) or in a parameters file apply to every robot of
 the fleet; a file's ``/robot_3/robot:`` section applies to robot 3 alone, as it would to a
-robot process. The namespace of each robot is set by the fleet: ``-r __ns:=...`` and
-``robot_id`` are refused.
+robot process. The namespace of each robot is set by the fleet: ``-r __ns:=...`` is refused,
+and a ``robot_id`` must match it. The robots share one ``/clock`` subscription, so their
+``use_sim_time`` cannot be changed while they run.
 """
 
 import re
@@ -26,8 +27,10 @@ from typing import List, Optional, Sequence
 from formation_ros.nodes.robot import RobotNode
 from formation_ros.ros.runner import run
 from formation_ros.ros.topics import robot_namespace
+from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import ROSClock
 from rclpy.node import Node
+from rclpy.parameter import Parameter
 from rclpy.utilities import remove_ros_args
 
 PROG = 'fleet'
@@ -107,7 +110,17 @@ def share_sim_clock(nodes: Sequence[Node]) -> int:
         source.detach_node()
         first.attach_clock(clock)
         shared += 1
+    for node in nodes:
+        node.add_on_set_parameters_callback(_keep_sim_time)
     return shared
+
+
+def _keep_sim_time(parameters: List[Parameter]) -> SetParametersResult:
+    """Refuse to change ``use_sim_time`` of a fleet's robot: their clocks are shared."""
+    if any(parameter.name == 'use_sim_time' for parameter in parameters):
+        return SetParametersResult(successful=False, reason='use_sim_time of a fleet robot is '
+                                   'fixed at start (the fleet shares one /clock subscription)')
+    return SetParametersResult(successful=True)
 
 
 def make_fleet(ids: Sequence[int]) -> List[RobotNode]:
@@ -118,7 +131,10 @@ def make_fleet(ids: Sequence[int]) -> List[RobotNode]:
     disagrees with every namespace but one and is refused there).
     """
     nodes = [RobotNode(namespace=robot_namespace(i)) for i in ids]
-    share_sim_clock(nodes)
+    shared = share_sim_clock(nodes)
+    if nodes and nodes[0].sim_time:
+        nodes[0].get_logger().info(f'fleet of {len(nodes)} robots: {shared + 1} clocks driven '
+                                   'by one /clock subscription')
     return nodes
 
 

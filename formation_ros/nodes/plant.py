@@ -50,6 +50,8 @@ from visualization_msgs.msg import MarkerArray
 
 RESEND_AFTER = 0.05
 PUBLISHES_TIMED = 256
+"""States whose first publish time is kept for the answer latency; answers to older states are
+not timed."""
 PATH_LENGTH = 100
 CHUNK_PERIOD = 1.0
 DUPLICATE_GRACE = 25.0
@@ -221,7 +223,7 @@ class PlantNode(Node):
     def _publish(self) -> None:
         """Publish /clock, then every robot's pose and what its range sensor sees."""
         self._publish_clock()
-        self.published_ns[self.model.t_ns] = time.monotonic_ns()
+        self.published_ns.setdefault(self.model.t_ns, time.monotonic_ns())
         while len(self.published_ns) > PUBLISHES_TIMED:
             self.published_ns.popitem(last=False)
         poses, arrays = self.state_messages.fill(self.model.q, self.model.neighbours(),

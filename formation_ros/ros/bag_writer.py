@@ -190,10 +190,18 @@ class McapStorage:
         self._stream.close()
         self._mcap = self._stream = None
 
+    def list_files(self, information: Dict[str, Any]) -> None:
+        """Set the file lists of a bag's metadata (``rosbag2_bagfile_information``) in place."""
+        information['relative_file_paths'] = [stats.name for stats in self.files]
+        information['files'] = [stats.entry() for stats in self.files]
+
     def close(self, version: int, metadata: str) -> None:
-        """Finish the file being written, with the ``rosbag2`` metadata record."""
+        """Finish the file being written, with the ``rosbag2`` metadata record (every file)."""
         if self._mcap is not None:
-            self._finish_file(metadata)
+            information = yaml.safe_load(metadata)
+            self.list_files(information)
+            self._finish_file(yaml.safe_dump(information, default_flow_style=False,
+                                             sort_keys=False).strip())
 
     def abort(self) -> None:
         """Close the file as it is (no summary)."""
@@ -216,9 +224,7 @@ class _Rosbag2Writer(Writer):
             return
         with self.metapath.open(encoding='utf-8') as stream:
             document = yaml.safe_load(stream)
-        information = document['rosbag2_bagfile_information']
-        information['relative_file_paths'] = [stats.name for stats in storage.files]
-        information['files'] = [stats.entry() for stats in storage.files]
+        storage.list_files(document['rosbag2_bagfile_information'])
         temporary = self.metapath.with_suffix('.yaml.tmp')
         with temporary.open('w', encoding='utf-8') as stream:
             yaml.safe_dump(document, stream, default_flow_style=False, sort_keys=False)

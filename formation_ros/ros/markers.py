@@ -44,9 +44,11 @@ def _marker(ns, marker_id, kind, stamp_ns, rgba):
 
 def _zones(ns, first_id, centres, radii, dim, stamp_ns, rgba):
     """
-    One SPHERE_LIST per distinct radius: discs (flattened spheres) in 2D, balls in 3D.
+    One SPHERE_LIST per distinct radius (scale.z is the disc thickness in 2D).
 
-    A marker per robot costs a Python message each; a list marker costs one per radius.
+    A marker per robot costs a Python message each; a list marker costs one per radius. RViz
+    draws the points of a sphere list as camera-facing spheres of diameter scale.x, so a 2D zone
+    is a disc only when seen from above.
     """
     markers = []
     for k, radius in enumerate(np.unique(radii)):

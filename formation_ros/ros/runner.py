@@ -181,8 +181,11 @@ def _exit_now(code: int) -> None:
     teardown, which destroys the DDS participant and took about a second on a busy machine,
     while nobody waits for this process any more. Python's and C's output is flushed first.
     """
-    sys.stdout.flush()
-    sys.stderr.flush()
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except OSError:
+            pass
     try:
         ctypes.CDLL(None).fflush(None)
     except (OSError, AttributeError):
@@ -200,8 +203,9 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
 
     ``make_nodes`` returns one node or several, which then share one executor (and the one
     thread of this process). The spin also ends when the launcher named in the environment is
-    gone (see :class:`LauncherWatch`). Returns the exit code: 0, or 2 for invalid parameters
-    (one line per bad parameter) or a command line rclpy cannot start from.
+    gone (see :class:`LauncherWatch`). Returns the exit code: 0; 1 if a node's ``finish()``
+    failed (the others still finish); 2 for invalid parameters (one line per bad parameter) or a
+    command line rclpy cannot start from.
     """
     if not _init(args, name):
         return 2
@@ -237,8 +241,12 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
         signal.signal(signal.SIGTERM, signal.SIG_IGN)
         for node in nodes:
             finish = getattr(node, 'finish', None)
-            if finish is not None:
-                finish()
+            try:
+                if finish is not None:
+                    finish()
+            except Exception as exc:  # noqa: B902 - one node's failure must not stop the rest
+                node.get_logger().error(f'could not finish: {type(exc).__name__}: {exc}')
+                code = 1
         for node in nodes:
             node.destroy_node()
         if executor is not None:

@@ -19,6 +19,7 @@ files beside it.
 from dataclasses import dataclass, field
 from io import BytesIO
 import os
+import re
 import shutil
 import struct
 import tempfile
@@ -71,6 +72,10 @@ def read_messages(path: str) -> Tuple[Recorded, Dict[str, int]]:
     # rosbags parses untrusted files: whatever it raises means that this bag is not whole.
     except Exception as exc:
         raise BagError(f'{path}: rosbags cannot read it ({_one_line(exc)})') from None
+    read = sum(len(messages) for messages in recorded.values())
+    known_count = sum(connection.msgcount for connection in known)
+    if read != known_count:
+        raise BagError(f'{path}: {METADATA} counts {known_count} messages, its files hold {read}')
     return recorded, counts
 
 
@@ -241,13 +246,18 @@ class _McapScan:
         topic.messages.append((message.log_time, message.data))
 
 
+def _natural(name: str) -> List[Any]:
+    """Sort key that puts ``bag_2.mcap`` before ``bag_10.mcap``."""
+    return [int(part) if part.isdigit() else part for part in re.split(r'([0-9]+)', name)]
+
+
 def mcap_files(path: str) -> List[str]:
-    """Return the MCAP files of a bag directory (each ``*.mcap``, sorted), or [path] itself."""
+    """Return the MCAP files of a bag directory (each ``*.mcap``, in order), or [path] itself."""
     if os.path.isfile(path):
         return [path]
     if not os.path.isdir(path):
         raise BagError(f'{path}: no such file or directory')
-    return [os.path.join(path, name) for name in sorted(os.listdir(path))
+    return [os.path.join(path, name) for name in sorted(os.listdir(path), key=_natural)
             if name.endswith('.mcap') and os.path.isfile(os.path.join(path, name))]
 
 

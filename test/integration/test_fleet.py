@@ -18,7 +18,8 @@ from formation_ros.tools.supervise import ProcessSpec
 from helpers import (CONFIG, exe, launch, project_processes, SimClock, SQUARE, START_UP,
                      stop_when, watch_commands)
 import numpy as np
-from rcl_interfaces.srv import GetParameters
+from rcl_interfaces.srv import GetParameters, SetParameters
+from rclpy.parameter import Parameter
 from test_parameters import call
 import yaml
 
@@ -53,7 +54,8 @@ def test_each_robot_of_a_fleet_is_its_own_node_with_its_parameters(
     own.write_text(yaml.safe_dump({'/robot_2/robot': {'ros__parameters': {
         'control_rate': 25.0}}}))
     processes.start(ProcessSpec('fleet', [exe(install, 'fleet'), '--robots', '1-3', '--ros-args',
-                                          '--params-file', SQUARE, '--params-file', str(own)]))
+                                          '--params-file', SQUARE, '--params-file', str(own),
+                                          '-p', 'use_sim_time:=true']))
     assert probe.spin_until(
         lambda: {('robot', f'/robot_{i}') for i in (1, 2, 3)}
         <= set(probe.get_node_names_and_namespaces()), START_UP), processes.log('fleet')
@@ -69,6 +71,18 @@ def test_each_robot_of_a_fleet_is_its_own_node_with_its_parameters(
              if namespace.startswith('/robot_')]
     assert sorted(names) == ['robot'] * 3, names
     assert len(fleet_pids(install, '--robots 1-3')) == 1
+
+    def clock_readers():
+        return [info for info in probe.get_subscriptions_info_by_topic('/clock')
+                if info.node_namespace.startswith('/robot_')]
+
+    assert probe.spin_until(lambda: clock_readers() and all(
+        probe.count_publishers(f'/robot_{i}/cmd_vel') == 1 for i in (1, 2, 3)), START_UP)
+    assert len(clock_readers()) == 1, clock_readers()
+    refused = call(probe, probe.create_client(SetParameters, '/robot_2/robot/set_parameters'),
+                   SetParameters.Request(parameters=[
+                       Parameter('use_sim_time', value=False).to_parameter_msg()]))
+    assert not refused.results[0].successful and 'fleet' in refused.results[0].reason
 
 
 def test_killing_one_fleet_process_stops_only_its_robots(processes, install, probe, tmp_path):
