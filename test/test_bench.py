@@ -16,12 +16,18 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SOAK = os.path.join(ROOT, 'bench', 'bench_soak.py')
 
 
-@pytest.fixture(scope='module')
-def soak():
-    spec = importlib.util.spec_from_file_location('bench_soak', SOAK)
+def load_bench(path):
+    """Import a benchmark script (bench/ is not a package) as a module."""
+    name = os.path.splitext(os.path.basename(path))[0]
+    spec = importlib.util.spec_from_file_location(name, path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+@pytest.fixture(scope='module')
+def soak():
+    return load_bench(SOAK)
 
 
 @pytest.fixture
@@ -148,10 +154,7 @@ ORPHANS = os.path.join(ROOT, 'bench', 'bench_orphans.py')
 
 @pytest.fixture(scope='module')
 def orphans():
-    spec = importlib.util.spec_from_file_location('bench_orphans', ORPHANS)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_bench(ORPHANS)
 
 
 def test_orphans_help_and_arguments(orphans, fake_install, tmp_path):
