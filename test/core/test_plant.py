@@ -186,7 +186,7 @@ def test_duration_histogram_percentiles_against_numpy():
 
 
 def brute_force_start(n, dim, radius, separation, seed):
-    """The random start drawn the same way, each candidate compared with every point placed."""
+    """Draw the random start the same way, comparing each candidate with every point placed."""
     rng = np.random.default_rng(seed)
     placed = []
     while len(placed) < n:
