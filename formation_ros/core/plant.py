@@ -317,12 +317,15 @@ class PlantModel:
     control law constants (for the bound c M1); reference: the desired trajectory (to recover
     u_hat when auditing the bound); input_timeout_ns: the oldest state stamp a command may
     answer; collision_distance: m; max_speed: cap on every world command component, m/s (0:
-    none beyond the law's own bound).
+    none beyond the law's own bound); pair_radius: with a value of at least the collision
+    distance (``formation_sim`` gives the law's b), the model keeps every pair within it of each
+    new state (:attr:`pairs`, for the law) and checks collisions among them instead of
+    searching the tree a second time.
     """
 
     def __init__(self, start: ArrayLike, sensing_radii: ArrayLike, step_ns: int,
                  law: LawParams, reference: Reference, input_timeout_ns: int,
-                 collision_distance: float, max_speed: float = 0.0):
+                 collision_distance: float, max_speed: float = 0.0, pair_radius: float = 0.0):
         """Place the robots at ``start`` at time 0."""
         self.q = np.array(start, dtype=float)
         self.radii = np.array(sensing_radii, dtype=float)
@@ -334,6 +337,9 @@ class PlantModel:
         self.reference = reference
         self.input_timeout_ns = int(input_timeout_ns)
         self.collision_distance = float(collision_distance)
+        self.pair_radius = float(pair_radius)
+        self.pairs: Optional[NDArray[np.intp]] = None
+        """(P, 2) pairs i < j within ``pair_radius`` of each other now (None without it)."""
         self.max_speed = float(max_speed)
         self.bound_tolerance = (BOUND_TOLERANCE_FIXED if reference.is_stationary
                                 else BOUND_TOLERANCE_MOVING)
@@ -463,8 +469,16 @@ class PlantModel:
         return float(np.min(distance[:, 1]))
 
     def _close_pairs(self) -> Set[Tuple[int, int]]:
-        pairs = self.tree.query_pairs(self.collision_distance, output_type='ndarray').tolist()
-        return {(int(i), int(j)) for i, j in pairs}
+        """Pairs within the collision distance now (and :attr:`pairs`, when they are kept)."""
+        if self.pair_radius > 0.0 and self.pair_radius >= self.collision_distance:
+            self.pairs = self.tree.query_pairs(self.pair_radius,
+                                               output_type='ndarray').reshape(-1, 2)
+            diff = self.q[self.pairs[:, 0]] - self.q[self.pairs[:, 1]]
+            close = self.pairs[np.einsum('kd,kd->k', diff, diff)
+                               <= self.collision_distance ** 2].tolist()
+        else:
+            close = self.tree.query_pairs(self.collision_distance, output_type='ndarray').tolist()
+        return {(int(i), int(j)) for i, j in close}
 
     def _new_collisions(self) -> List[Tuple[int, int, float]]:
         pairs = self._close_pairs()
