@@ -421,9 +421,13 @@ class Launch:
             if self._died(left):
                 return
 
+    def place(self, spec: ProcessSpec) -> ProcessSpec:
+        """Return the spec to start for node ``spec`` (here: itself; hosts.py runs it elsewhere)."""
+        return spec
+
     def _start(self, spec: ProcessSpec) -> bool:
         try:
-            self.supervisor.start(spec)
+            self.supervisor.start(self.place(spec))
         except OSError as exc:
             self.failure = f'cannot start {spec.name}: {exc}'
             return False
@@ -509,19 +513,25 @@ def say(message: str, stream: Optional[TextIO] = None) -> None:
         pass
 
 
-def main(argv: Optional[Sequence[str]] = None) -> int:
-    """Run the launcher with ``argv`` (default: the command line); return the exit code."""
+def main(argv: Optional[Sequence[str]] = None, make: Optional[type] = None,
+         usage: str = USAGE) -> int:
+    """
+    Run the launcher with ``argv`` (default: the command line); return the exit code.
+
+    make: the class of the run (default :class:`Launch`; ``formation_ros.tools.hosts`` runs
+    the nodes on several hosts with a subclass), usage: the text of ``--help``.
+    """
     try:
         options = parse_args(sys.argv[1:] if argv is None else argv)
         if options is None:
-            print(USAGE, end='')
+            print(usage, end='')
             return 0
         options = check_paths(options)
         install = find_install(options.prefix, os.environ)
         num_robots, wall_seconds = read_parameters(options.params)
     except UsageError as exc:
         if exc.args[0] is None:
-            print(USAGE, end='', file=sys.stderr)
+            print(usage, end='', file=sys.stderr)
         else:
             say(exc.args[0])
         return 2
@@ -542,7 +552,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     say(f'{num_robots} robots{processes} from {options.params} ({install.describe()}), {span}; '
         f"ROS_DOMAIN_ID {network.get(DOMAIN_ENV) or '0'}, discovery "
         f'{network[DISCOVERY_ENV].lower()}', sys.stdout)
-    return Launch(options, install, num_robots, wall_seconds).run()
+    return (make or Launch)(options, install, num_robots, wall_seconds).run()
 
 
 def _ros2_knows_package(env: Mapping[str, str]) -> bool:
