@@ -10,7 +10,7 @@ import sys
 import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-SCRIPTS = ('setup_env.sh', 'demo.sh', 'run_tests.sh', 'launch_formation.sh')
+SCRIPTS = ('setup_env.sh', 'demo.sh', 'run_tests.sh', 'launch_formation.sh', 'hosts.sh')
 
 
 def run(script, *args):
@@ -280,3 +280,30 @@ def test_every_node_gets_the_discovery_settings(fake_install, monkeypatch, optio
     head = result.stdout.splitlines()[0]
     domain, discovery = expected.split()[:2]
     assert head.endswith(f'; ROS_DOMAIN_ID {domain}, discovery {discovery.lower()}'), head
+
+
+@pytest.mark.parametrize('args, says', [
+    (('--robot-hosts', '0'), '--robot-hosts must be a whole number from 1 to 100'),
+    (('--loss', '101'), '--loss must be a whole number from 0 to 100'),
+    (('--loss', 'some'), '--loss must be a whole number from 0 to 100'),
+    (('--discovery', 'localhost'), '--discovery cannot be given'),
+    (('--cleanup', 'x.yaml'), '--cleanup takes no other arguments'),
+    (('--domain-id', '300'), '--domain-id must be a whole number from 0 to 232'),
+])
+def test_hosts_script_refuses_bad_options(args, says):
+    result = run('hosts.sh', os.path.join(ROOT, 'config', 'square_4.yaml'), *args)
+    assert result.returncode == 2
+    assert result.stderr.startswith(f'hosts.sh: {says}'), result.stderr
+    assert len(result.stderr.splitlines()) == 1
+
+
+def test_hosts_places_plant_and_robots():
+    from formation_ros.tools.hosts import host_names, host_of, spread
+    assert host_names(2) == ['plant', 'robots_1', 'robots_2']
+    assert spread(5, 2) == [[1, 3, 5], [2, 4]]
+    assert spread(2, 3) == [[1], [2], []]
+    for name in ('plant', 'reference', 'record'):
+        assert host_of(name, 2) == 'plant'
+    for robots, host in zip(spread(7, 3), host_names(3)[1:]):
+        assert {host_of(f'robot_{i}', 3) for i in robots} == {host}
+    assert host_of('fleet_3', 2) == 'robots_1'

@@ -48,10 +48,12 @@ import sys
 import time
 from typing import Mapping, Optional, Sequence
 
-from formation_ros.tools.launcher import Install, Launch, main as launcher_main, Options, say
-from formation_ros.tools.launcher import UsageError
+from formation_ros.tools import launcher
+from formation_ros.tools.launcher import Install, Launch, main as launcher_main, Options
+from formation_ros.tools.launcher import parse_args, say, UsageError
 from formation_ros.tools.supervise import ProcessSpec, Supervisor
 
+PROG = 'hosts.sh'
 PREFIX = 'frh'
 NAME = re.compile(r'^frh-(\d+)-(\d+)-([a-z][a-z0-9_]*)$')
 SWITCH = 'switch'
@@ -357,8 +359,8 @@ class HostsLaunch(Launch):
                     f"{', '.join(map(str, robots)) or 'none'}"
                     + (f', {self.loss} % loss each way' if self.loss else ''), sys.stdout)
             say(f"host plant ({self.hosts.hosts['plant'].address}): plant, reference"
-                + (', record' if self.options.record else '') + f' (namespaces {self.hosts.tag}-*)',
-                sys.stdout)
+                + (', record' if self.options.record else '')
+                + f' (namespaces {self.hosts.tag}-*)', sys.stdout)
             return super().run()
 
 
@@ -394,11 +396,15 @@ report failed, 2 bad usage, parameters, or no namespaces here.
 def main(argv: Optional[Sequence[str]] = None) -> int:
     """Run ``scripts/hosts.sh`` with ``argv`` (default: the command line); the exit code."""
     args = list(sys.argv[1:] if argv is None else argv)
+    os.environ.pop('FORMATION_LAUNCHER_MODULE', None)
+    launcher.PROG = PROG
     if '-h' in args or '--help' in args:
         print(USAGE, end='')
         return 0
     try:
         robot_hosts, loss, cleanup, rest = _own_options(args)
+        if not cleanup:
+            parse_args(rest)
         reason = unavailable(loss=loss > 0)
         if reason is not None:
             raise UsageError(f'cannot make hosts here: {reason}')
@@ -408,7 +414,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                 f"{' '.join(removed)}", sys.stdout)
             return 0
     except (UsageError, HostsError) as exc:
-        say(str(exc))
+        if exc.args[0] is None:
+            print(USAGE, end='', file=sys.stderr)
+        else:
+            say(str(exc))
         return 2
     make = functools.partial(HostsLaunch, robot_hosts=robot_hosts, loss=loss)
     try:

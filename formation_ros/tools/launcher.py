@@ -422,7 +422,7 @@ class Launch:
                 return
 
     def place(self, spec: ProcessSpec) -> ProcessSpec:
-        """Return the spec to start for node ``spec`` (here: itself; hosts.py runs it elsewhere)."""
+        """Return the spec to start for node ``spec`` (itself; hosts.py runs it elsewhere)."""
         return spec
 
     def _start(self, spec: ProcessSpec) -> bool:

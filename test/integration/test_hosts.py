@@ -24,7 +24,7 @@ from formation_ros.core.declarations import Exe
 from formation_ros.core.params import load_config
 from formation_ros.tools import hosts as hosts_module
 from formation_ros.tools.bag import read_messages
-from formation_ros.tools.hosts import Hosts, host_names, HostsError, spread
+from formation_ros.tools.hosts import host_names, Hosts, HostsError, spread
 from formation_ros.tools.launcher import Install, node_specs, Options, recorder_spec
 from formation_ros.tools.launcher import watch_environment
 from formation_ros.tools.report import load_bag, write_report
@@ -191,7 +191,7 @@ def between(stamps, first, last):
 
 
 def assert_completed(metrics, config_path):
-    """The formation completed without collision, commands within the bound."""
+    """Assert that the formation completed without collision, commands within the bound."""
     assert metrics['final_max_error'] <= SETTLED, metrics
     assert metrics['settle_time'] is not None, metrics
     assert metrics['collisions'] == 0 and metrics['bound_violations'] == 0, metrics
@@ -209,6 +209,7 @@ def test_formation_converges_across_three_hosts(net, install, tmp_path):
     pids = net.pids()
     metrics, topics, _ = run.finish()
     assert_completed(metrics, SQUARE)
+    print(f"three hosts: settle time {metrics['settle_time']} s")
     for host, robots in run.robots.items():
         assert len(pids[f'{net.tag}-{host}']) == len(robots)
         for i in robots:
@@ -281,6 +282,11 @@ def test_a_cut_robot_host_stops_and_rejoins(net, install, tmp_path):
     assert max(moved) > 0.01, moved
     assert_completed(metrics, params)
     assert metrics['settle_time'] > still_to, metrics
+    again = [min(m for m, _, u in probe.heard('cmd_vel', i) if m > restored_at and any(u))
+             for i in run.robots[cut]]
+    print(f'cut 5 s: robots controlling again {min(again) - restored_at:.3f} to '
+          f'{max(again) - restored_at:.3f} s after the link returned; settle time '
+          f"{metrics['settle_time']} s")
 
 
 def test_a_robot_host_that_joins_10_s_late_is_taken_in(net, install, tmp_path):
