@@ -409,9 +409,13 @@ class PlantModel:
         counts.collisions += len(collisions)
         return StepReport(t_ns, q, admission, violations, collisions)
 
+    def sensed_pairs(self) -> Tuple[NDArray[np.intp], NDArray[np.intp]]:
+        """Every robot's range sensor now: (observer, seen) pairs, see :func:`sensed_pairs`."""
+        return sensed_pairs(self.tree, self.q, self.radii)
+
     def neighbours(self) -> List[NDArray[np.intp]]:
         """Robot i's range sensor: indices of the other robots strictly within R_i, each sorted."""
-        observer, seen = sensed_pairs(self.tree, self.q, self.radii)
+        observer, seen = self.sensed_pairs()
         splits = np.searchsorted(observer, np.arange(1, self.num_robots))
         return np.split(seen, splits)
 
