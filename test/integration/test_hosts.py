@@ -180,6 +180,11 @@ def positions(topics, robot, start, end):
                      if start <= stamp_of(m) <= end])
 
 
+def values_of(status):
+    """Return the key-value pairs of a DiagnosticStatus as a dict."""
+    return {pair.key: pair.value for pair in status.values}
+
+
 def stamp_of(message):
     """Return the header stamp of ``message`` in seconds."""
     return message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
@@ -243,6 +248,11 @@ def test_formation_converges_with_20_percent_loss_on_every_robot_link(net, insta
     print(f'delivered across a 20 % loss link: pose (best effort) {min(poses):.3f} to '
           f'{max(poses):.3f}, cmd_vel (reliable) {min(commands):.3f} to {max(commands):.3f}; '
           f"settle time {metrics['settle_time']} s")
+    alarms = [values_of(status)['robots with lost cmd_vel']
+              for _, m in topics['/diagnostics'] for status in m.status
+              if status.name == 'formation_ros/plant']
+    print(f"plant statuses with a robot's liveliness lost at 20 % loss: "
+          f"{sum(a != 'none' for a in alarms)} of {len(alarms)}")
     assert max(poses) < 0.92, poses
     assert min(commands) > max(poses), (commands, poses)
 
@@ -284,6 +294,11 @@ def test_a_cut_robot_host_stops_and_rejoins(net, install, tmp_path):
     assert metrics['settle_time'] > still_to, metrics
     again = [min(m for m, _, u in probe.heard('cmd_vel', i) if m > restored_at and any(u))
              for i in run.robots[cut]]
+    plant_lost = [values_of(status)['robots with lost cmd_vel']
+                  for _, m in topics['/diagnostics'] for status in m.status
+                  if status.name == 'formation_ros/plant']
+    assert '1, 3' in plant_lost, plant_lost
+    assert plant_lost[-1] == 'none', plant_lost[-5:]
     print(f'cut 5 s: robots controlling again {min(again) - restored_at:.3f} to '
           f'{max(again) - restored_at:.3f} s after the link returned; settle time '
           f"{metrics['settle_time']} s")
