@@ -13,9 +13,9 @@ The probe hears ``/diagnostics`` like any monitoring tool.
 import signal
 import time
 
+from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.ros import qos
 from formation_ros.ros.diagnostics import PERIOD
-from diagnostic_msgs.msg import DiagnosticArray
 from helpers import node, SQUARE, START_UP
 import pytest
 
@@ -67,7 +67,8 @@ def test_dead_robot_and_dead_plant_are_noticed(processes, install, probe):
     killed = time.monotonic()
     assert probe.spin_until(
         lambda: all(latest(f'formation_ros/robot_{i}', killed).get('plant (pose publisher)')
-                    == 'lost' for i in range(2, 5)), NOTICE_WITHIN), latest('formation_ros/robot_2')
+                    == 'lost' for i in range(2, 5)),
+        NOTICE_WITHIN), latest('formation_ros/robot_2')
     plant_noticed = max(next(at for at, who, values in heard if at >= killed
                              and who == f'formation_ros/robot_{i}'
                              and values.get('plant (pose publisher)') == 'lost')
