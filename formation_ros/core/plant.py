@@ -107,6 +107,11 @@ class Admission:
     status: NDArray[np.int8]
     largest_u_hat: NDArray[np.float64]
 
+    @property
+    def counted(self) -> NDArray[np.bool_]:
+        """(N,) whether each robot's command counted for the step (applied or saturated)."""
+        return (self.status == CommandStatus.APPLIED) | (self.status == CommandStatus.SATURATED)
+
 
 @dataclass(frozen=True)
 class StepReport:
@@ -311,6 +316,7 @@ class PlantModel:
         self._states: 'OrderedDict[int, NDArray[np.float64]]' = OrderedDict([(0, self.q)])
         self._states_kept = min(MAX_STATES_KEPT, 2 + self.input_timeout_ns // self.step_ns)
         self._audited = np.full(self.num_robots, -1, dtype=np.int64)
+        self._robots = np.arange(self.num_robots)
         self._colliding = self._close_pairs()
 
     @property
@@ -388,7 +394,8 @@ class PlantModel:
     def advance(self, commands: Commands) -> StepReport:
         """Admit the commands, audit the bound, step q' = u over dt, check collisions."""
         admission = self.admit(commands)
-        violations = self._audit(commands, admission)
+        counted = admission.counted
+        violations = self._audit(commands, admission, counted)
         t_ns, q = self.t_ns, self.q
         self.q = q + self.dt * admission.u
         self.t_ns += self.step_ns
@@ -398,9 +405,8 @@ class PlantModel:
             self._states.popitem(last=False)
         counts = self.counts
         counts.steps += 1
-        np.add.at(counts.status_steps, (admission.status, np.arange(self.num_robots)), 1)
+        counts.status_steps[admission.status, self._robots] += 1
         counts.bound_violations += len(violations)
-        counted = np.isin(admission.status, (CommandStatus.APPLIED, CommandStatus.SATURATED))
         oldest = int(np.max(t_ns - commands.stamp_ns[counted])) if np.any(counted) else 0
         counts.oldest_counted_ns = max(counts.oldest_counted_ns, oldest)
         age_bin = min(-(-oldest // self.step_ns), AGE_BINS) if np.all(counted) else AGE_BINS
@@ -436,9 +442,9 @@ class PlantModel:
         self._colliding = pairs
         return [(i, j, float(np.linalg.norm(self.q[i] - self.q[j]))) for i, j in new]
 
-    def _audit(self, commands: Commands, admission: Admission) -> List[Tuple[int, float]]:
+    def _audit(self, commands: Commands, admission: Admission,
+               counted: NDArray[np.bool_]) -> List[Tuple[int, float]]:
         """Return (robot, largest |u_hat| component) of new commands above c M1 (once each)."""
-        counted = np.isin(admission.status, (CommandStatus.APPLIED, CommandStatus.SATURATED))
         fresh = counted & (commands.stamp_ns != self._audited)
         self._audited[fresh] = commands.stamp_ns[fresh]
         over = np.flatnonzero(fresh & (admission.largest_u_hat - self.law.u_bound
