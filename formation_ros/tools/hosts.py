@@ -45,8 +45,9 @@ import shutil
 import signal
 import subprocess
 import sys
+import threading
 import time
-from typing import Mapping, Optional, Sequence
+from typing import IO, Mapping, Optional, Sequence
 
 from formation_ros.tools import launcher
 from formation_ros.tools.launcher import Install, Launch, main as launcher_main, Options
@@ -168,7 +169,7 @@ class Hosts:
     """
 
     def __init__(self, names: Sequence[str], env: Optional[Mapping[str, str]] = None,
-                 log_dir: Optional[str] = None, echo: Optional[object] = None) -> None:
+                 log_dir: Optional[str] = None, echo: Optional[IO[str]] = None) -> None:
         """Plan the network; nothing is made before :meth:`create` (or ``with``)."""
         if not names or len(set(names)) != len(names) or len(names) > MAX_HOSTS:
             raise ValueError(f'give 1 to {MAX_HOSTS} distinct host names, got {list(names)}')
@@ -181,7 +182,7 @@ class Hosts:
         self.switch = f'{self.tag}-{SWITCH}'
         self.hosts = {name: Host(name, f'{self.tag}-{name}', f'p{k}', f'{NETWORK}.{k}')
                       for k, name in enumerate(names, start=1)}
-        self.supervisor = Supervisor(echo=echo, log_dir=log_dir,  # type: ignore[arg-type]
+        self.supervisor = Supervisor(echo=echo, log_dir=log_dir,
                                      env=self.environment(os.environ if env is None else env))
         self._previous: dict[int, object] = {}
         self._made: list[str] = []
@@ -421,8 +422,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         return 2
     make = functools.partial(HostsLaunch, robot_hosts=robot_hosts, loss=loss)
     try:
-        return launcher_main(rest + ['--discovery', 'subnet'], make=make,  # type: ignore
-                             usage=USAGE)
+        return launcher_main(rest + ['--discovery', 'subnet'], make=make, usage=USAGE)
     except HostsError as exc:
         say(str(exc))
         return 1
@@ -468,7 +468,6 @@ def _alive(pid: int) -> bool:
 
 
 def _main_thread() -> bool:
-    import threading
     return threading.current_thread() is threading.main_thread()
 
 

@@ -28,7 +28,7 @@ import signal
 import subprocess
 import sys
 import time
-from typing import Mapping, Optional, Sequence, TextIO
+from typing import Callable, Mapping, Optional, Sequence, TextIO
 
 from formation_ros.tools.supervise import describe_returncode, ProcessSpec, Supervisor
 
@@ -513,7 +513,7 @@ def say(message: str, stream: Optional[TextIO] = None) -> None:
         pass
 
 
-def main(argv: Optional[Sequence[str]] = None, make: Optional[type] = None,
+def main(argv: Optional[Sequence[str]] = None, make: Optional[Callable[..., 'Launch']] = None,
          usage: str = USAGE) -> int:
     """
     Run the launcher with ``argv`` (default: the command line); return the exit code.
