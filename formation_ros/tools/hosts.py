@@ -62,6 +62,7 @@ BRIDGE = 'br0'
 DEVICE = 'eth0'
 NETWORK = '10.77.0'
 LOSS_TABLE = 'frh_loss'
+LOSS_HOOKS = ('ingress', 'egress')
 TRANSPORT_ENV = {'FASTDDS_BUILTIN_TRANSPORTS': 'UDPv4',
                  'ROS_AUTOMATIC_DISCOVERY_RANGE': 'SUBNET'}
 COMMAND_TIMEOUT = 30.0
@@ -250,7 +251,8 @@ class Hosts:
 
         An nftables ``netdev`` table in the host's namespace drops packets on ``eth0``'s
         ingress and egress hooks (``numgen random mod 100 < percent drop``); sending
-        processes get no error, as with a lossy cable.
+        processes get no error, as with a lossy cable. Counters count the packets that reach
+        each hook and those dropped (:meth:`loss_counts`).
         """
         if not 0 <= percent <= 100:
             raise ValueError(f'loss must be 0 to 100 %, got {percent}')
@@ -263,9 +265,21 @@ class Hosts:
         chains = ''.join(
             f'  chain {hook} {{\n'
             f'    type filter hook {hook} device "{DEVICE}" priority 0; policy accept;\n'
-            f'    numgen random mod 100 < {percent} drop\n'
-            '  }\n' for hook in ('ingress', 'egress'))
+            '    counter\n'
+            f'    numgen random mod 100 < {percent} counter drop\n'
+            '  }\n' for hook in LOSS_HOOKS)
         run_command(nft + ['-f', '-'], stdin=f'table netdev {LOSS_TABLE} {{\n{chains}}}\n')
+
+    def loss_counts(self, host: str) -> dict[str, tuple[int, int]]:
+        """Return {hook: (packets seen, packets dropped)} of ``host``'s loss table."""
+        text = run_command(['ip', 'netns', 'exec', self.hosts[host].namespace, 'nft', 'list',
+                            'table', 'netdev', LOSS_TABLE])
+        counts = {}
+        for hook in LOSS_HOOKS:
+            chain = text.split(f'chain {hook} {{', 1)[1].split('}', 1)[0]
+            seen, dropped = (int(n) for n in re.findall(r'counter packets (\d+)', chain))
+            counts[hook] = (seen, dropped)
+        return counts
 
     def rules(self, host: str) -> str:
         """Return the nftables rule set of ``host`` (empty when it has none)."""
