@@ -16,6 +16,7 @@ run left no namespace and no process behind.
 import dataclasses
 import json
 import os
+import signal
 import subprocess
 import sys
 import time
@@ -28,7 +29,7 @@ from formation_ros.tools.hosts import host_names, Hosts, HostsError, spread
 from formation_ros.tools.launcher import Install, node_specs, Options, recorder_spec
 from formation_ros.tools.launcher import watch_environment
 from formation_ros.tools.report import load_bag, write_report
-from formation_ros.tools.supervise import ProcessSpec
+from formation_ros.tools.supervise import ProcessSpec, Supervisor
 from helpers import project_processes, SQUARE, START_UP, write_params
 import numpy as np
 import pytest
@@ -337,7 +338,7 @@ def test_a_robot_host_that_joins_10_s_late_is_taken_in(net, install, tmp_path):
 CHILD = """
 import os, signal, sys, time
 from formation_ros.tools.hosts import Hosts
-from formation_ros.tools.supervise import ProcessSpec
+from formation_ros.tools.supervise import ProcessSpec, Supervisor
 with Hosts(['a', 'b']) as net:
     net.set_loss('b', 50)
     for host in ('a', 'b'):
@@ -389,3 +390,31 @@ def test_hosts_remove_what_they_made_when_the_test_fails():
             net.set_loss('a', 20)
             net.hosts['a'] = dataclasses.replace(net.hosts['a'], namespace='frh-0-0-missing')
             net.set_loss('a', 10)
+
+
+def test_hosts_script_runs_a_formation_and_cleans_up_after_ctrl_c(install, ros_env, tmp_path):
+    links = root_links()
+    script = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(
+        os.path.abspath(__file__)))), 'scripts', 'hosts.sh')
+    bag = tmp_path / 'bag'
+    with Supervisor(log_dir=str(tmp_path / 'logs'), env=ros_env) as processes:
+        processes.start(ProcessSpec('hosts', ['bash', script, SQUARE, '--prefix', install,
+                                              '--record', str(bag), '--duration', '0',
+                                              '--loss', '10']))
+        deadline = time.monotonic() + START_UP
+        while 'starting the clock' not in processes.log('hosts'):
+            assert processes.running('hosts') and time.monotonic() < deadline, \
+                processes.log('hosts')
+            time.sleep(0.1)
+        log = processes.log('hosts')
+        tag = log.split('(namespaces ')[1].split('-*)')[0]
+        assert len(hosts_module.run_namespaces(tag)) == 4
+        processes.send_signal('hosts', signal.SIGINT)
+        info = processes.wait('hosts', 120)
+        log = processes.log('hosts')
+    assert info is not None and info.returncode == 0, log
+    assert 'host robots_1 (10.77.0.2): robots 1, 3, 10 % loss each way' in log
+    assert 'ROS_DOMAIN_ID' in log and 'discovery subnet' in log
+    assert (bag / 'metadata.yaml').exists() and (bag / 'metrics.json').exists()
+    assert not hosts_module.run_namespaces(tag)
+    assert not project_processes(install) and root_links() == links
