@@ -31,14 +31,16 @@ Positions are rows: ``q`` has shape (N, dim), in m; commands (N, dim) in m/s.
 from collections import OrderedDict
 from dataclasses import dataclass, field
 import enum
-from typing import Dict, List, Optional, Set, Tuple
+from typing import Dict, List, Optional, Set, Tuple, TYPE_CHECKING
 
 from formation_ros.core.frames import from_frame_velocity, to_frame_velocity
 from formation_ros.core.law import LawParams
 from formation_ros.core.reference import Reference
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.spatial import cKDTree
+
+if TYPE_CHECKING:
+    from scipy.spatial import cKDTree
 
 NS_PER_S = 1_000_000_000
 BOUND_TOLERANCE_FIXED = 1e-9
@@ -110,7 +112,9 @@ class Admission:
     @property
     def counted(self) -> NDArray[np.bool_]:
         """(N,) whether each robot's command counted for the step (applied or saturated)."""
-        return (self.status == CommandStatus.APPLIED) | (self.status == CommandStatus.SATURATED)
+        counted: NDArray[np.bool_] = ((self.status == CommandStatus.APPLIED)
+                                      | (self.status == CommandStatus.SATURATED))
+        return counted
 
 
 @dataclass(frozen=True)
@@ -264,7 +268,7 @@ def start_positions(spec: StartSpec) -> Optional[NDArray[np.float64]]:
                         spec.seed)
 
 
-def sensed_pairs(tree: cKDTree, q: NDArray[np.float64],
+def sensed_pairs(tree: 'cKDTree', q: NDArray[np.float64],
                  radii: NDArray[np.float64]) -> Tuple[NDArray[np.intp], NDArray[np.intp]]:
     """
     Who senses whom: arrays (observer, seen) of every ordered pair with ||q_o - q_s|| < R_o.
@@ -310,6 +314,8 @@ class PlantModel:
         self.bound_tolerance = (BOUND_TOLERANCE_FIXED if reference.is_stationary
                                 else BOUND_TOLERANCE_MOVING)
         self.t_ns = 0
+        from scipy.spatial import cKDTree  # here: a robot imports this module, not the tree
+        self._tree_type = cKDTree
         self.tree = cKDTree(self.q)
         self.counts = PlantCounts(status_steps=np.zeros((len(CommandStatus), self.num_robots),
                                                         dtype=np.int64))
@@ -399,7 +405,7 @@ class PlantModel:
         t_ns, q = self.t_ns, self.q
         self.q = q + self.dt * admission.u
         self.t_ns += self.step_ns
-        self.tree = cKDTree(self.q)
+        self.tree = self._tree_type(self.q)
         self._states[self.t_ns] = self.q
         while len(self._states) > self._states_kept:
             self._states.popitem(last=False)
