@@ -21,15 +21,18 @@ import time
 from formation_ros.ros import fields, qos
 from geometry_msgs.msg import PoseStamped, TwistStamped
 import rclpy
-from rclpy.executors import ExternalShutdownException
+from rclpy.executors import SingleThreadedExecutor
+from rclpy.signals import SignalHandlerOptions
 from rosgraph_msgs.msg import Clock
 
 
 def main(argv):
     """Listen and write until stopped."""
     out, robots = argv[1], [int(word) for word in argv[2].split(',') if word]
-    rclpy.init()
-    signal.signal(signal.SIGTERM, lambda *_: rclpy.try_shutdown())
+    rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
+    stop = []
+    for number in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(number, lambda *_: stop.append(True))
     node = rclpy.create_node('hosts_probe')
     stream = open(out, 'a', buffering=1, encoding='utf-8')
     last = [-1.0]
@@ -59,14 +62,16 @@ def main(argv):
                                  lambda m, i=robot: on_command(i, m), qos.COMMAND)
         node.create_subscription(PoseStamped, f'/robot_{robot}/pose',
                                  lambda m, i=robot: on_pose(i, m), qos.STATE)
+    executor = SingleThreadedExecutor()
+    executor.add_node(node)
     try:
-        rclpy.spin(node)
-    except (KeyboardInterrupt, ExternalShutdownException):
-        pass
+        while not stop:
+            executor.spin_once(timeout_sec=0.1)
     finally:
         stream.close()
-        if rclpy.ok():
-            rclpy.shutdown()
+        executor.shutdown()
+        node.destroy_node()
+        rclpy.shutdown()
 
 
 if __name__ == '__main__':
