@@ -47,6 +47,9 @@ BOUND_TOLERANCE_FIXED = 1e-9
 BOUND_TOLERANCE_MOVING = 1e-3
 MAX_STATES_KEPT = 512
 MAX_START_TRIES = 20000
+GRID_FROM = 64
+"""A random start compares a candidate with every point placed while there are fewer than this
+many, with the points of the neighbouring grid cells after."""
 PLANT_STATS_FILE = 'plant_stats.json'
 AGE_BINS = 64
 """Command ages counted step by step in :attr:`PlantCounts.age_steps` (one more bin: none)."""
@@ -239,10 +242,23 @@ def random_start(n: int, dim: int, radius: float, min_separation: float,
     """
     Uniform random positions in the disc/ball of ``radius`` about 0, pairwise >= separation.
 
-    Returns (n, dim), or None when the points do not fit after many tries.
+    Returns (n, dim), or None when the points do not fit after many tries, or at once when
+    they cannot fit at all (n balls of radius ``min_separation / 2`` about them would not fit,
+    by volume, in the ball of radius ``radius + min_separation / 2``). Candidates are drawn
+    one by one and kept when no point placed so far is closer than ``min_separation``; the
+    placed points are kept in a grid of cells ``min_separation`` wide, so once there are
+    :data:`GRID_FROM` or more a candidate is compared with the points of its own and the
+    neighbouring cells only (the same decisions as comparing it with every point, in O(1)
+    instead of O(n)).
     """
+    if n * (0.5 * min_separation) ** dim > (radius + 0.5 * min_separation) ** dim:
+        return None
     rng = np.random.default_rng(seed)
     placed = np.empty((n, dim))
+    separation_sq = min_separation ** 2
+    cell = min_separation if min_separation > 0.0 else 1.0
+    grid: Dict[Tuple[int, ...], List[int]] = {}
+    offsets = np.array(list(np.ndindex(*(3,) * dim))) - 1
     count = 0
     tries = 0
     while count < n:
@@ -252,10 +268,18 @@ def random_start(n: int, dim: int, radius: float, min_separation: float,
         direction = rng.normal(size=dim)
         direction /= np.linalg.norm(direction)
         candidate = direction * radius * rng.random() ** (1.0 / dim)
-        if count and np.min(np.sum((placed[:count] - candidate) ** 2, axis=1)) \
-                < min_separation ** 2:
+        cells = (candidate // cell).astype(np.int64) if count >= GRID_FROM else None
+        if cells is None:
+            others = placed[:count]
+        else:
+            others = placed[[index for key in map(tuple, (cells + offsets).tolist())
+                             for index in grid.get(key, ())]]
+        if len(others) and np.min(np.sum((others - candidate) ** 2, axis=1)) < separation_sq:
             continue
         placed[count] = candidate
+        if cells is None:
+            cells = (candidate // cell).astype(np.int64)
+        grid.setdefault(tuple(cells.tolist()), []).append(count)
         count += 1
     return placed
 
@@ -293,12 +317,15 @@ class PlantModel:
     control law constants (for the bound c M1); reference: the desired trajectory (to recover
     u_hat when auditing the bound); input_timeout_ns: the oldest state stamp a command may
     answer; collision_distance: m; max_speed: cap on every world command component, m/s (0:
-    none beyond the law's own bound).
+    none beyond the law's own bound); pair_radius: with a value of at least the collision
+    distance (``formation_sim`` gives the law's b), the model keeps every pair within it of each
+    new state (:attr:`pairs`, for the law) and checks collisions among them instead of
+    searching the tree a second time.
     """
 
     def __init__(self, start: ArrayLike, sensing_radii: ArrayLike, step_ns: int,
                  law: LawParams, reference: Reference, input_timeout_ns: int,
-                 collision_distance: float, max_speed: float = 0.0):
+                 collision_distance: float, max_speed: float = 0.0, pair_radius: float = 0.0):
         """Place the robots at ``start`` at time 0."""
         self.q = np.array(start, dtype=float)
         self.radii = np.array(sensing_radii, dtype=float)
@@ -310,6 +337,9 @@ class PlantModel:
         self.reference = reference
         self.input_timeout_ns = int(input_timeout_ns)
         self.collision_distance = float(collision_distance)
+        self.pair_radius = float(pair_radius)
+        self.pairs: Optional[NDArray[np.intp]] = None
+        """(P, 2) pairs i < j within ``pair_radius`` of each other now (None without it)."""
         self.max_speed = float(max_speed)
         self.bound_tolerance = (BOUND_TOLERANCE_FIXED if reference.is_stationary
                                 else BOUND_TOLERANCE_MOVING)
@@ -439,8 +469,16 @@ class PlantModel:
         return float(np.min(distance[:, 1]))
 
     def _close_pairs(self) -> Set[Tuple[int, int]]:
-        pairs = self.tree.query_pairs(self.collision_distance, output_type='ndarray').tolist()
-        return {(int(i), int(j)) for i, j in pairs}
+        """Pairs within the collision distance now (and :attr:`pairs`, when they are kept)."""
+        if self.pair_radius > 0.0 and self.pair_radius >= self.collision_distance:
+            self.pairs = self.tree.query_pairs(self.pair_radius,
+                                               output_type='ndarray').reshape(-1, 2)
+            diff = self.q[self.pairs[:, 0]] - self.q[self.pairs[:, 1]]
+            close = self.pairs[np.einsum('kd,kd->k', diff, diff)
+                               <= self.collision_distance ** 2].tolist()
+        else:
+            close = self.tree.query_pairs(self.collision_distance, output_type='ndarray').tolist()
+        return {(int(i), int(j)) for i, j in close}
 
     def _new_collisions(self) -> List[Tuple[int, int, float]]:
         pairs = self._close_pairs()

@@ -137,7 +137,8 @@ def simulate_fixed_step(config: FormationConfig, duration: float, dt: float,
     reference = config.reference()
     step_ns = int(round(dt * NS_PER_S))
     model = PlantModel(config.start, config.sensing_radii, step_ns, law, reference,
-                       input_timeout_ns=step_ns, collision_distance=DEFAULT_COLLISION_DISTANCE)
+                       input_timeout_ns=step_ns, collision_distance=DEFAULT_COLLISION_DISTANCE,
+                       pair_radius=law.repulsion_radius)
     commands = Commands.empty(config.num_robots, config.dim)
     steps = int(round(duration / dt))
     stride = max(1, int(round(sample_dt / dt)))
@@ -145,7 +146,7 @@ def simulate_fixed_step(config: FormationConfig, duration: float, dt: float,
     for k in range(steps + 1):
         frame = reference.sample(model.t)
         commands.store_all(team_command(model.q, config.vertices, config.sensing_radii, law,
-                                        frame, model.tree).u, model.t_ns)
+                                        frame, model.tree, model.pairs).u, model.t_ns)
         if k == steps:
             times.append(model.t)
             states.append(model.q)

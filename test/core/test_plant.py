@@ -6,7 +6,7 @@
 import math
 import os
 
-from formation_ros.core.law import make_law, team_command
+from formation_ros.core.law import make_law, neighbour_pairs, team_command
 from formation_ros.core.params import load_config
 from formation_ros.core.plant import (Commands, CommandStatus, PlantModel, random_start,
                                       start_positions, StartSpec)
@@ -183,3 +183,43 @@ def test_duration_histogram_percentiles_against_numpy():
     assert histogram.percentile_ns(100) == values.max()
     histogram.add([-5, 0])
     assert histogram.bins[0] >= 2
+
+
+def brute_force_start(n, dim, radius, separation, seed):
+    """Draw the random start the same way, comparing each candidate with every point placed."""
+    rng = np.random.default_rng(seed)
+    placed = []
+    while len(placed) < n:
+        direction = rng.normal(size=dim)
+        direction /= np.linalg.norm(direction)
+        candidate = direction * radius * rng.random() ** (1.0 / dim)
+        if all(np.sum((p - candidate) ** 2) >= separation ** 2 for p in placed):
+            placed.append(candidate)
+    return np.array(placed)
+
+
+@pytest.mark.parametrize('n, dim, radius, separation, seed', [
+    (40, 2, 1.0, 0.1, 0), (200, 2, 2.5, 0.2, 7), (60, 3, 1.0, 0.15, 3), (25, 2, 3.0, 0.0, 1)])
+def test_random_start_with_its_grid_equals_comparing_with_every_point(n, dim, radius,
+                                                                      separation, seed):
+    assert np.array_equal(random_start(n, dim, radius, separation, seed),
+                          brute_force_start(n, dim, radius, separation, seed))
+
+
+def test_pairs_kept_for_the_law_are_its_pairs_and_give_the_same_collisions():
+    rng = np.random.default_rng(4)
+    start = rng.uniform(-1.0, 1.0, (60, 2))
+    start[1] = start[0] + [0.0205, 0.0]
+    plain, keeping = (PlantModel(start, np.full(60, 1.0), MS, LAW, FIXED, 50 * MS, 1e-3,
+                                 pair_radius=radius) for radius in (0.0, LAW.repulsion_radius))
+    assert plain.pairs is None
+    commands = Commands.empty(60, 2)
+    for _ in range(20):
+        assert np.array_equal(keeping.pairs, neighbour_pairs(keeping.q, LAW.repulsion_radius))
+        u = rng.uniform(-0.2, 0.2, (60, 2))
+        u[0], u[1] = [0.5, 0.0], [-0.5, 0.0]
+        commands.store_all(u, plain.t_ns)
+        reports = plain.advance(commands), keeping.advance(commands)
+        assert reports[0].collisions == reports[1].collisions
+        assert np.array_equal(plain.q, keeping.q)
+    assert plain.counts.collisions == keeping.counts.collisions > 0
