@@ -286,13 +286,14 @@ def test_a_cut_robot_host_stops_and_rejoins(net, install, tmp_path):
     metrics, topics, _ = run.finish()
     for i in run.robots[cut]:
         during = [u for m, _, u in probe.heard('cmd_vel', i)
-                  if cut_at + timeout + 0.5 <= m <= restored_at]
+                  if cut_at + timeout + 1.0 <= m <= restored_at]
         assert during and not any(any(u) for u in during), (i, during[:5])
-    still_from, still_to = plant.clock_at(cut_at + 1.5), plant.clock_at(restored_at)
-    assert still_to - still_from > 2.0, (still_from, still_to)
+    # The plant holds a body once its last command is plant.input_timeout (0.5 s) old.
+    still_from, still_to = plant.clock_at(cut_at) + 1.0, plant.clock_at(restored_at)
+    assert still_to - still_from > 1.0, (still_from, still_to)
     for i in run.robots[cut]:
         held = positions(topics, i, still_from, still_to)
-        assert len(held) > 50 and np.ptp(held, axis=0).max() < 1e-9, held[[0, -1]]
+        assert len(held) > 25 and np.ptp(held, axis=0).max() < 1e-9, held[[0, -1]]
     moved = [np.ptp(positions(topics, i, still_from, still_to), axis=0).max()
              for i in run.robots[others]]
     assert max(moved) > 0.01, moved
