@@ -72,9 +72,10 @@ class RobotSettings:
 
 @dataclass(frozen=True)
 class ReferenceSettings:
-    """The reference node's own parameters."""
+    """The reference node's own parameters, and the plant's step (lockstep sends one ahead)."""
 
     rate: float
+    step_ns: int
 
 
 @dataclass(frozen=True)
@@ -248,7 +249,8 @@ def _own_settings(values: Mapping[str, Any], exe: Exe, n: int,
             input_timeout=values['input_timeout'],
             wait_for_subscribers=values['wait_for_subscribers'])}
     if exe is Exe.REFERENCE:
-        return {'reference_node': ReferenceSettings(rate=values['reference.rate'])}
+        return {'reference_node': ReferenceSettings(
+            rate=values['reference.rate'], step_ns=int(round(NS_PER_S / values['plant.rate'])))}
     if exe is Exe.RECORD:
         return {'recorder': RecorderSettings(path=values['record.path'],
                                              overwrite=values['record.overwrite'],
