@@ -36,7 +36,6 @@ from formation_ros.ros.cdr import (CdrError, encode_twist_stamped, OdometryData,
                                    PoseData, read_odometry, read_pose_array, read_pose_stamped,
                                    TooManyPoses)
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
-from formation_ros.ros.liveliness import PeerLiveliness
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
 from formation_ros.ros.runner import run
@@ -97,11 +96,10 @@ class RobotNode(Node):
         self.waiting = True
         self.wait_subscribers = settings.wait_for_subscribers
 
-        self.plant_liveliness = PeerLiveliness()
-        self.create_subscription(PoseStamped, topics.POSE, self.on_pose, qos.STATE, raw=True,
-                                 event_callbacks=self.plant_liveliness.callbacks())
-        self.create_subscription(PoseArray, topics.NEIGHBOURS, self.on_neighbours, qos.STATE,
+        self.create_subscription(PoseStamped, topics.POSE, self.on_pose, qos.STATE_INPUT,
                                  raw=True)
+        self.create_subscription(PoseArray, topics.NEIGHBOURS, self.on_neighbours,
+                                 qos.STATE_INPUT, raw=True)
         self.create_subscription(Odometry, topics.REFERENCE, self.on_reference, qos.REFERENCE,
                                  raw=True)
         self.cmd_pub = self.create_publisher(TwistStamped, topics.CMD_VEL, qos.COMMAND)
@@ -330,13 +328,9 @@ class RobotNode(Node):
             values['max |u| component [m/s]'] = float(np.max(np.abs(self.last.u)))
             values['max |u_hat| component [m/s]'] = float(np.max(np.abs(self.last.u_hat)))
         values['bound c*M1 [m/s]'] = self.law.u_bound
-        values['plant (pose publisher)'] = self.plant_liveliness.state()
-        values['plant liveliness lost'] = self.plant_liveliness.lost
         values.update({f'rejected {name} messages ({reason.value})': count
                        for (name, reason), count in self.rejected.items()})
-        if self.plant_liveliness.state() == 'lost':
-            level, message = 'warn', 'publishing zero: the plant is gone (liveliness lost)'
-        elif self.waiting:
+        if self.waiting:
             level, message = 'warn', 'waiting for its first inputs'
         elif self.once.is_active('stale'):
             level, message = 'warn', 'publishing zero: inputs stale'

@@ -12,8 +12,11 @@ Quality of service of every formation topic, in one place.
   that joins late still gets the latest samples (and the fixed reference is never missed).
 * State (``pose``, ``neighbors``): best effort, keep last 1; at 50 to 100 Hz a stale sample is
   useless and a resent one would arrive late. In lockstep the plant resends a state that was not
-  answered. Liveliness automatic, lease :data:`LIVELINESS_LEASE`: a robot hears within a second
-  that the plant is gone.
+  answered. The plant offers the liveliness lease :data:`LIVELINESS_LEASE` (``STATE``); robots
+  subscribe asking for none (``STATE_INPUT``), so they hear any publisher of poses and
+  neighbours, a localisation system or range-sensor driver with the ROS default QoS too. A
+  robot notices a silent plant by its watchdog instead (``input_timeout``, 0.5 s by default:
+  it publishes zero and its ``/diagnostics`` says so).
 * Clock (``/clock``): reliable, keep last 1; it matches rclpy's best-effort time source and
   reliable subscribers such as a recorder.
 * Diagnostics (``/diagnostics``): reliable, keep last 10, volatile, as diagnostic tools expect.
@@ -25,11 +28,12 @@ The recorder subscribes with the publishers' reliability and durability but a de
 overwritten by the next one.
 
 Matching: a subscriber that asks for a liveliness lease only matches publishers that offer
-at most that lease. The formation's own publishers and subscribers of ``cmd_vel``, ``pose``
-and ``neighbors`` use the same profile, so they match; the recorder and tools such as
-``ros2 topic echo`` ask for no lease (infinite) and match any publisher. A publisher with the
-ROS default (no lease), e.g. ``ros2 topic pub`` without ``--qos-liveliness``, does not reach
-the plant or a robot: it must offer a lease of at most 1 s.
+at most that lease, and only a subscriber that asks for one is told when a publisher's lease
+runs out. The plant asks for the lease on every ``cmd_vel`` (robots offer it), so a robot whose
+process died or whose link was cut shows as lost within the lease; a ``cmd_vel`` publisher
+with the ROS default (no lease), e.g. ``ros2 topic pub`` without ``--qos-liveliness automatic
+--qos-liveliness-lease-duration 1``, does not reach the plant. The recorder and tools such as
+``ros2 topic echo`` ask for no lease (infinite) and match any publisher.
 """
 
 from formation_ros.ros.topics import QosKind
@@ -53,6 +57,7 @@ def _profile(depth, reliability, durability, lease=None):
 COMMAND = _profile(10, ReliabilityPolicy.RELIABLE, DurabilityPolicy.VOLATILE, LIVELINESS_LEASE)
 REFERENCE = _profile(10, ReliabilityPolicy.RELIABLE, DurabilityPolicy.TRANSIENT_LOCAL)
 STATE = _profile(1, ReliabilityPolicy.BEST_EFFORT, DurabilityPolicy.VOLATILE, LIVELINESS_LEASE)
+STATE_INPUT = _profile(1, ReliabilityPolicy.BEST_EFFORT, DurabilityPolicy.VOLATILE)
 CLOCK = _profile(1, ReliabilityPolicy.RELIABLE, DurabilityPolicy.VOLATILE)
 DIAGNOSTICS = _profile(10, ReliabilityPolicy.RELIABLE, DurabilityPolicy.VOLATILE)
 MARKERS = _profile(1, ReliabilityPolicy.RELIABLE, DurabilityPolicy.TRANSIENT_LOCAL)

@@ -2,12 +2,13 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-A dead peer is noticed through DDS liveliness and reported in ``/diagnostics``.
+A dead peer is noticed and reported in ``/diagnostics``.
 
 The plant, the reference node and four robots run as real processes; kill -9 of a robot must
-show in the plant's status (``robots with lost cmd_vel``), kill -9 of the plant in the robots'
-(``plant (pose publisher)``), well before DDS would drop the dead participant (about 20 s).
-The probe hears ``/diagnostics`` like any monitoring tool.
+show in the plant's status through DDS liveliness (``robots with lost cmd_vel``), well before
+DDS would drop the dead participant (about 20 s); kill -9 of the plant in the robots' status
+through their watchdog (``publishing zero: inputs stale``). The probe hears ``/diagnostics``
+like any monitoring tool.
 """
 
 import signal
@@ -30,16 +31,28 @@ def values_of(status):
     return {pair.key: pair.value for pair in status.values}
 
 
+STALE = 'publishing zero: inputs stale'
+
+
 def test_dead_robot_and_dead_plant_are_noticed(processes, install, probe):
     heard = []
     probe.create_subscription(
         DiagnosticArray, '/diagnostics',
-        lambda m: heard.extend((time.monotonic(), s.name, values_of(s)) for s in m.status),
+        lambda m: heard.extend((time.monotonic(), s.name, s.message, values_of(s))
+                               for s in m.status),
         qos.DIAGNOSTICS)
 
     def latest(name, since=0.0):
-        found = [values for at, who, values in heard if who == name and at >= since]
+        found = [values for at, who, _, values in heard if who == name and at >= since]
         return found[-1] if found else {}
+
+    def status_of(name, since=0.0):
+        found = [message for at, who, message, _ in heard if who == name and at >= since]
+        return found[-1] if found else None
+
+    def first(name, since, condition):
+        return next(at for at, who, message, values in heard
+                    if who == name and at >= since and condition(message, values))
 
     processes.start(node(install, 'plant', SQUARE))
     processes.start(node(install, 'reference', SQUARE, '-p', 'use_sim_time:=true'))
@@ -49,7 +62,7 @@ def test_dead_robot_and_dead_plant_are_noticed(processes, install, probe):
                              process=f'robot_{i}'))
     assert probe.spin_until(
         lambda: latest('formation_ros/plant').get('robots with alive cmd_vel') == '1, 2, 3, 4'
-        and latest('formation_ros/robot_2').get('plant (pose publisher)') == 'alive',
+        and status_of('formation_ros/robot_2') == 'controlling',
         START_UP), processes.log('plant')
     assert latest('formation_ros/plant')['robots with lost cmd_vel'] == 'none'
 
@@ -58,21 +71,18 @@ def test_dead_robot_and_dead_plant_are_noticed(processes, install, probe):
     assert probe.spin_until(
         lambda: latest('formation_ros/plant', killed).get('robots with lost cmd_vel') == '1',
         NOTICE_WITHIN), latest('formation_ros/plant')
-    robot_noticed = next(at for at, who, values in heard if at >= killed
-                         and who == 'formation_ros/plant'
-                         and values.get('robots with lost cmd_vel') == '1') - killed
+    robot_noticed = first('formation_ros/plant', killed,
+                          lambda _, values: values.get('robots with lost cmd_vel') == '1') - killed
     assert latest('formation_ros/plant', killed)['robots with alive cmd_vel'] == '2, 3, 4'
 
     processes.send_signal('plant', signal.SIGKILL)
     killed = time.monotonic()
     assert probe.spin_until(
-        lambda: all(latest(f'formation_ros/robot_{i}', killed).get('plant (pose publisher)')
-                    == 'lost' for i in range(2, 5)),
-        NOTICE_WITHIN), latest('formation_ros/robot_2')
-    plant_noticed = max(next(at for at, who, values in heard if at >= killed
-                             and who == f'formation_ros/robot_{i}'
-                             and values.get('plant (pose publisher)') == 'lost')
+        lambda: all(status_of(f'formation_ros/robot_{i}', killed) == STALE for i in range(2, 5)),
+        NOTICE_WITHIN), [status_of(f'formation_ros/robot_{i}') for i in range(2, 5)]
+    plant_noticed = max(first(f'formation_ros/robot_{i}', killed,
+                              lambda message, _: message == STALE)
                         for i in range(2, 5)) - killed
-    print(f'noticed in /diagnostics: robot killed {robot_noticed:.2f} s, plant killed '
-          f'{plant_noticed:.2f} s (lease {qos.LIVELINESS_LEASE:g} s, period {PERIOD:g} s)')
-    assert latest('formation_ros/robot_2', killed)['plant liveliness lost'] == '1'
+    print(f'noticed in /diagnostics: robot killed {robot_noticed:.2f} s (lease '
+          f'{qos.LIVELINESS_LEASE:g} s), plant killed {plant_noticed:.2f} s (watchdog), status '
+          f'period {PERIOD:g} s')

@@ -33,6 +33,10 @@ def test_commands_and_states_offer_the_lease_and_the_recorder_asks_for_none():
                                                                profile.durability)
     for kind in (QosKind.REFERENCE, QosKind.CLOCK, QosKind.DIAGNOSTICS, QosKind.MARKERS):
         assert qos.BY_KIND[kind].liveliness_lease_duration.nanoseconds == 0
+    # robots hear any publisher of poses and neighbours: they ask for no lease
+    assert qos.STATE_INPUT.liveliness_lease_duration.nanoseconds == 0
+    assert (qos.STATE_INPUT.reliability, qos.STATE_INPUT.depth) == (qos.STATE.reliability,
+                                                                    qos.STATE.depth)
 
 
 def test_peer_liveliness_follows_the_events():
