@@ -351,6 +351,20 @@ with Hosts(['a', 'b']) as net:
 """
 
 
+def in_namespaces(namespaces, wanted, timeout=60.0):
+    """
+    Return the process ids inside ``namespaces`` once there are ``wanted`` (or at the timeout).
+
+    A process started with ``ip netns exec`` enters its namespace a moment after it starts.
+    """
+    deadline = time.monotonic() + timeout
+    while True:
+        pids = [pid for name in namespaces for pid in hosts_module.namespace_pids(name)]
+        if len(pids) >= wanted or time.monotonic() > deadline:
+            return pids
+        time.sleep(0.05)
+
+
 @pytest.mark.parametrize('how', ['SIGTERM', 'SIGINT', 'kill'])
 def test_hosts_leave_nothing_behind(how, tmp_path):
     links, rules = root_links(), root_ruleset()
@@ -361,7 +375,7 @@ def test_hosts_leave_nothing_behind(how, tmp_path):
         assert tag.startswith('frh-'), tag
         made = hosts_module.run_namespaces(tag)
         assert len(made) == 3
-        pids = [pid for name in made for pid in hosts_module.namespace_pids(name)]
+        pids = in_namespaces(made, 2)
         assert len(pids) == 2
         if how != 'kill':
             child.send_signal(getattr(__import__('signal'), how))
