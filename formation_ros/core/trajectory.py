@@ -5,13 +5,15 @@
 
 from dataclasses import dataclass
 import os
-from typing import List, Sequence, Tuple
+from typing import List, Optional, Sequence, Tuple
 
 from formation_ros.core.frames import desired_positions, FrameSample, to_frame_velocity
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 ARRAYS = ('t', 'q', 'u', 'u_hat', 'q_desired', 'q_od')
+BODY_ARRAYS = ('heading', 'q_body', 'body_command')
+"""Arrays of a unicycle run, beside :data:`ARRAYS` (which then describe the hand points)."""
 
 
 @dataclass(frozen=True)
@@ -22,6 +24,10 @@ class Trajectory:
     t: (T,) s; q, q_desired: (T, N, dim) m; u: (T, N, dim) world-frame commands, m/s;
     u_hat: (T, N, dim) bounded formation-frame commands of eq. (14), m/s;
     q_od: (T, dim) the reference centre, m.
+
+    For unicycles q, u and u_hat are those of the hand points (what the law controls), and
+    heading (T, N) in rad, q_body (T, N, 2) the axle centres in m and body_command (T, N, 2)
+    the (v, w) held, in m/s and rad/s, describe the bodies; all three are None for points.
     """
 
     t: NDArray[np.float64]
@@ -30,6 +36,9 @@ class Trajectory:
     u_hat: NDArray[np.float64]
     q_desired: NDArray[np.float64]
     q_od: NDArray[np.float64]
+    heading: Optional[NDArray[np.float64]] = None
+    q_body: Optional[NDArray[np.float64]] = None
+    body_command: Optional[NDArray[np.float64]] = None
 
     @property
     def num_robots(self) -> int:
@@ -42,8 +51,10 @@ class Trajectory:
         return int(self.q.shape[2])
 
     def save(self, path: str) -> None:
-        """Write the arrays to ``path`` (a .npz file)."""
-        np.savez_compressed(path, **{name: getattr(self, name) for name in ARRAYS})
+        """Write the arrays to ``path`` (a .npz file); the body arrays only when present."""
+        arrays = {name: getattr(self, name) for name in ARRAYS + BODY_ARRAYS
+                  if getattr(self, name) is not None}
+        np.savez_compressed(path, **arrays)
 
     @classmethod
     def from_frames(cls, t: ArrayLike, q: ArrayLike, u: ArrayLike,
@@ -71,7 +82,8 @@ class Trajectory:
             missing = [name for name in ARRAYS if name not in data]
             if missing:
                 raise ValueError(f"{path}: missing arrays {', '.join(missing)}")
-            return cls(**{name: data[name] for name in ARRAYS})
+            return cls(**{name: data[name] for name in ARRAYS + BODY_ARRAYS
+                          if name in data})
 
 
 CHUNKS_DIR = 'trajectory_chunks'
