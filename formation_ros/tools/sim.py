@@ -34,6 +34,7 @@ from formation_ros.core.params import (FormationConfig, load_config,
                                        validate_for_every_executable)
 from formation_ros.core.params_file import load_params_file
 from formation_ros.core.plant import Commands, NS_PER_S, PlantModel
+from formation_ros.core.safety import guaranteed_min_distance
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.core.unicycle import hand_points, unicycle_commands, unicycle_rates
 import numpy as np
@@ -229,9 +230,17 @@ def run_metrics(trajectory: Trajectory, config: FormationConfig, integrator: str
         body = config.body
         extra.update(body_metrics(trajectory.q_body, trajectory.body_command,
                                   config.law().u_bound, body.hand_distance, body.radius))
-        extra.update({'max_linear': body.max_linear, 'max_angular': body.max_angular})
+        extra.update({'max_linear': body.max_linear, 'max_angular': body.max_angular,
+                      'guaranteed_min_hand_point_distance': guaranteed_min_distance(
+                          trajectory.q[0], config.vertices, config.law(),
+                          config.reference().sample(float(trajectory.t[0])))})
     return compute_metrics(trajectory.t, trajectory.q, trajectory.u, trajectory.u_hat,
                            trajectory.q_desired, config.law().u_bound, extra)
+
+
+def _limit(metrics: dict, name: str, unit: str) -> str:
+    value = metrics.get(name)
+    return '' if value is None else f', body.{name} = {value:g} {unit}'
 
 
 def format_summary(metrics: dict, out_dir: Optional[str] = None) -> str:
@@ -251,14 +260,19 @@ def format_summary(metrics: dict, out_dir: Optional[str] = None) -> str:
     ]
     if metrics.get('body_kind') == 'unicycle':
         touching = 2.0 * metrics['body_radius']
+        guaranteed = metrics['guaranteed_min_hand_point_distance']
         contact = 'bodies touched' if metrics['min_body_distance'] < touching else 'no contact'
         lines[3] = lines[3].replace('min pair distance', 'min hand-point distance')
         lines += [
             f"  closest body approach: {metrics['min_body_distance']:.4g} m ({contact}; "
             f'2 x body.radius = {touching:.4g} m)',
-            f"  max |v|: {metrics['max_abs_v']:.4g} m/s (bound sqrt(2) c M1 = "
-            f"{metrics['v_bound']:.4g} m/s), max |w|: {metrics['max_abs_omega']:.4g} rad/s "
-            f"(bound sqrt(2) c M1 / l = {metrics['omega_bound']:.4g} rad/s)",
+            '  guaranteed by the potential from this start (docs/equations.md, U6): hand '
+            f'points >= {guaranteed:.4g} m apart, so bodies >= '
+            f"{guaranteed - 2.0 * metrics['hand_distance']:.4g} m",
+            f"  max |v|: {metrics['max_abs_v']:.4g} m/s (sqrt(2) c M1 = "
+            f"{metrics['v_bound']:.4g} m/s{_limit(metrics, 'max_linear', 'm/s')}), "
+            f"max |w|: {metrics['max_abs_omega']:.4g} rad/s (sqrt(2) c M1 / l = "
+            f"{metrics['omega_bound']:.4g} rad/s{_limit(metrics, 'max_angular', 'rad/s')})",
         ]
     if out_dir:
         lines.append(f'  results in {out_dir}')
