@@ -16,6 +16,7 @@ from formation_ros.core.params_file import load_params_file
 from formation_ros.core.safety import guaranteed_min_distance
 from formation_ros.core.trajectory import ARRAYS, BODY_ARRAYS, Trajectory
 from formation_ros.core.unicycle import command_bounds, hand_points
+from formation_ros.tools.plots import FIGURES
 from formation_ros.tools.sim import run_metrics, simulate
 import numpy as np
 import pytest
@@ -167,6 +168,8 @@ def test_cli_writes_headings_beside_the_usual_arrays(tmp_path):
                 'guaranteed_min_hand_point_distance'):
         assert key in metrics
     assert metrics['body_kind'] == 'unicycle' and metrics['max_linear'] == 0.22
+    for name in FIGURES:
+        assert (out / name).stat().st_size > 10000, name
 
 
 def test_cli_refuses_a_file_beyond_turtlebot_limits_with_what_would_fit(tmp_path):
