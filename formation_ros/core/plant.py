@@ -468,13 +468,18 @@ class PlantModel:
         counts.collisions += len(collisions)
         return StepReport(t_ns, q, admission, violations, collisions, points, heading)
 
-    def neighbours(self) -> List[NDArray[np.intp]]:
+    def sensed_pairs(self) -> Tuple[NDArray[np.intp], NDArray[np.intp]]:
         """
-        Robot i's range sensor: indices of the other bodies strictly within its range, sorted.
+        Every robot's range sensor now: (observer, seen) pairs, see :func:`sensed_pairs`.
 
-        The range is R_i for points and R_i + 2 l for unicycles (``sensor_radii``).
+        A sensor sees bodies, strictly within R_i for points and R_i + 2 l for unicycles
+        (``sensor_radii``), so that it sees every hand point within R_i of its own.
         """
-        observer, seen = sensed_pairs(self.body_tree, self.q, self.sensor_radii)
+        return sensed_pairs(self.body_tree, self.q, self.sensor_radii)
+
+    def neighbours(self) -> List[NDArray[np.intp]]:
+        """Robot i's range sensor: indices of the other bodies it sees, each sorted."""
+        observer, seen = self.sensed_pairs()
         splits = np.searchsorted(observer, np.arange(1, self.num_robots))
         return np.split(seen, splits)
 

@@ -35,12 +35,14 @@ from formation_ros.core.frames import desired_positions
 from formation_ros.core.plant import (Commands, CommandStatus, DurationHistogram, NS_PER_S,
                                       PLANT_STATS_FILE, PlantModel, StepReport)
 from formation_ros.core.trajectory import CHUNKS_DIR, ChunkWriter, read_chunks, Trajectory
-from formation_ros.ros import fields, messages, qos, topics
+from formation_ros.ros import messages, qos, topics
+from formation_ros.ros.cdr import CdrError, encode_clock, read_twist_stamped, StateEncoder
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.markers import formation_markers, Paths
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
-from formation_ros.ros.runner import LOCKSTEP_POLL, run
+from formation_ros.ros.runner import run
+from formation_ros.ros.wake import Wake
 from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
 import numpy as np
 from rclpy.clock import Clock, ClockType
@@ -95,7 +97,8 @@ class PlantNode(Node):
         self.latency = DurationHistogram()
         self.rate_window = (time.monotonic(), 0)
 
-        self.state_messages = messages.StateMessages(self.n, self.dim)
+        self.state_encoder = StateEncoder(self.n, self.dim, messages.WORLD_FRAME)
+        self.malformed = np.zeros(self.n, dtype=np.int64)
         self.pose_pubs, self.neighbour_pubs = [], []
         for i in range(1, self.n + 1):
             self.pose_pubs.append(self.create_publisher(
@@ -104,13 +107,13 @@ class PlantNode(Node):
                 PoseArray, topics.robot_topic(i, topics.NEIGHBOURS), qos.STATE))
             self.command_subs.append(self.create_subscription(
                 TwistStamped, topics.robot_topic(i, topics.CMD_VEL),
-                lambda msg, index=i - 1: self.on_command(index, msg), qos.COMMAND))
+                lambda data, index=i - 1: self.on_command(index, data), qos.COMMAND, raw=True))
         self.clock_pub = self.create_publisher(ClockMsg, topics.CLOCK, qos.CLOCK)
         self.diagnostics_pub = self.create_publisher(
             DiagnosticArray, topics.DIAGNOSTICS, qos.DIAGNOSTICS)
-        period = LOCKSTEP_POLL if self.lockstep else \
-            self.model.dt / settings.realtime_factor
+        period = RESEND_AFTER if self.lockstep else self.model.dt / settings.realtime_factor
         self.timer = self.create_timer(period, self.on_timer, clock=self.steady)
+        self.step_wake = Wake(self, self.on_timer, self.steady)
         self.diagnostics_timer = self.create_timer(PERIOD, self.on_diagnostics,
                                                    clock=self.steady)
         if self.chunks is not None:
@@ -126,11 +129,20 @@ class PlantNode(Node):
             + ('lockstep' if self.lockstep
                else f'realtime factor {settings.realtime_factor:g}'))
 
-    def on_command(self, index: int, msg: TwistStamped) -> None:
-        """Store robot ``index``'s latest command and when it arrived."""
-        self.commands.store(index, fields.velocity_of(msg, self.dim),
-                            fields.stamp_to_ns(msg.header.stamp))
+    def on_command(self, index: int, data: bytes) -> None:
+        """Store robot ``index``'s latest command and when it arrived (lockstep: wake the step)."""
+        try:
+            command = read_twist_stamped(data)
+        except CdrError as exc:
+            self.malformed[index] += 1
+            self.once.start(f'malformed-{index}', f'robot {index + 1}: ignoring cmd_vel bytes '
+                                                  f'that are not a TwistStamped ({exc}; logged '
+                                                  'once, counted in diagnostics)', 'error')
+            return
+        self.commands.store(index, command.linear[:self.dim], command.stamp_ns)
         self.arrived_ns[index] = time.monotonic_ns()
+        if self.lockstep:
+            self.step_wake.arm()
 
     def _time_answers(self) -> None:
         """Count how long each new command took: from its state's publish to its arrival."""
@@ -142,7 +154,12 @@ class PlantNode(Node):
         self.timed_stamp[new] = stamps[new]
 
     def on_timer(self) -> None:
-        """Free-running: one step per tick. Lockstep: step when every robot has answered."""
+        """
+        Free-running: one step per tick. Lockstep: step when every robot has answered.
+
+        In lockstep this runs when a command arrives (:class:`Wake`) and every
+        ``RESEND_AFTER`` s, to send a state again that was not answered.
+        """
         if self.started_wall is None:
             self.started_wall = time.monotonic()
             self._publish()
@@ -160,11 +177,13 @@ class PlantNode(Node):
         answered = bool(np.all(self.commands.present
                                & (self.commands.stamp_ns == self.model.t_ns)))
         assert self.started_wall is not None
-        wall = time.monotonic() - self.started_wall
-        ahead = self.model.t > self.settings.realtime_factor * wall
-        if answered and not ahead:
+        ahead_s = self.model.t / self.settings.realtime_factor - (time.monotonic()
+                                                                  - self.started_wall)
+        if answered and ahead_s <= 0.0:
             self._step()
             self._publish()
+        elif answered:
+            self.step_wake.arm(ahead_s)
         else:
             self._resend_if_due()
 
@@ -218,7 +237,7 @@ class PlantNode(Node):
             self.once.end(f'saturated-{i}')
 
     def _publish_clock(self) -> None:
-        self.clock_pub.publish(ClockMsg(clock=messages.ns_to_stamp(self.model.t_ns)))
+        self.clock_pub.publish(encode_clock(self.model.t_ns))
 
     def _publish(self) -> None:
         """Publish /clock, then every robot's pose and what its range sensor sees."""
@@ -226,8 +245,8 @@ class PlantNode(Node):
         self.published_ns.setdefault(self.model.t_ns, time.monotonic_ns())
         while len(self.published_ns) > PUBLISHES_TIMED:
             self.published_ns.popitem(last=False)
-        poses, arrays = self.state_messages.fill(self.model.q, self.model.neighbours(),
-                                                 self.model.t_ns)
+        observer, seen = self.model.sensed_pairs()
+        poses, arrays = self.state_encoder.encode(self.model.q, observer, seen, self.model.t_ns)
         for publisher, message in zip(self.pose_pubs, poses):
             publisher.publish(message)
         for publisher, message in zip(self.neighbour_pubs, arrays):
@@ -272,6 +291,9 @@ class PlantNode(Node):
                   'bound c*M1 [m/s]': self.law.u_bound,
                   'oldest command counted [s]': counts.oldest_counted_ns / NS_PER_S}
         values.update({name.replace('_', ' '): count for name, count in counts.totals().items()})
+        if np.any(self.malformed):
+            values['robots with malformed cmd_vel messages'] = ', '.join(
+                f'{i + 1}: {count}' for i, count in enumerate(self.malformed.tolist()) if count)
         for status in (CommandStatus.STALE, CommandStatus.FUTURE, CommandStatus.NON_FINITE,
                        CommandStatus.SATURATED):
             robots = counts.by_robot(status)
@@ -366,6 +388,8 @@ class PlantNode(Node):
             'max_ms': self.latency.largest_ns / 1e6}
         stats['by_robot'] = {status.name.lower(): counts.by_robot(status)
                              for status in CommandStatus if status is not CommandStatus.APPLIED}
+        stats['malformed_command_messages'] = {
+            i + 1: count for i, count in enumerate(self.malformed.tolist()) if count}
         with open(os.path.join(output_dir, PLANT_STATS_FILE), 'w', encoding='utf-8') as stream:
             json.dump(stats, stream, indent=2)
             stream.write('\n')

@@ -12,20 +12,26 @@ header.stamp is the time t of the sample. With ``use_sim_time`` t is the plant's
 without it, t counts from the node's start. The timer runs on the wall clock at
 ``reference.rate``, so samples keep coming (with the same stamp) while the plant holds its clock,
 e.g. while it waits for the robots. In lockstep it publishes one sample for every new value of
-the simulated clock. The topic is transient local: a late robot gets the latest sample.
+the simulated clock, as soon as the clock moves (a jump callback of its clock arms a one-shot
+timer, ``formation_ros.ros.wake``; the timer at ``reference.rate`` publishes the first sample and
+any it missed). The topic is transient local: a late robot gets the latest sample.
 """
 
 from typing import List, Optional
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.declarations import Exe
+from formation_ros.core.frames import frame_to_pose
 from formation_ros.ros import fields, messages, qos, topics
+from formation_ros.ros.cdr import encode_odometry
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
-from formation_ros.ros.runner import LOCKSTEP_POLL, run
+from formation_ros.ros.runner import run
+from formation_ros.ros.wake import Wake
 from nav_msgs.msg import Odometry
-from rclpy.clock import Clock, ClockType
+from rclpy.clock import Clock, ClockType, JumpThreshold
+from rclpy.duration import Duration
 from rclpy.node import Node
 
 
@@ -51,9 +57,13 @@ class ReferenceNode(Node):
                                                      qos.DIAGNOSTICS)
         self.diagnostics_timer = self.create_timer(
             PERIOD, self.on_diagnostics, clock=Clock(clock_type=ClockType.STEADY_TIME))
-        period = LOCKSTEP_POLL if self.lockstep else 1.0 / settings.rate
-        self.timer = self.create_timer(period, self.on_timer,
-                                       clock=Clock(clock_type=ClockType.STEADY_TIME))
+        steady = Clock(clock_type=ClockType.STEADY_TIME)
+        self.timer = self.create_timer(1.0 / settings.rate, self.on_timer, clock=steady)
+        if self.lockstep:
+            self.clock_moved = Wake(self, self.on_timer, steady)
+            self.jump_handle = self.get_clock().create_jump_callback(
+                JumpThreshold(min_forward=Duration(nanoseconds=1), min_backward=None),
+                post_callback=lambda jump: self.clock_moved.arm())
         self.get_logger().info(
             f'reference: {self.reference.kind} in {self.dim}D, '
             + ('lockstep' if self.lockstep else f'{settings.rate:g} Hz')
@@ -63,13 +73,14 @@ class ReferenceNode(Node):
                                       'the plant state stamps')
 
     def on_timer(self) -> None:
-        """Publish the sample of the current time (in lockstep: only when the clock moved)."""
+        """Publish the sample of the current time (in lockstep: once per value of the clock)."""
         stamp = self.get_clock().now().nanoseconds
         if self.lockstep and stamp == self.last_stamp:
             return
         self.last_stamp = stamp
         frame = self.reference.sample((stamp - self.epoch_ns) / fields.NS_PER_S)
-        self.pub.publish(messages.reference_odometry(frame, stamp, self.dim))
+        self.pub.publish(encode_odometry(stamp, messages.WORLD_FRAME, messages.FORMATION_FRAME,
+                                         *frame_to_pose(frame, self.dim)))
         self.published += 1
 
     def on_diagnostics(self) -> None:

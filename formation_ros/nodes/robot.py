@@ -12,10 +12,13 @@ one per robot, each in its namespace::
     ros2 run formation_ros robot --ros-args -r __ns:=/robot_1 -p robot_id:=1 \\
         --params-file config/paper_section5.yaml
 
-The command is stamped with the stamp of the state it was computed from, so the plant can tell
-how old it is (and, in lockstep, which state it answers). The neighbours are read from the
-serialized PoseArray (``formation_ros.ros.cdr``): rclpy's own conversion builds three Python
-objects per neighbour, which was most of a robot's time in a dense formation.
+A robot answers each state as soon as its pose and neighbours (same stamp) are both in: the
+callbacks store them and arm a one-shot timer (``formation_ros.ros.wake``) that computes and
+publishes. A timer at ``control_rate`` is the watchdog (zero when an input is stale) and answers
+a state whose neighbours were lost. The command is stamped with the stamp of the state it was
+computed from, so the plant can tell how old it is (and, in lockstep, which state it answers).
+Every input is read from its serialized bytes and the command written as bytes
+(``formation_ros.ros.cdr``): rclpy's own conversions were most of a robot's time.
 """
 
 from collections import deque
@@ -29,14 +32,18 @@ from formation_ros.core.declarations import Exe
 from formation_ros.core.frames import advance, FrameSample
 from formation_ros.core.law import Command, robot_command
 from formation_ros.ros import fields, messages, qos, topics
-from formation_ros.ros.cdr import CdrError, PoseArrayData, read_pose_array, TooManyPoses
+from formation_ros.ros.cdr import (CdrError, encode_twist_stamped, OdometryData, PoseArrayData,
+                                   PoseData, read_odometry, read_pose_array, read_pose_stamped,
+                                   TooManyPoses)
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
-from formation_ros.ros.runner import LOCKSTEP_POLL, run
+from formation_ros.ros.runner import run
+from formation_ros.ros.wake import Wake
 from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
 from nav_msgs.msg import Odometry
 import numpy as np
+from numpy.typing import NDArray
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 
@@ -52,12 +59,12 @@ class Reason(enum.Enum):
     FRAME = f"a frame other than '{messages.WORLD_FRAME}'"
     CLOCK = 'stamps from another clock'
     TOO_MANY = 'more neighbours than there are robots'
-    MALFORMED = 'bytes that are not a whole PoseArray'
+    MALFORMED = 'bytes that are not a whole message of its type'
     TOO_FAST = 'a speed or turn rate its reference kind cannot have'
 
 
 class RobotNode(Node):
-    """One robot: stores what it hears in callbacks, computes and publishes in its timer."""
+    """One robot: stores what it hears in callbacks, computes and publishes in its timers."""
 
     def __init__(self, **kwargs):
         """Declare and check parameters, then set up topics and the control timer."""
@@ -78,7 +85,7 @@ class RobotNode(Node):
         self.once = OnceLog(self.get_logger())
         self.steady = Clock(clock_type=ClockType.STEADY_TIME)
 
-        self.pose: Optional[PoseStamped] = None
+        self.pose: Optional[PoseData] = None
         self.neighbours: Optional[PoseArrayData] = None
         self.references: deque = deque(maxlen=REFERENCE_BUFFER)
         self.received_ns = dict.fromkeys(INPUTS)
@@ -89,17 +96,20 @@ class RobotNode(Node):
         self.waiting = True
         self.wait_subscribers = settings.wait_for_subscribers
 
-        self.create_subscription(PoseStamped, topics.POSE, self.on_pose, qos.STATE)
+        self.create_subscription(PoseStamped, topics.POSE, self.on_pose, qos.STATE, raw=True)
         self.create_subscription(PoseArray, topics.NEIGHBOURS, self.on_neighbours, qos.STATE,
                                  raw=True)
-        self.create_subscription(Odometry, topics.REFERENCE, self.on_reference, qos.REFERENCE)
+        self.create_subscription(Odometry, topics.REFERENCE, self.on_reference, qos.REFERENCE,
+                                 raw=True)
         self.cmd_pub = self.create_publisher(TwistStamped, topics.CMD_VEL, qos.COMMAND)
         self.diagnostics_pub = self.create_publisher(DiagnosticArray, topics.DIAGNOSTICS,
                                                      qos.DIAGNOSTICS)
         self.diagnostics_timer = self.create_timer(PERIOD, self.on_diagnostics,
                                                    clock=self.steady)
-        period = LOCKSTEP_POLL if self.lockstep else 1.0 / settings.control_rate
-        self.timer = self.create_timer(period, self.on_timer, clock=self.steady)
+        self.answer = Wake(self, self.on_state, self.steady)
+        if not self.lockstep:
+            self.timer = self.create_timer(1.0 / settings.control_rate, self.on_timer,
+                                           clock=self.steady)
         self.get_logger().info(
             f'robot {self.index + 1}/{config.num_robots}: vertex {np.round(self.vertex, 4)}, '
             f'R_i = {self.sensing_radius:g} m, b = {config.repulsion_radius:g} m, '
@@ -142,14 +152,18 @@ class RobotNode(Node):
         self.once.end(f'{name}-{Reason.CLOCK.name}', f'{name} messages on this clock again')
         return True
 
-    def on_pose(self, msg: PoseStamped) -> None:
-        """Store the latest own pose."""
-        p = msg.pose.position
-        if self._check('pose', msg.header.frame_id, fields.stamp_to_ns(msg.header.stamp),
-                       all(map(math.isfinite, (p.x, p.y, p.z)))):
-            self.pose = msg
+    def on_pose(self, data: bytes) -> None:
+        """Store the latest own pose, read from the serialized PoseStamped."""
+        try:
+            pose = read_pose_stamped(data)
+        except CdrError as exc:
+            self._reject('pose', Reason.MALFORMED, f' ({exc})')
+            return
+        if self._check('pose', pose.frame_id, pose.stamp_ns, pose.finite):
+            self.pose = pose
             self.pose_count += 1
             self.received_ns['pose'] = self._now_ns()
+            self.answer.arm()
 
     def on_neighbours(self, data: bytes) -> None:
         """Store the latest sensed neighbour positions, read from the serialized PoseArray."""
@@ -165,35 +179,42 @@ class RobotNode(Node):
                        bool(np.all(np.isfinite(heard.positions)))):
             self.neighbours = heard
             self.received_ns['neighbour'] = self._now_ns()
+            self.answer.arm()
 
-    def on_reference(self, msg: Odometry) -> None:
+    def on_reference(self, data: bytes) -> None:
         """Store a reference sample (a few are kept to match state stamps in lockstep)."""
-        if msg.header.frame_id != messages.WORLD_FRAME:
-            self._reject('reference', Reason.FRAME, f' (got {msg.header.frame_id!r})')
-        elif not fields.odometry_is_finite(msg):
+        try:
+            msg = read_odometry(data)
+        except CdrError as exc:
+            self._reject('reference', Reason.MALFORMED, f' ({exc})')
+            return
+        if msg.frame_id != messages.WORLD_FRAME:
+            self._reject('reference', Reason.FRAME, f' (got {msg.frame_id!r})')
+        elif not msg.finite:
             self._reject('reference', Reason.NON_FINITE)
         elif not self._plausible(msg):
             self._reject('reference', Reason.TOO_FAST)
         else:
             self.references.append(msg)
             self.received_ns['reference'] = self._now_ns()
+            if self.lockstep:
+                self.answer.arm()
 
-    def _plausible(self, msg: Odometry) -> bool:
+    def _plausible(self, msg: OdometryData) -> bool:
         """Whether a reference sample's speed and turn rate fit the configured reference."""
-        linear, angular = msg.twist.twist.linear, msg.twist.twist.angular
-        speed = math.sqrt(linear.x ** 2 + linear.y ** 2 + linear.z ** 2)
-        turn = math.sqrt(angular.x ** 2 + angular.y ** 2 + angular.z ** 2)
+        speed = math.hypot(*msg.linear)
+        turn = math.hypot(*msg.angular)
         return (speed <= self.speed_limit * (1.0 + RATE_TOLERANCE) + RATE_TOLERANCE
                 and turn <= self.turn_limit * (1.0 + RATE_TOLERANCE) + RATE_TOLERANCE)
 
     def _reference_for(self, stamp_ns: int, exact: bool) -> Optional[FrameSample]:
         """Return the reference frame at ``stamp_ns``: that sample, else the newest carried on."""
         for msg in reversed(self.references):
-            if fields.stamp_to_ns(msg.header.stamp) == stamp_ns:
-                return fields.frame_of(msg, self.dim)
+            if msg.stamp_ns == stamp_ns:
+                return msg.frame(self.dim)
         if exact or not self.references:
             return None
-        newest = fields.frame_of(self.references[-1], self.dim)
+        newest = self.references[-1].frame(self.dim)
         ahead = stamp_ns / fields.NS_PER_S - newest.t
         if abs(ahead) * fields.NS_PER_S > self.timeout_ns:
             self._reject('reference', Reason.CLOCK, f' ({-ahead:+.3g} s from the state: start '
@@ -207,39 +228,59 @@ class RobotNode(Node):
         if frame is None:
             return None
         neighbours = self.neighbours.positions[:, :self.dim]
-        own = fields.position_of(self.pose, self.dim)
-        self.last = robot_command(own, self.vertex, neighbours, self.sensing_radius, self.law,
-                                  frame)
+        self.last = robot_command(self._own_position(), self.vertex, neighbours,
+                                  self.sensing_radius, self.law, frame)
         return self.last.u
 
-    def on_timer(self) -> None:
-        """
-        Answer the newest state once: compute and publish its command (zero if inputs are stale).
+    def _own_position(self) -> NDArray[np.float64]:
+        assert self.pose is not None
+        return np.array(self.pose.position[:self.dim])
 
-        A tick that finds no new pose since the last answer publishes nothing: the plant holds
-        the last command until it is ``plant.input_timeout`` old.
+    def _publish_command(self, u: Optional[NDArray[np.float64]], stamp_ns: int) -> None:
+        """Publish ``u`` ((dim,) m/s; None: zero) answering the state stamped ``stamp_ns``."""
+        self.cmd_pub.publish(encode_twist_stamped(
+            stamp_ns, messages.WORLD_FRAME, np.zeros(self.dim) if u is None else u))
+
+    def on_state(self) -> None:
+        """
+        Answer a state as soon as its pose and neighbours are both in (armed by the callbacks).
+
+        In lockstep the reference sample of the state's stamp is needed too; otherwise the
+        newest sample is carried forward to the state's time.
         """
         if self.lockstep:
             self._lockstep_answer()
-            return
+        elif (self.pose is not None and self.neighbours is not None
+              and self.neighbours.stamp_ns == self.pose.stamp_ns):
+            self._answer_newest()
+
+    def on_timer(self) -> None:
+        """
+        Watchdog at ``control_rate``: zero when an input is stale, else answer a state left over.
+
+        A state whose neighbours did not arrive (best effort) is answered here with the latest
+        neighbours; a tick that finds no new pose since the last answer publishes nothing: the
+        plant holds the last command until it is ``plant.input_timeout`` old.
+        """
+        self._answer_newest()
+
+    def _answer_newest(self) -> None:
+        """Answer the newest state once: compute and publish its command (zero if stale)."""
         if self.waiting and not self._ready():
             return
         now = self._now_ns()
         stale = [name for name in INPUTS if self.received_ns[name] is None
                  or now - self.received_ns[name] > self.timeout_ns]
         if stale:
-            stamp = fields.stamp_to_ns(self.pose.header.stamp)
-            self.cmd_pub.publish(messages.twist_stamped(np.zeros(self.dim), stamp, self.dim))
+            self._publish_command(None, self.pose.stamp_ns)
             self.once.start('stale', f"no new {', '.join(stale)} for "
                                      f'{self.timeout_ns / 1e9:g} s: publishing zero')
             return
         self.once.end('stale', 'inputs fresh again: controlling')
         if self.pose_count == self.answered_count:
             return
-        stamp = fields.stamp_to_ns(self.pose.header.stamp)
-        command = self._command(stamp, False)
-        self.cmd_pub.publish(messages.twist_stamped(
-            np.zeros(self.dim) if command is None else command, stamp, self.dim))
+        stamp = self.pose.stamp_ns
+        self._publish_command(self._command(stamp, False), stamp)
         self.answered_count = self.pose_count
 
     def _ready(self) -> bool:
@@ -261,13 +302,13 @@ class RobotNode(Node):
             return
         if self.waiting and not self._ready():
             return
-        stamp = fields.stamp_to_ns(self.pose.header.stamp)
+        stamp = self.pose.stamp_ns
         if self.neighbours.stamp_ns != stamp:
             return
         command = self._command(stamp, True)
         if command is None:
             return
-        self.cmd_pub.publish(messages.twist_stamped(command, stamp, self.dim))
+        self._publish_command(command, stamp)
         self.answered_count = self.pose_count
 
     def on_diagnostics(self) -> None:
@@ -278,7 +319,7 @@ class RobotNode(Node):
                   for name in INPUTS}
         if self.neighbours is not None and self.pose is not None:
             gaps = np.linalg.norm(self.neighbours.positions[:, :self.dim]
-                                  - fields.position_of(self.pose, self.dim), axis=1)
+                                  - self._own_position(), axis=1)
             values['neighbours heard'] = len(gaps)
             values['neighbours within R_i'] = int(np.count_nonzero(gaps < self.sensing_radius))
             values['neighbours within b'] = int(np.count_nonzero(gaps < self.law.repulsion_radius))

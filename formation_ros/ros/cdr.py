@@ -2,34 +2,45 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-Read a serialized geometry_msgs/PoseArray (CDR bytes) straight into numpy.
+The formation messages as CDR bytes: read into numpy and written from numpy, without rclpy.
 
-rclpy turns a received PoseArray into one Python ``Pose``, ``Point`` and ``Quaternion`` object
-per element: for a robot that senses 30 neighbours that costs a few hundred microseconds per
-message, most of a robot's time in a dense formation. A subscription with ``raw=True`` hands
-over the CDR bytes instead, and :func:`read_pose_array` reads the stamp, the frame and the
-positions from them with a few numpy calls.
+rclpy turns every message it receives into Python objects and every message it publishes back
+into C structures, field by field: a PoseArray costs one ``Pose``, ``Point`` and ``Quaternion``
+per element, an Odometry two 36-element covariance arrays. In a team of robots that was most of
+the CPU time of every process (profiles in the README). Subscriptions with ``raw=True`` hand over
+the serialized bytes, and ``Publisher.publish`` takes bytes, so the hot topics (``pose``,
+``neighbors``, ``cmd_vel``, ``/formation/reference``, ``/clock``) go through this module: the
+same messages on the wire, read and written with a few ``struct`` and numpy calls.
 
 The layout (XCDR1, as every ROS 2 rmw writes it): a 4-byte encapsulation header (``00 01`` for
-little endian, ``00 00`` for big endian, then two option bytes); then, aligned relative to the
-end of that header, ``stamp.sec`` (int32), ``stamp.nanosec`` (uint32), ``frame_id`` (uint32
-length counting the terminating NUL, the bytes, the NUL), the element count (uint32, 4-aligned)
-and per element seven float64 (8-aligned): position x, y, z, orientation x, y, z, w.
+little endian, ``00 00`` for big endian, then two option bytes); then the fields in order, each
+aligned to its own size relative to the end of that header: ``int32``/``uint32`` to 4,
+``float64`` to 8; a string is a uint32 length counting the terminating NUL, the bytes and the
+NUL; a sequence a uint32 count and the elements. A Header is ``stamp.sec`` (int32),
+``stamp.nanosec`` (uint32), ``frame_id``. Readers take either byte order and refuse anything that
+is not a whole message (:class:`CdrError`); writers write little endian with zero padding.
 """
 
 from dataclasses import dataclass
+import math
 import struct
+from typing import List, Sequence, Tuple
 
+from formation_ros.core.frames import frame_from_pose, FrameSample
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 HEADER = 4
+LITTLE = b'\x00\x01\x00\x00'
 POSE_DOUBLES = 7
+COVARIANCE_DOUBLES = 36
+NS_PER_S = 1_000_000_000
 ENDIANS = {b'\x00\x01': '<', b'\x00\x00': '>'}
+IDENTITY = (0.0, 0.0, 0.0, 1.0)
 
 
 class CdrError(ValueError):
-    """The bytes are not a serialized PoseArray (cut short, unknown encoding, bad lengths)."""
+    """The bytes are not a serialized message of the expected type (cut short, bad lengths)."""
 
 
 class TooManyPoses(CdrError):
@@ -45,9 +56,107 @@ class PoseArrayData:
     positions: NDArray[np.float64]
 
 
+@dataclass(frozen=True)
+class PoseData:
+    """A PoseStamped: stamp (ns), frame, position (3,) in m, orientation (x, y, z, w)."""
+
+    stamp_ns: int
+    frame_id: str
+    position: Tuple[float, float, float]
+    orientation: Tuple[float, float, float, float]
+
+    @property
+    def finite(self) -> bool:
+        """Whether every number is finite."""
+        return all(map(math.isfinite, self.position + self.orientation))
+
+
+@dataclass(frozen=True)
+class TwistData:
+    """A TwistStamped: stamp (ns), frame, linear (3,) m/s and angular (3,) rad/s velocity."""
+
+    stamp_ns: int
+    frame_id: str
+    linear: Tuple[float, float, float]
+    angular: Tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class OdometryData:
+    """
+    A reference sample (nav_msgs/Odometry without its covariances).
+
+    position (3,) m and orientation (x, y, z, w) of the pose; linear (3,) m/s and angular (3,)
+    rad/s of the twist; stamp in ns.
+    """
+
+    stamp_ns: int
+    frame_id: str
+    child_frame_id: str
+    position: Tuple[float, float, float]
+    orientation: Tuple[float, float, float, float]
+    linear: Tuple[float, float, float]
+    angular: Tuple[float, float, float]
+
+    @property
+    def finite(self) -> bool:
+        """Whether every number is finite and the quaternion is not zero."""
+        values = self.position + self.orientation + self.linear + self.angular
+        return (all(map(math.isfinite, values))
+                and sum(v * v for v in self.orientation) > 0.0)
+
+    def frame(self, dim: int) -> FrameSample:
+        """Return the formation frame this sample carries (``core.frames.frame_from_pose``)."""
+        return frame_from_pose(self.stamp_ns / NS_PER_S, self.position, self.orientation,
+                               self.linear, self.angular, dim)
+
+
 def _align(offset: int, size: int) -> int:
     """Return ``offset`` moved up to a multiple of ``size`` counted from the end of the header."""
     return offset + (-(offset - HEADER)) % size
+
+
+class _Reader:
+    """Reads fields of one serialized message in order, checking that each one is there."""
+
+    def __init__(self, data: bytes, what: str) -> None:
+        self.view = memoryview(data)
+        self.what = what
+        if len(self.view) < HEADER:
+            raise CdrError(f'{len(self.view)} bytes: too short for a {what}')
+        endian = ENDIANS.get(bytes(self.view[:2]))
+        if endian is None:
+            raise CdrError(f'unknown CDR encapsulation {bytes(self.view[:2]).hex()}')
+        self.endian = endian
+        self.offset = HEADER
+
+    def _take(self, fmt: str, size: int, align: int) -> Tuple:
+        start = _align(self.offset, align)
+        if start + size > len(self.view):
+            raise CdrError(f'a {self.what} cut short at byte {len(self.view)}')
+        self.offset = start + size
+        return struct.unpack_from(self.endian + fmt, self.view, start)
+
+    def string(self, name: str) -> str:
+        (length,) = self._take('I', 4, 4)
+        start = self.offset
+        if length < 1 or start + length > len(self.view) or self.view[start + length - 1] != 0:
+            raise CdrError(f'{name} is cut short or not terminated')
+        self.offset = start + length
+        return bytes(self.view[start:start + length - 1]).decode('utf-8', 'replace')
+
+    def header(self) -> Tuple[int, str]:
+        sec, nanosec = self._take('iI', 8, 4)
+        return sec * NS_PER_S + nanosec, self.string('frame_id')
+
+    def doubles(self, count: int) -> Tuple[float, ...]:
+        return self._take(f'{count}d', 8 * count, 8)
+
+    def skip_doubles(self, count: int) -> None:
+        self._take('', 8 * count, 8)
+
+    def uint32(self) -> int:
+        return self._take('I', 4, 4)[0]
 
 
 def read_pose_array(data: bytes, max_poses: int) -> PoseArrayData:
@@ -58,27 +167,143 @@ def read_pose_array(data: bytes, max_poses: int) -> PoseArrayData:
     :class:`CdrError` (a ValueError) for anything that is not a whole PoseArray. The positions
     are a copy, independent of ``data``.
     """
-    view = memoryview(data)
-    if len(view) < HEADER + 12:
-        raise CdrError(f'{len(view)} bytes: too short for a PoseArray')
-    endian = ENDIANS.get(bytes(view[:2]))
-    if endian is None:
-        raise CdrError(f'unknown CDR encapsulation {bytes(view[:2]).hex()}')
-    sec, nanosec, length = struct.unpack_from(endian + 'iII', view, HEADER)
-    start = HEADER + 12
-    if length < 1 or start + length > len(view) or view[start + length - 1] != 0:
-        raise CdrError('frame_id is cut short or not terminated')
-    frame_id = bytes(view[start:start + length - 1]).decode('utf-8', 'replace')
-    offset = _align(start + length, 4)
-    if offset + 4 > len(view):
-        raise CdrError('cut short before the element count')
-    (count,) = struct.unpack_from(endian + 'I', view, offset)
+    reader = _Reader(data, 'PoseArray')
+    stamp_ns, frame_id = reader.header()
+    count = reader.uint32()
     if count > max_poses:
         raise TooManyPoses(f'{count} poses, more than {max_poses}')
-    offset = _align(offset + 4, 8) if count else offset + 4
-    if offset + count * POSE_DOUBLES * 8 > len(view):
-        raise CdrError(f'cut short: {count} poses do not fit in {len(view)} bytes')
-    values = np.frombuffer(view, dtype=np.dtype(np.float64).newbyteorder(endian),
+    offset = _align(reader.offset, 8) if count else reader.offset
+    if offset + count * POSE_DOUBLES * 8 > len(reader.view):
+        raise CdrError(f'cut short: {count} poses do not fit in {len(reader.view)} bytes')
+    values = np.frombuffer(reader.view, dtype=np.dtype(np.float64).newbyteorder(reader.endian),
                            count=count * POSE_DOUBLES, offset=offset)
     positions = values.reshape(count, POSE_DOUBLES)[:, :3].astype(np.float64)
-    return PoseArrayData(sec * 1_000_000_000 + nanosec, frame_id, positions)
+    return PoseArrayData(stamp_ns, frame_id, positions)
+
+
+def read_pose_stamped(data: bytes) -> PoseData:
+    """Read a serialized geometry_msgs/PoseStamped; :class:`CdrError` if it is not one."""
+    reader = _Reader(data, 'PoseStamped')
+    stamp_ns, frame_id = reader.header()
+    values = reader.doubles(POSE_DOUBLES)
+    return PoseData(stamp_ns, frame_id, values[:3], values[3:])
+
+
+def read_twist_stamped(data: bytes) -> TwistData:
+    """Read a serialized geometry_msgs/TwistStamped; :class:`CdrError` if it is not one."""
+    reader = _Reader(data, 'TwistStamped')
+    stamp_ns, frame_id = reader.header()
+    values = reader.doubles(6)
+    return TwistData(stamp_ns, frame_id, values[:3], values[3:])
+
+
+def read_odometry(data: bytes) -> OdometryData:
+    """Read a serialized nav_msgs/Odometry (its covariances skipped); CdrError if not one."""
+    reader = _Reader(data, 'Odometry')
+    stamp_ns, frame_id = reader.header()
+    child = reader.string('child_frame_id')
+    pose = reader.doubles(POSE_DOUBLES)
+    reader.skip_doubles(COVARIANCE_DOUBLES)
+    twist = reader.doubles(6)
+    reader.skip_doubles(COVARIANCE_DOUBLES)
+    return OdometryData(stamp_ns, frame_id, child, pose[:3], pose[3:], twist[:3], twist[3:])
+
+
+def _string(text: str) -> bytes:
+    """Return a CDR string for a 4-aligned offset: its length, bytes and NUL."""
+    raw = text.encode('utf-8') + b'\x00'
+    return struct.pack('<I', len(raw)) + raw
+
+
+def _pad(length: int, size: int) -> bytes:
+    return b'\x00' * ((-(length - HEADER)) % size)
+
+
+def encode_header(stamp_ns: int, frame_id: str) -> bytes:
+    """Return the encapsulation header and a Header at ``stamp_ns`` (>= 0) in ``frame_id``."""
+    head = LITTLE + struct.pack('<iI', stamp_ns // NS_PER_S, stamp_ns % NS_PER_S)
+    return head + _string(frame_id)
+
+
+def _with_doubles(prefix: bytes, values: Sequence[float]) -> bytes:
+    return prefix + _pad(len(prefix), 8) + struct.pack(f'<{len(values)}d', *values)
+
+
+def _xyz(vector: ArrayLike) -> List[float]:
+    values = [0.0, 0.0, 0.0]
+    flat = [float(v) for v in np.asarray(vector, dtype=float).ravel()[:3]]
+    values[:len(flat)] = flat
+    return values
+
+
+def encode_pose_stamped(stamp_ns: int, frame_id: str, position: ArrayLike,
+                        orientation: Sequence[float] = IDENTITY) -> bytes:
+    """Return a serialized PoseStamped: ``position`` ((dim,) m, z = 0 in 2D) and a quaternion."""
+    return _with_doubles(encode_header(stamp_ns, frame_id),
+                         _xyz(position) + [float(v) for v in orientation])
+
+
+def encode_twist_stamped(stamp_ns: int, frame_id: str, linear: ArrayLike,
+                         angular: ArrayLike = (0.0, 0.0, 0.0)) -> bytes:
+    """Return a serialized TwistStamped: ``linear`` ((dim,) m/s) and ``angular`` (rad/s)."""
+    return _with_doubles(encode_header(stamp_ns, frame_id), _xyz(linear) + _xyz(angular))
+
+
+def encode_odometry(stamp_ns: int, frame_id: str, child_frame_id: str, position: ArrayLike,
+                    orientation: Sequence[float], linear: ArrayLike,
+                    angular: ArrayLike) -> bytes:
+    """Return a serialized nav_msgs/Odometry with zero covariances (vectors of 3 values)."""
+    prefix = encode_header(stamp_ns, frame_id)
+    prefix += _pad(len(prefix), 4)
+    prefix += _string(child_frame_id)
+    zeros = [0.0] * COVARIANCE_DOUBLES
+    return _with_doubles(prefix, _xyz(position) + [float(v) for v in orientation] + zeros
+                         + _xyz(linear) + _xyz(angular) + zeros)
+
+
+def encode_clock(stamp_ns: int) -> bytes:
+    """Return a serialized rosgraph_msgs/Clock at ``stamp_ns`` (>= 0)."""
+    return LITTLE + struct.pack('<iI', stamp_ns // NS_PER_S, stamp_ns % NS_PER_S)
+
+
+class StateEncoder:
+    """
+    The plant's state messages of all robots at once: poses and range-sensor readings as bytes.
+
+    Every robot's pose is 7 float64 (x, y, z, identity quaternion) in one (N, 7) array; a
+    PoseStamped is a fixed prefix and that row, a PoseArray a prefix with its count and the rows
+    of the robots it lists, taken with one numpy index for all arrays together.
+    """
+
+    def __init__(self, num_robots: int, dim: int, frame_id: str) -> None:
+        """Prepare the messages of ``num_robots`` robots in ``dim`` (2 or 3) dimensions."""
+        self.dim = dim
+        self.frame_id = frame_id
+        self.rows = np.zeros((num_robots, POSE_DOUBLES))
+        self.rows[:, 6] = 1.0
+
+    def encode(self, q: NDArray[np.float64], observer: NDArray[np.intp],
+               seen: NDArray[np.intp], stamp_ns: int) -> Tuple[List[bytes], List[bytes]]:
+        """
+        Return (poses, arrays): robot i's serialized PoseStamped and PoseArray at ``stamp_ns``.
+
+        q: (N, dim) positions, m; (observer, seen): every sensed pair, sorted by observer
+        (``core.plant.sensed_pairs``): robot ``observer[k]`` sees robot ``seen[k]``.
+        """
+        self.rows[:, :self.dim] = q
+        header = encode_header(stamp_ns, self.frame_id)
+        pose_prefix = header + _pad(len(header), 8)
+        poses = [pose_prefix + row for row in map(bytes, self.rows)]
+        count_at = len(header) + len(_pad(len(header), 4))
+        counts = np.bincount(observer, minlength=len(q))
+        ends = np.cumsum(counts) * POSE_DOUBLES * 8
+        body = self.rows[seen].tobytes()
+        array_prefix = header + _pad(len(header), 4)
+        padding = _pad(count_at + 4, 8)
+        arrays = []
+        start = 0
+        for count, end in zip(counts.tolist(), ends.tolist()):
+            arrays.append(array_prefix + struct.pack('<I', count) + (padding if count else b'')
+                          + body[start:end])
+            start = end
+        return poses, arrays

@@ -1,7 +1,12 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""Build ROS messages from the numpy arrays of the core (reading them is ``fields``)."""
+"""
+Build ROS messages from the numpy arrays of the core (reading them is ``fields``).
+
+The nodes write their hot topics as bytes (``cdr``); these typed messages are what tools and
+tests publish, and what the byte writers are tested against.
+"""
 
 from builtin_interfaces.msg import Time
 from formation_ros.core.frames import frame_to_pose
@@ -47,48 +52,6 @@ def pose_array(points, stamp_ns, dim):
         pose.orientation.w = 1.0
         msg.poses.append(pose)
     return msg
-
-
-class StateMessages:
-    """
-    The plant's state messages (poses, what each range sensor sees), built once, then refilled.
-
-    Every robot's position is written into one ``Pose`` per robot, and a robot's neighbour
-    array lists the ``Pose`` objects of its neighbours (one object may be in several arrays:
-    each is serialized when it is published, before the next refill). This spares building
-    ``N + sum of neighbours`` messages per publish in Python.
-    """
-
-    def __init__(self, num_robots: int, dim: int) -> None:
-        """Allocate the messages of ``num_robots`` robots in ``dim`` (2 or 3) dimensions."""
-        self.dim = dim
-        self.poses = [_stamped(PoseStamped(), 0) for _ in range(num_robots)]
-        self.shared = [Pose() for _ in range(num_robots)]
-        self.arrays = [_stamped(PoseArray(), 0) for _ in range(num_robots)]
-        for message, pose in zip(self.poses, self.shared):
-            message.pose.orientation.w = 1.0
-            pose.orientation.w = 1.0
-
-    def fill(self, q, neighbours, stamp_ns):
-        """
-        Refill every message for positions ``q`` ((N, dim), m) at ``stamp_ns``.
-
-        neighbours: for each robot, the indices of the robots it senses. Returns (poses,
-        arrays): robot i's PoseStamped and PoseArray, to publish before the next fill.
-        """
-        stamp = ns_to_stamp(stamp_ns)
-        rows = [_xyz(row, self.dim) for row in q.tolist()]
-        for message, pose, (x, y, z) in zip(self.poses, self.shared, rows):
-            message.header.stamp = stamp
-            position = message.pose.position
-            position.x, position.y, position.z = x, y, z
-            position = pose.position
-            position.x, position.y, position.z = x, y, z
-        shared = self.shared
-        for array, seen in zip(self.arrays, neighbours):
-            array.header.stamp = stamp
-            array.poses = [shared[j] for j in seen.tolist()]
-        return self.poses, self.arrays
 
 
 def twist_stamped(velocity, stamp_ns, dim):

@@ -36,8 +36,6 @@ from rclpy.signals import SignalHandlerOptions
 import yaml
 
 SIGNAL_LATENCY = 0.1
-LOCKSTEP_POLL = 0.001
-"""Period, s (steady clock), of the timer with which a lockstep node looks for a new state."""
 LAUNCHER_PID_ENV = 'FORMATION_LAUNCHER_PID'
 LAUNCHER_START_ENV = 'FORMATION_LAUNCHER_START'
 """Process id and start time (clock ticks after boot, /proc/<pid>/stat) of the launcher."""

@@ -1,15 +1,23 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""Reading serialized PoseArrays with numpy equals rclpy's own deserialisation."""
+"""Reading and writing the formation messages as bytes equals rclpy's own serialisation."""
 
+import math
+
+from formation_ros.core.frames import frame_from_pose, frame_to_pose
 from formation_ros.ros import messages
-from formation_ros.ros.cdr import CdrError, read_pose_array
+from formation_ros.ros.cdr import (CdrError, encode_clock, encode_odometry, encode_pose_stamped,
+                                   encode_twist_stamped, read_odometry, read_pose_array,
+                                   read_pose_stamped, read_twist_stamped)
 from formation_ros.ros.fields import points_of, stamp_to_ns
-from geometry_msgs.msg import Pose, PoseArray
+from geometry_msgs.msg import (Point, Pose, PoseArray, PoseStamped, Quaternion, TwistStamped,
+                               Vector3)
+from nav_msgs.msg import Odometry
 import numpy as np
 import pytest
 from rclpy.serialization import deserialize_message, serialize_message
+from rosgraph_msgs.msg import Clock
 
 
 @pytest.mark.parametrize('frame', ['', 'w', 'world', 'abc', 'world_frame_x', 'é'])
@@ -65,3 +73,96 @@ def test_big_endian_bytes_read_as_the_same_values():
     read = read_pose_array(data, max_poses=1)
     assert read.stamp_ns == 3_000_000_007 and read.frame_id == 'world'
     assert read.positions.tolist() == [values[:3]]
+
+
+def _vector(values):
+    return {'x': values[0], 'y': values[1], 'z': values[2]}
+
+
+@pytest.mark.parametrize('frame', ['', 'world', 'robot_12/base_link'])
+def test_pose_twist_and_odometry_readers_equal_rclpys(frame):
+    rng = np.random.default_rng(len(frame))
+    values = rng.normal(size=20) * 100.0
+    stamp = 1_234_567_890_123_456_789
+    pose = PoseStamped()
+    pose.header.stamp = messages.ns_to_stamp(stamp)
+    pose.header.frame_id = frame
+    pose.pose.position = Point(**_vector(values[:3]))
+    pose.pose.orientation = Quaternion(x=values[3], y=values[4], z=values[5], w=values[6])
+    read = read_pose_stamped(serialize_message(pose))
+    assert (read.stamp_ns, read.frame_id) == (stamp, frame)
+    assert read.position == tuple(values[:3]) and read.orientation == tuple(values[3:7])
+
+    twist = TwistStamped()
+    twist.header = pose.header
+    twist.twist.linear = Vector3(**_vector(values[7:10]))
+    twist.twist.angular = Vector3(**_vector(values[10:13]))
+    read_twist = read_twist_stamped(serialize_message(twist))
+    assert (read_twist.stamp_ns, read_twist.frame_id) == (stamp, frame)
+    assert read_twist.linear == tuple(values[7:10])
+    assert read_twist.angular == tuple(values[10:13])
+
+    odometry = Odometry()
+    odometry.header = pose.header
+    odometry.child_frame_id = frame + 'x'
+    odometry.pose.pose = pose.pose
+    odometry.pose.covariance = rng.normal(size=36)
+    odometry.twist.twist = twist.twist
+    odometry.twist.covariance = rng.normal(size=36)
+    read_odom = read_odometry(serialize_message(odometry))
+    assert (read_odom.stamp_ns, read_odom.frame_id, read_odom.child_frame_id) == (
+        stamp, frame, frame + 'x')
+    assert read_odom.position == tuple(values[:3])
+    assert read_odom.orientation == tuple(values[3:7])
+    assert read_odom.linear == tuple(values[7:10]) and read_odom.angular == tuple(values[10:13])
+
+
+@pytest.mark.parametrize('reader, message', [
+    (read_pose_stamped, messages.pose_stamped(np.array([1.0, 2.0]), 7, 2)),
+    (read_twist_stamped, messages.twist_stamped(np.array([1.0, 2.0]), 7, 2)),
+    (read_odometry, messages.reference_odometry(None, 7, 2))])
+def test_every_cut_of_a_message_is_a_cdr_error(reader, message):
+    data = serialize_message(message)
+    reader(data)
+    for end in range(len(data)):
+        with pytest.raises(CdrError):
+            reader(data[:end])
+    with pytest.raises(CdrError, match='encapsulation'):
+        reader(b'\x05\x05' + data[2:])
+
+
+def test_finite_tells_non_finite_values_and_a_zero_quaternion():
+    good = read_odometry(serialize_message(messages.reference_odometry(None, 7, 2)))
+    assert good.finite
+    message = messages.reference_odometry(None, 7, 2)
+    message.twist.twist.angular.z = math.inf
+    assert not read_odometry(serialize_message(message)).finite
+    message = messages.reference_odometry(None, 7, 2)
+    message.pose.pose.orientation.w = 0.0
+    assert not read_odometry(serialize_message(message)).finite
+    pose = messages.pose_stamped(np.array([math.nan, 0.0]), 7, 2)
+    assert not read_pose_stamped(serialize_message(pose)).finite
+
+
+@pytest.mark.parametrize('stamp', [0, 999_999_999, 1_000_000_000, 1_700_000_123_456_789])
+def test_written_messages_are_what_rclpy_writes_and_reads(stamp):
+    rng = np.random.default_rng(stamp % 1000)
+    u, w = rng.normal(size=3), rng.normal(size=3)
+    cases = [
+        (encode_pose_stamped(stamp, 'world', u[:2]), messages.pose_stamped(u, stamp, 2)),
+        (encode_twist_stamped(stamp, 'world', u[:2]), messages.twist_stamped(u, stamp, 2)),
+        (encode_clock(stamp), Clock(clock=messages.ns_to_stamp(stamp)))]
+    quaternion = rng.normal(size=4)
+    frame = frame_from_pose(stamp / 1e9, rng.normal(size=3), quaternion / np.linalg.norm(
+        quaternion), rng.normal(size=3), rng.normal(size=3), 3)
+    odometry = messages.reference_odometry(frame, stamp, 3)
+    position, quaternion, linear, angular = frame_to_pose(frame, 3)
+    cases.append((encode_odometry(stamp, 'world', 'formation', position, quaternion, linear,
+                                  angular), odometry))
+    twist = messages.twist_stamped(u, stamp, 3)
+    twist.twist.angular = Vector3(**_vector(w))
+    cases.append((encode_twist_stamped(stamp, 'world', u, w), twist))
+    for data, message in cases:
+        expected = serialize_message(message)
+        assert isinstance(data, bytes) and len(data) == len(expected)
+        assert deserialize_message(data, type(message)) == message
