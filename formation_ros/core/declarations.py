@@ -80,6 +80,13 @@ class BodyKind(Choice):
     UNICYCLE = 'unicycle'
 
 
+class PoseType(Choice):
+    """The message a robot reads its own pose from: ``pose_type``."""
+
+    POSE_STAMPED = 'pose_stamped'
+    ODOMETRY = 'odometry'
+
+
 class ReferenceKind(Choice):
     """Desired formation trajectory: ``reference.kind``."""
 
@@ -247,6 +254,11 @@ DECLARATIONS = (
     Param('input_timeout', Kind.DOUBLE, 0.5,
           'A robot publishes zero when no new pose, neighbours or reference arrived for this '
           'long, s (wall clock; not in lockstep).', low=above(0.0), users=ROBOT),
+    Param('pose_type', Kind.STRING, PoseType.POSE_STAMPED.value,
+          "Message type of a robot's 'pose' topic: 'pose_stamped' (geometry_msgs/PoseStamped, "
+          "what the plant publishes) or 'odometry' (nav_msgs/Odometry, e.g. a real base's "
+          'localisation, remapped onto pose).', choices=_choices(PoseType),
+          users=frozenset({Exe.ROBOT})),
     Param('wait_for_subscribers', Kind.INT, 1,
           'A robot sends its first command only once cmd_vel has this many subscribers (the '
           'plant; 2 when a recorder listens too).', low=at_least(0), high=at_least(1000),

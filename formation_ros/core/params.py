@@ -19,7 +19,7 @@ from typing import Any, Dict, List, Mapping, Optional, Tuple, Union
 
 from formation_ros.core.bodies import BodySettings, POINT_BODY, random_headings
 from formation_ros.core.declarations import (BodyKind, check_values, Exe, JumpKind, ParamError,
-                                             PsiKind, ReferenceKind)
+                                             PoseType, PsiKind, ReferenceKind)
 from formation_ros.core.law import LawParams, make_law, PSI_FUNCTIONS
 from formation_ros.core.params_file import load_params_file, PathText
 from formation_ros.core.plant import NS_PER_S, start_positions, StartSpec
@@ -72,6 +72,7 @@ class RobotSettings:
     control_rate: float
     input_timeout: float
     wait_for_subscribers: int
+    pose_type: PoseType = PoseType.POSE_STAMPED
 
 
 @dataclass(frozen=True)
@@ -243,7 +244,7 @@ def _up(value: float) -> float:
     return math.ceil(value / scale) * scale
 
 
-def _body(values: Mapping[str, Any], dim: int, exe: Exe, problems: Problems) -> BodySettings:
+def _body(values: Mapping[str, Any], dim: int, problems: Problems) -> BodySettings:
     """Check ``body.*`` and build the :class:`BodySettings` (docs/equations.md, U5)."""
     kind = BodyKind(values['body.kind'])
     l_value = values.get('body.hand_distance')
@@ -256,9 +257,6 @@ def _body(values: Mapping[str, Any], dim: int, exe: Exe, problems: Problems) -> 
     if dim != 2:
         problems.append(('body.kind', f'unicycle needs dim 2 (a differential-drive robot moves '
                                       f'in the plane), got dim {dim}'))
-    if exe in (Exe.PLANT, Exe.ROBOT):
-        problems.append(('body.kind', 'unicycle bodies run in formation_sim only so far: the '
-                                      'plant and robot nodes do not drive them yet'))
     if values.get('plant.max_speed', 0.0) > 0.0:
         problems.append(('plant.max_speed', 'is for point bodies; give unicycles '
                                             'body.max_linear and body.max_angular'))
@@ -344,7 +342,8 @@ def _own_settings(values: Mapping[str, Any], exe: Exe, n: int,
         return {'robot': RobotSettings(
             robot_id=values['robot_id'], control_rate=values['control_rate'],
             input_timeout=values['input_timeout'],
-            wait_for_subscribers=values['wait_for_subscribers'])}
+            wait_for_subscribers=values['wait_for_subscribers'],
+            pose_type=PoseType(values['pose_type']))}
     if exe is Exe.REFERENCE:
         return {'reference_node': ReferenceSettings(rate=values['reference.rate'])}
     if exe is Exe.RECORD:
@@ -381,7 +380,7 @@ def validate(raw: Mapping[str, Any], executable: Union[Exe, str] = Exe.SIM) -> F
     origin = _vector(values, 'reference.origin', dim, problems)
     velocity = _vector(values, 'reference.velocity', dim, problems)
     own = _own_settings(values, exe, n, problems)
-    body = _body(values, dim, exe, problems)
+    body = _body(values, dim, problems)
     headings = _headings(values, body, n, problems) if start is not None else None
     if start is not None and not problems:
         _body_geometry(body, start, headings, problems)

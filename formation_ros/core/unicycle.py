@@ -120,3 +120,23 @@ def wrap_angle(angle: ArrayLike) -> Float:
     """Angles wrapped into [-pi, pi), same shape."""
     return np.asarray((np.asarray(angle, dtype=float) + math.pi) % (2.0 * math.pi) - math.pi,
                       dtype=float)
+
+
+def quaternions_from_headings(heading: ArrayLike) -> Float:
+    """Return unit quaternions (x, y, z, w) of rotations by th about +z: (..., 4)."""
+    half = 0.5 * np.asarray(heading, dtype=float)
+    zeros = np.zeros_like(half)
+    return np.stack((zeros, zeros, np.sin(half), np.cos(half)), axis=-1)
+
+
+def headings_from_quaternions(quaternion: ArrayLike) -> Float:
+    """
+    Yaw th in (-pi, pi] of orientations given as quaternions (x, y, z, w): (...).
+
+    ``th = atan2(2 (w z + x y), 1 - 2 (y^2 + z^2))``, the rotation about +z of the body's x
+    axis projected onto the plane; the quaternion need not be normalised (it is scaled out).
+    """
+    x, y, z, w = np.moveaxis(np.asarray(quaternion, dtype=float), -1, 0)
+    norm = x * x + y * y + z * z + w * w
+    return np.asarray(np.arctan2(2.0 * (w * z + x * y), norm - 2.0 * (y * y + z * z)),
+                      dtype=float)

@@ -6,8 +6,9 @@
 import math
 
 from formation_ros.core.unicycle import (axle_positions, command_bounds, hand_points,
-                                         hand_velocity, unicycle_commands, unicycle_rates,
-                                         wrap_angle, zoh_step)
+                                         hand_velocity, headings_from_quaternions,
+                                         quaternions_from_headings, unicycle_commands,
+                                         unicycle_rates, wrap_angle, zoh_step)
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -143,3 +144,18 @@ def test_wrap_angle():
                                                 -7.0]))
     assert np.allclose(np.sin(wrapped), np.sin([0.0, math.pi, -math.pi, 3 * math.pi + 0.1,
                                                 -7.0]))
+
+
+def test_quaternions_and_headings_round_trip_and_match_scipy():
+    from scipy.spatial.transform import Rotation
+    th = RNG.uniform(-math.pi, math.pi, 100)
+    quaternions = quaternions_from_headings(th)
+    assert np.allclose(Rotation.from_quat(quaternions).as_euler('ZYX')[:, 0], th, atol=1e-14)
+    assert np.allclose(headings_from_quaternions(quaternions), th, atol=1e-14)
+    assert np.allclose(headings_from_quaternions(3.0 * quaternions), th, atol=1e-14)
+    tilted = Rotation.from_euler('ZYX', np.column_stack([th, 0.1 * th, -0.05 * th]))
+    assert np.allclose(headings_from_quaternions(tilted.as_quat()), th, atol=1e-12)
+    assert headings_from_quaternions([0.0, 0.0, 0.0, 1.0]) == 0.0
+    one = quaternions_from_headings(th[0])
+    assert np.array_equal(one, quaternions[0]) and headings_from_quaternions(one) == \
+        headings_from_quaternions(quaternions)[0]
