@@ -170,3 +170,23 @@ def test_random_headings_are_uniform_and_seeded():
     assert np.all((headings >= -math.pi) & (headings < math.pi))
     counts, _ = np.histogram(headings, bins=8, range=(-math.pi, math.pi))
     assert np.all(np.abs(counts - 2500) < 250)
+
+
+def test_chunks_keep_the_body_arrays(tmp_path):
+    from formation_ros.core.trajectory import ChunkWriter, read_body_chunks, read_chunks
+    writer = ChunkWriter(str(tmp_path / 'chunks'))
+    for k in range(5):
+        writer.append(0.1 * k, np.full((3, 2), k), np.ones((3, 2)), heading=np.full(3, 0.5 * k),
+                      q_body=np.full((3, 2), -k), body_command=np.full((3, 2), 2.0 * k))
+        if k == 2:
+            writer.flush()
+    writer.flush()
+    t, q, u = read_chunks(writer.folder)
+    body = read_body_chunks(writer.folder)
+    assert t.tolist() == pytest.approx([0.0, 0.1, 0.2, 0.3, 0.4]) and q.shape == (5, 3, 2)
+    assert body['heading'][:, 0].tolist() == [0.0, 0.5, 1.0, 1.5, 2.0]
+    assert body['q_body'].shape == (5, 3, 2) and body['body_command'][4, 0, 0] == 8.0
+    points = ChunkWriter(str(tmp_path / 'points'))
+    points.append(0.0, np.zeros((3, 2)), np.zeros((3, 2)))
+    points.flush()
+    assert read_body_chunks(points.folder) is None

@@ -169,3 +169,44 @@ def test_unicycle_robot_takes_odometry_and_answers_in_its_body_frame(processes, 
                          hand_points(others[1:2], their_headings[1:2], l_value),
                          config.sensing_radii[0], config.law()).u
     assert np.any(near != u)
+
+
+def test_plant_moves_a_unicycle_by_body_frame_commands_and_drops_world_frame_ones(
+        processes, install, probe, tmp_path):
+    params = four_unicycles(tmp_path)
+    config = load_config(params)
+    out = tmp_path / 'plant'
+    processes.start(node(install, 'plant', params, '-p', 'plant.wait_for_robots:=false',
+                         '-p', f'plant.output_dir:={out}'))
+    pubs = {i: probe.create_publisher(TwistStamped, f'/robot_{i}/cmd_vel', qos.COMMAND)
+            for i in (1, 2)}
+    stamps = []
+    probe.create_subscription(PoseStamped, '/robot_1/pose',
+                              lambda m: stamps.append(fields.stamp_to_ns(m.header.stamp)),
+                              qos.STATE)
+
+    def send():
+        stamp = stamps[-1] if stamps else 0
+        for i, frame in ((1, 'robot_1/base_link'), (2, messages.WORLD_FRAME)):
+            message = TwistStamped()
+            message.header.stamp = messages.ns_to_stamp(stamp)
+            message.header.frame_id = frame
+            message.twist.linear.x, message.twist.angular.z = 0.1, 0.5
+            pubs[i].publish(message)
+        return len(stamps) > 60
+
+    assert probe.spin_until(send, 60), processes.log('plant')
+    [info] = processes.stop(['plant'])
+    assert info.returncode == 0, processes.log('plant')
+    stats = json.loads((out / 'plant_stats.json').read_text())
+    assert stats['wrong_frame_command_messages']['2'] > 0
+    assert '1' not in stats['wrong_frame_command_messages']
+    trajectory = Trajectory.load(str(out / 'trajectory.npz'))
+    moved = trajectory.body_command[:, 0]
+    assert np.all((moved == [0.1, 0.5]) | (moved == 0.0)) and np.any(moved[:, 0] == 0.1)
+    assert np.all(trajectory.body_command[:, 1] == 0.0)
+    assert np.ptp(trajectory.q_body[:, 1], axis=0).max() == 0.0
+    turned = trajectory.heading[-1, 0] - config.start_headings[0]
+    assert turned > 0.05
+    log = processes.log('plant')
+    assert log.count("ignoring cmd_vel in frame 'world'") == 1 and 'Traceback' not in log
