@@ -29,7 +29,6 @@ from typing import Optional, overload
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.spatial.transform import Rotation
 
 STATIONARY = None
 SPEED_EPS = 1e-12
@@ -203,15 +202,56 @@ def _rotation_and_angular_velocity(
 
 
 def quaternion_from_matrix(rotation: ArrayLike) -> NDArray[np.float64]:
-    """Return the unit quaternion (x, y, z, w), w >= 0, of a 3x3 rotation matrix."""
-    quat: NDArray[np.float64] = Rotation.from_matrix(np.asarray(rotation, dtype=float)).as_quat()
-    return quat if quat[3] >= 0.0 else -quat
+    """
+    Return the unit quaternion (x, y, z, w), w >= 0, of a 3x3 rotation matrix.
+
+    Computed from the largest of 1 + trace and the three 1 + 2 R_kk - trace (Shepperd's choice),
+    so no division is by a small number; the result is normalised.
+    """
+    r = np.asarray(rotation, dtype=float)
+    trace = r[0, 0] + r[1, 1] + r[2, 2]
+    candidates = (1.0 + trace, 1.0 + 2.0 * r[0, 0] - trace, 1.0 + 2.0 * r[1, 1] - trace,
+                  1.0 + 2.0 * r[2, 2] - trace)
+    k = int(np.argmax(candidates))
+    root = 2.0 * np.sqrt(candidates[k])
+    if k == 0:
+        quat = np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1], 0.0]) / root
+        quat[3] = 0.25 * root
+    else:
+        i, j, m = k - 1, k % 3, (k + 1) % 3
+        quat = np.empty(4)
+        quat[i] = 0.25 * root
+        quat[j] = (r[j, i] + r[i, j]) / root
+        quat[m] = (r[m, i] + r[i, m]) / root
+        quat[3] = (r[m, j] - r[j, m]) / root
+    unit: NDArray[np.float64] = quat / np.linalg.norm(quat)
+    return unit if unit[3] >= 0.0 else -unit
 
 
 def matrix_from_quaternion(quat: ArrayLike) -> NDArray[np.float64]:
     """Return the rotation matrix (3, 3) of a quaternion (x, y, z, w) != 0, normalised first."""
-    matrix: NDArray[np.float64] = Rotation.from_quat(np.asarray(quat, dtype=float)).as_matrix()
-    return matrix
+    x, y, z, w = np.asarray(quat, dtype=float) / np.linalg.norm(quat)
+    return np.array([
+        [1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w)],
+        [2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w)],
+        [2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)]])
+
+
+def rotation_of_vector(rotvec: ArrayLike) -> NDArray[np.float64]:
+    """
+    Return the rotation matrix (3, 3) of a rotation vector (axis times angle in rad; Rodrigues).
+
+    Near zero angle the coefficients sin(a)/a and (1 - cos(a))/a**2 are taken from their series.
+    """
+    v = np.asarray(rotvec, dtype=float)
+    angle = float(np.linalg.norm(v))
+    k = skew(v)
+    if angle < 1e-4:
+        a2 = angle * angle
+        first, second = 1.0 - a2 / 6.0 + a2 * a2 / 120.0, 0.5 - a2 / 24.0 + a2 * a2 / 720.0
+    else:
+        first, second = np.sin(angle) / angle, (1.0 - np.cos(angle)) / (angle * angle)
+    return np.eye(3) + first * k + second * (k @ k)
 
 
 def frame_to_pose(frame: Optional[FrameSample], dim: int) -> Pose:
@@ -266,7 +306,7 @@ def advance(frame: Optional[FrameSample], dt: float) -> Optional[FrameSample]:
         return frame
     dim = frame.q_od.shape[0]
     jmat, omega = _rotation_and_angular_velocity(frame)
-    moved = jmat @ Rotation.from_rotvec(-omega * dt).as_matrix()
+    moved = jmat @ rotation_of_vector(-omega * dt)
     moved_dot = -moved @ skew(omega)
     return FrameSample(frame.t + dt, frame.q_od + frame.qdot_od * dt, frame.qdot_od.copy(),
                        moved[:dim, :dim].copy(), moved_dot[:dim, :dim].copy())

@@ -29,7 +29,6 @@ from typing import Optional, Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy import special
 
 JUMP_KINDS = ('poly', 'smooth')
 
@@ -76,7 +75,7 @@ class PolyJump:
         self._binomials = np.array([math.comb(n, j) for j in range(p + 1, n + 1)], dtype=float)
         self._t_powers = np.arange(0, p + 1)
         self._one_minus_t_powers = n - np.arange(p + 1, n + 1)
-        self._inv_beta = 1.0 / special.beta(p + 1, p + 1)
+        self._inv_beta = math.factorial(n) / math.factorial(p) ** 2  # 1 / B(p + 1, p + 1)
 
     def __repr__(self) -> str:
         """Return a short description."""

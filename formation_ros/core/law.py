@@ -16,14 +16,16 @@ use it, so they agree to rounding.
 
 from dataclasses import dataclass
 import math
-from typing import Callable, Optional
+from typing import Callable, Optional, TYPE_CHECKING
 
 from formation_ros.core.frames import (FrameSample, from_frame_velocity, STATIONARY, to_frame,
                                        to_frame_vectors)
 from formation_ros.core.jump import JumpFunction, make_jump
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.spatial import cKDTree
+
+if TYPE_CHECKING:
+    from scipy.spatial import cKDTree
 
 MAX_REPULSION = 1e200
 GAIN_MAX = 1e6
@@ -172,14 +174,16 @@ def robot_command(q_i: ArrayLike, vertex_i: ArrayLike, neighbours: ArrayLike,
 
 
 def neighbour_pairs(q: ArrayLike, radius: float,
-                    tree: Optional[cKDTree] = None) -> NDArray[np.intp]:
+                    tree: Optional['cKDTree'] = None) -> NDArray[np.intp]:
     """
     Pairs (i, j), i < j, with ||q_i - q_j|| <= radius, from a k-d tree: (P, 2) int array.
 
     tree: a k-d tree of ``q`` already built (the plant model keeps one per step), else one is
-    built here.
+    built here (scipy.spatial is imported then: a robot, which never calls this, does not load
+    it).
     """
     if tree is None:
+        from scipy.spatial import cKDTree
         tree = cKDTree(np.asarray(q, dtype=float))
     pairs: NDArray[np.intp] = tree.query_pairs(r=radius, output_type='ndarray').reshape(-1, 2)
     return pairs
@@ -187,7 +191,7 @@ def neighbour_pairs(q: ArrayLike, radius: float,
 
 def team_command(q: ArrayLike, vertices: ArrayLike, sensing_radii: ArrayLike, law: LawParams,
                  frame: Optional[FrameSample] = STATIONARY,
-                 tree: Optional[cKDTree] = None) -> Command:
+                 tree: Optional['cKDTree'] = None) -> Command:
     """
     Control of every robot at once (the vectorised form of :func:`robot_command`).
 

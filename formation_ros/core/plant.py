@@ -38,7 +38,7 @@ for points, (N, 2) holding (v, w) in m/s and rad/s for unicycles.
 from collections import OrderedDict
 from dataclasses import dataclass, field
 import enum
-from typing import Dict, List, Optional, Set, Tuple
+from typing import Dict, List, Optional, Set, Tuple, TYPE_CHECKING
 
 from formation_ros.core.bodies import Bodies, PointBodies
 from formation_ros.core.frames import from_frame_velocity, to_frame_velocity
@@ -46,7 +46,9 @@ from formation_ros.core.law import LawParams
 from formation_ros.core.reference import Reference
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.spatial import cKDTree
+
+if TYPE_CHECKING:
+    from scipy.spatial import cKDTree
 
 NS_PER_S = 1_000_000_000
 BOUND_TOLERANCE_FIXED = 1e-9
@@ -114,6 +116,13 @@ class Admission:
     u: NDArray[np.float64]
     status: NDArray[np.int8]
     largest_u_hat: NDArray[np.float64]
+
+    @property
+    def counted(self) -> NDArray[np.bool_]:
+        """(N,) whether each robot's command counted for the step (applied or saturated)."""
+        counted: NDArray[np.bool_] = ((self.status == CommandStatus.APPLIED)
+                                      | (self.status == CommandStatus.SATURATED))
+        return counted
 
 
 @dataclass(frozen=True)
@@ -271,7 +280,7 @@ def start_positions(spec: StartSpec) -> Optional[NDArray[np.float64]]:
                         spec.seed)
 
 
-def sensed_pairs(tree: cKDTree, q: NDArray[np.float64],
+def sensed_pairs(tree: 'cKDTree', q: NDArray[np.float64],
                  radii: NDArray[np.float64]) -> Tuple[NDArray[np.intp], NDArray[np.intp]]:
     """
     Who senses whom: arrays (observer, seen) of every ordered pair with ||q_o - q_s|| < R_o.
@@ -329,6 +338,8 @@ class PlantModel:
         self.bound_tolerance = (BOUND_TOLERANCE_FIXED if reference.is_stationary
                                 else BOUND_TOLERANCE_MOVING)
         self.t_ns = 0
+        from scipy.spatial import cKDTree  # here: a robot imports this module, not the tree
+        self._tree_type = cKDTree
         self._moved()
         self.counts = PlantCounts(status_steps=np.zeros((len(CommandStatus), self.num_robots),
                                                         dtype=np.int64))
@@ -336,13 +347,14 @@ class PlantModel:
         self._headings: 'OrderedDict[int, NDArray[np.float64]]' = OrderedDict([(0, self.heading)])
         self._states_kept = min(MAX_STATES_KEPT, 2 + self.input_timeout_ns // self.step_ns)
         self._audited = np.full(self.num_robots, -1, dtype=np.int64)
+        self._robots = np.arange(self.num_robots)
         self._colliding = self._close_pairs()
 
     def _moved(self) -> None:
         """Update the control points and the k-d trees after the bodies moved."""
         self.points = self.body.control_points(self.q, self.heading)
-        self.tree = cKDTree(self.points)
-        self.body_tree = self.tree if self.points is self.q else cKDTree(self.q)
+        self.tree = self._tree_type(self.points)
+        self.body_tree = self.tree if self.points is self.q else self._tree_type(self.q)
 
     @property
     def t(self) -> float:
@@ -445,7 +457,8 @@ class PlantModel:
     def advance(self, commands: Commands) -> StepReport:
         """Admit the commands, audit the bound, step the bodies over dt, check collisions."""
         admission = self.admit(commands)
-        violations = self._audit(commands, admission)
+        counted = admission.counted
+        violations = self._audit(commands, admission, counted)
         t_ns, q, points, heading = self.t_ns, self.q, self.points, self.heading
         self.q, self.heading = self.body.step(q, heading, admission.u, self.dt)
         self.t_ns += self.step_ns
@@ -457,9 +470,8 @@ class PlantModel:
             self._headings.popitem(last=False)
         counts = self.counts
         counts.steps += 1
-        np.add.at(counts.status_steps, (admission.status, np.arange(self.num_robots)), 1)
+        counts.status_steps[admission.status, self._robots] += 1
         counts.bound_violations += len(violations)
-        counted = np.isin(admission.status, (CommandStatus.APPLIED, CommandStatus.SATURATED))
         oldest = int(np.max(t_ns - commands.stamp_ns[counted])) if np.any(counted) else 0
         counts.oldest_counted_ns = max(counts.oldest_counted_ns, oldest)
         age_bin = min(-(-oldest // self.step_ns), AGE_BINS) if np.all(counted) else AGE_BINS
@@ -508,9 +520,9 @@ class PlantModel:
         self._colliding = pairs
         return [(i, j, float(np.linalg.norm(self.q[i] - self.q[j]))) for i, j in new]
 
-    def _audit(self, commands: Commands, admission: Admission) -> List[Tuple[int, float]]:
+    def _audit(self, commands: Commands, admission: Admission,
+               counted: NDArray[np.bool_]) -> List[Tuple[int, float]]:
         """Return (robot, largest |u_hat| component) of new commands above c M1 (once each)."""
-        counted = np.isin(admission.status, (CommandStatus.APPLIED, CommandStatus.SATURATED))
         fresh = counted & (commands.stamp_ns != self._audited)
         self._audited[fresh] = commands.stamp_ns[fresh]
         over = np.flatnonzero(fresh & (admission.largest_u_hat - self.law.u_bound

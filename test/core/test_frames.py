@@ -7,7 +7,8 @@ import math
 
 from formation_ros.core.frames import (advance, desired_positions, frame_from_pose,
                                        frame_to_pose, from_frame_velocity,
-                                       matrix_from_quaternion, quaternion_from_matrix, to_frame)
+                                       matrix_from_quaternion, quaternion_from_matrix,
+                                       rotation_of_vector, to_frame)
 from formation_ros.core.reference import GERONO_LOOP_LENGTH, Reference
 import numpy as np
 import pytest
@@ -282,3 +283,14 @@ def test_advance_figure_eight_first_order_in_dt(dim):
     for coarse, fine in zip(errors, errors[1:]):
         for k in range(2):
             assert coarse[k] / fine[k] == pytest.approx(4.0, rel=0.1)
+
+
+def test_rotation_of_a_vector_matches_axis_angle_down_to_tiny_angles():
+    cases = rotation_cases() + [(np.array([0.0, 0.6, 0.8]), a) for a in (1e-3, 1e-5, 1e-9)]
+    for axis, angle in cases:
+        rotvec = axis * angle
+        before = rotvec.copy()
+        assert np.allclose(rotation_of_vector(rotvec), axis_angle_matrix(axis, angle),
+                           atol=1e-14), (axis, angle)
+        assert np.array_equal(rotvec, before)
+    assert np.array_equal(rotation_of_vector(np.zeros(3)), np.eye(3))
