@@ -20,6 +20,7 @@ from typing import Any, Dict, List, Mapping, Optional, Tuple, Union
 from formation_ros.core.bodies import BodySettings, POINT_BODY, random_headings
 from formation_ros.core.declarations import (BodyKind, check_values, Exe, JumpKind, ParamError,
                                              PoseType, PsiKind, ReferenceKind)
+from formation_ros.core.frames import desired_positions, from_frame_velocity
 from formation_ros.core.law import LawParams, make_law, PSI_FUNCTIONS
 from formation_ros.core.params_file import load_params_file, PathText
 from formation_ros.core.plant import NS_PER_S, start_positions, StartSpec
@@ -29,6 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 Problems = List[Tuple[str, str]]
+TRACKING_SAMPLES = 721
 HAND_POINTS_APART = 1e-9
 """Hand points closer than this at the start (m) are one point: the law has no direction."""
 
@@ -285,6 +287,33 @@ def _body(values: Mapping[str, Any], dim: int, problems: Problems) -> BodySettin
                         max_linear=max_linear, max_angular=max_angular)
 
 
+def _tracking_problems(body: BodySettings, vertices: NDArray[np.float64],
+                       reference: Reference, duration: float, problems: Problems) -> None:
+    """
+    Refuse a moving formation whose vertices need more speed than ``body.max_linear``.
+
+    At the formation each hand point moves with its vertex, at the feed-forward of eq. (25)
+    (``from_frame_velocity`` with u_hat = 0); |v| is at least that speed, so no gain can make a
+    unicycle slower than its vertex. Sampled at 721 times over the run.
+    """
+    if body.max_linear is None or reference.is_stationary:
+        return
+    fastest = 0.0
+    for t in np.linspace(0.0, duration, TRACKING_SAMPLES):
+        frame = reference.sample(float(t))
+        speeds = np.linalg.norm(from_frame_velocity(np.zeros_like(vertices),
+                                                    desired_positions(vertices, frame), frame),
+                                axis=1)
+        fastest = max(fastest, float(np.max(speeds)))
+    if fastest > body.max_linear:
+        problems.append(('body.max_linear', f'the formation moves its vertices at up to '
+                                            f'{fastest:.4g} m/s along this reference, more '
+                                            f'than body.max_linear = {body.max_linear:g} m/s: '
+                                            'a reference '
+                                            f'{_up(fastest / body.max_linear):g} times slower '
+                                            '(or vertices nearer its path) would fit'))
+
+
 def _headings(values: Mapping[str, Any], body: BodySettings, n: int,
               problems: Problems) -> Optional[NDArray[np.float64]]:
     """Start headings of unicycles: given, random with a random start, else 0."""
@@ -384,6 +413,10 @@ def validate(raw: Mapping[str, Any], executable: Union[Exe, str] = Exe.SIM) -> F
     headings = _headings(values, body, n, problems) if start is not None else None
     if start is not None and not problems:
         _body_geometry(body, start, headings, problems)
+    if body.is_unicycle and vertices is not None and not problems:
+        _tracking_problems(body, vertices, Reference(
+            values['reference.kind'], dim, origin, velocity, values['reference.radius'],
+            values['reference.speed'], values['reference.pitch']), values['duration'], problems)
     if problems or vertices is None:
         raise ParamError(problems)
     return FormationConfig(

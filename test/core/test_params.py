@@ -264,3 +264,24 @@ def test_hand_points_that_coincide_at_the_start_are_refused():
     with pytest.raises(ParamError, match='robots 1 and 2 start with their hand points at the '
                                          'same point'):
         validate(raw)
+
+
+def test_a_formation_moving_faster_than_the_robots_can_is_refused():
+    circle = load_params_file(os.path.join(CONFIG_DIR, 'unicycle_circle_2d.yaml'))
+    assert validate(circle).reference_kind == 'circle'
+    circle['reference.speed'] = 0.25
+    with pytest.raises(ParamError) as info:
+        validate(circle)
+    text = str(info.value)
+    vertices = np.array(circle['formation.vertices']).reshape(-1, 2)
+    fastest = 0.25 / 4.0 * np.max(np.hypot(vertices[:, 0], 4.0 + np.abs(vertices[:, 1])))
+    assert f"'body.max_linear': the formation moves its vertices at up to {fastest:.4g} m/s" \
+        in text
+    factor = math.ceil(fastest / 0.22 * 1000) / 1000
+    assert f'a reference {factor:g} times slower (or vertices nearer its path) would fit' in text
+    circle['reference.speed'] = 0.25 / factor
+    validate(circle)
+    line = load_params_file(os.path.join(CONFIG_DIR, 'unicycle_2d.yaml'))
+    line.update({'reference.kind': 'line', 'reference.velocity': [0.3, 0.0]})
+    with pytest.raises(ParamError, match='up to 0.3 m/s'):
+        validate(line)
