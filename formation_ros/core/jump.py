@@ -71,10 +71,8 @@ class PolyJump:
         self.order = int(order)
         p = self.order
         n = 2 * p + 1
-        # S(t) = sum_{j=p+1}^{n} C(n, j) t^(j-p-1) (1-t)^(n-j), so that h = t^(p+1) S(t).
-        self._binomials = np.array([math.comb(n, j) for j in range(p + 1, n + 1)], dtype=float)
-        self._t_powers = np.arange(0, p + 1)
-        self._one_minus_t_powers = n - np.arange(p + 1, n + 1)
+        # S(t) = sum_{k=0}^{p} C(n, p+1+k) t^k (1-t)^(p-k), so that h = t^(p+1) S(t).
+        self._binomials = [float(math.comb(n, p + 1 + k)) for k in range(p + 1)]
         self._inv_beta = math.factorial(n) / math.factorial(p) ** 2  # 1 / B(p + 1, p + 1)
 
     def __repr__(self) -> str:
@@ -82,9 +80,18 @@ class PolyJump:
         return f'PolyJump(order={self.order})'
 
     def _sum_s(self, t: NDArray[np.float64]) -> NDArray[np.float64]:
-        t = t[..., None]
-        total: NDArray[np.float64] = np.sum(
-            self._binomials * t ** self._t_powers * (1.0 - t) ** self._one_minus_t_powers, axis=-1)
+        """
+        S(t) by Horner's rule in t and 1 - t, t in [0, 1]: p steps of sums of positive terms.
+
+        total_k = total_{k+1} t + C(n, p+1+k) (1-t)^(p-k), from k = p - 1 down to 0.
+        """
+        s = 1.0 - t
+        s_power = s
+        total: NDArray[np.float64] = np.full_like(t, self._binomials[-1])
+        for k in range(self.order - 1, -1, -1):
+            total = total * t + self._binomials[k] * s_power
+            if k:
+                s_power = s_power * s
         return total
 
     def h(self, x: ArrayLike, a: float, b: float) -> NDArray[np.float64]:

@@ -55,6 +55,9 @@ BOUND_TOLERANCE_FIXED = 1e-9
 BOUND_TOLERANCE_MOVING = 1e-3
 MAX_STATES_KEPT = 512
 MAX_START_TRIES = 20000
+GRID_FROM = 64
+"""A random start compares a candidate with every point placed while there are fewer than this
+many, with the points of the neighbouring grid cells after."""
 PLANT_STATS_FILE = 'plant_stats.json'
 AGE_BINS = 64
 """Command ages counted step by step in :attr:`PlantCounts.age_steps` (one more bin: none)."""
@@ -251,10 +254,23 @@ def random_start(n: int, dim: int, radius: float, min_separation: float,
     """
     Uniform random positions in the disc/ball of ``radius`` about 0, pairwise >= separation.
 
-    Returns (n, dim), or None when the points do not fit after many tries.
+    Returns (n, dim), or None when the points do not fit after many tries, or at once when
+    they cannot fit at all (n balls of radius ``min_separation / 2`` about them would not fit,
+    by volume, in the ball of radius ``radius + min_separation / 2``). Candidates are drawn
+    one by one and kept when no point placed so far is closer than ``min_separation``; the
+    placed points are kept in a grid of cells ``min_separation`` wide, so once there are
+    :data:`GRID_FROM` or more a candidate is compared with the points of its own and the
+    neighbouring cells only (the same decisions as comparing it with every point, in O(1)
+    instead of O(n)).
     """
+    if n * (0.5 * min_separation) ** dim > (radius + 0.5 * min_separation) ** dim:
+        return None
     rng = np.random.default_rng(seed)
     placed = np.empty((n, dim))
+    separation_sq = min_separation ** 2
+    cell = min_separation if min_separation > 0.0 else 1.0
+    grid: Dict[Tuple[int, ...], List[int]] = {}
+    offsets = np.array(list(np.ndindex(*(3,) * dim))) - 1
     count = 0
     tries = 0
     while count < n:
@@ -264,10 +280,18 @@ def random_start(n: int, dim: int, radius: float, min_separation: float,
         direction = rng.normal(size=dim)
         direction /= np.linalg.norm(direction)
         candidate = direction * radius * rng.random() ** (1.0 / dim)
-        if count and np.min(np.sum((placed[:count] - candidate) ** 2, axis=1)) \
-                < min_separation ** 2:
+        cells = (candidate // cell).astype(np.int64) if count >= GRID_FROM else None
+        if cells is None:
+            others = placed[:count]
+        else:
+            others = placed[[index for key in map(tuple, (cells + offsets).tolist())
+                             for index in grid.get(key, ())]]
+        if len(others) and np.min(np.sum((others - candidate) ** 2, axis=1)) < separation_sq:
             continue
         placed[count] = candidate
+        if cells is None:
+            cells = (candidate // cell).astype(np.int64)
+        grid.setdefault(tuple(cells.tolist()), []).append(count)
         count += 1
     return placed
 

@@ -183,3 +183,24 @@ def test_duration_histogram_percentiles_against_numpy():
     assert histogram.percentile_ns(100) == values.max()
     histogram.add([-5, 0])
     assert histogram.bins[0] >= 2
+
+
+def brute_force_start(n, dim, radius, separation, seed):
+    """Draw the random start the same way, comparing each candidate with every point placed."""
+    rng = np.random.default_rng(seed)
+    placed = []
+    while len(placed) < n:
+        direction = rng.normal(size=dim)
+        direction /= np.linalg.norm(direction)
+        candidate = direction * radius * rng.random() ** (1.0 / dim)
+        if all(np.sum((p - candidate) ** 2) >= separation ** 2 for p in placed):
+            placed.append(candidate)
+    return np.array(placed)
+
+
+@pytest.mark.parametrize('n, dim, radius, separation, seed', [
+    (40, 2, 1.0, 0.1, 0), (200, 2, 2.5, 0.2, 7), (60, 3, 1.0, 0.15, 3), (25, 2, 3.0, 0.0, 1)])
+def test_random_start_with_its_grid_equals_comparing_with_every_point(n, dim, radius,
+                                                                      separation, seed):
+    assert np.array_equal(random_start(n, dim, radius, separation, seed),
+                          brute_force_start(n, dim, radius, separation, seed))
