@@ -17,6 +17,7 @@ from geometry_msgs.msg import Pose, PoseArray, PoseStamped, TwistStamped
 from helpers import launch, node, SimClock, stop_when, write_params
 from nav_msgs.msg import Odometry
 import numpy as np
+import pytest
 
 ROBOTS = 4
 FOUR = {'num_robots': ROBOTS, 'formation.vertices': [0.6, 0.6, -0.6, 0.6, -0.6, -0.6, 0.6, -0.6],
@@ -171,6 +172,7 @@ def test_unicycle_robot_takes_odometry_and_answers_in_its_body_frame(processes, 
     assert np.any(near != u)
 
 
+@pytest.mark.faults
 def test_plant_moves_a_unicycle_by_body_frame_commands_and_drops_world_frame_ones(
         processes, install, probe, tmp_path):
     params = four_unicycles(tmp_path)
