@@ -111,14 +111,17 @@ class Admission:
     """
     What counts for one step.
 
-    u: (N, dim) commands held over the step, m/s; status: (N,) :class:`CommandStatus` codes;
-    largest_u_hat: (N,) largest |u_hat| component of each command as sent (0 where it did not
-    count), m/s.
+    u: (N, dim) commands held over the step, m/s ((N, 2) (v, w) for unicycles); status: (N,)
+    :class:`CommandStatus` codes; largest_u_hat: (N,) largest |u_hat| component of each command
+    as sent (0 where it did not count), m/s; velocity: (N, dim) the control-point velocity each
+    held command stands for, world frame, m/s: ``u`` itself for points, R(th) (v, l w) at the
+    heading of the state it answers for unicycles (what the robot's law asked for).
     """
 
     u: NDArray[np.float64]
     status: NDArray[np.int8]
     largest_u_hat: NDArray[np.float64]
+    velocity: NDArray[np.float64]
 
     @property
     def counted(self) -> NDArray[np.bool_]:
@@ -411,17 +414,20 @@ class PlantModel:
         u = np.where(counted[:, None], commands.u, 0.0)
         largest = np.zeros(self.num_robots)
         if np.any(counted):
-            self._saturate(u, commands.stamp_ns, counted, status, largest)
-        return Admission(u=u, status=status, largest_u_hat=largest)
+            velocity = self._saturate(u, commands.stamp_ns, counted, status, largest)
+        else:
+            velocity = self.body.world_velocity(u, self.heading)
+        return Admission(u=u, status=status, largest_u_hat=largest, velocity=velocity)
 
     def _saturate(self, command: NDArray[np.float64], stamps: NDArray[np.int64],
                   counted: NDArray[np.bool_], status: NDArray[np.int8],
-                  largest: NDArray[np.float64]) -> None:
+                  largest: NDArray[np.float64]) -> NDArray[np.float64]:
         """
         Clip the counted commands (in place) to the law's bound and to the actuator caps.
 
         The bound applies to the velocity a command gives the control point (the command itself
-        for points; R(th) (v, l w) at the heading of the answered state for unicycles).
+        for points; R(th) (v, l w) at the heading of the answered state for unicycles). Returns
+        those velocities after clipping, (N, dim) (``command`` itself for points).
         """
         body = self.body
         heading = self._answered_headings(stamps, counted) if body.has_heading else self.heading
@@ -429,8 +435,12 @@ class PlantModel:
         over = self._clip_to_law(u, stamps, counted, largest)
         if u is not command and np.any(over):
             command[over] = body.body_command(u[over], heading[over])
-        over |= body.cap(command, counted)
+        capped = body.cap(command, counted)
+        if u is not command and np.any(capped):
+            u[capped] = body.world_velocity(command[capped], heading[capped])
+        over |= capped
         status[over] = CommandStatus.SATURATED
+        return u
 
     def _answered_headings(self, stamps: NDArray[np.int64],
                            counted: NDArray[np.bool_]) -> NDArray[np.float64]:

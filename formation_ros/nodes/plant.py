@@ -224,8 +224,7 @@ class PlantNode(Node):
             self.closest_body = min(self.closest_body, self.model.closest_body_distance())
             if self.chunks is not None and self.unicycles:
                 self.chunks.append(report.t_ns / NS_PER_S, report.points,
-                                   self.bodies.world_velocity(report.admission.u,
-                                                              report.heading),
+                                   report.admission.velocity,
                                    heading=report.heading, q_body=report.q,
                                    body_command=report.admission.u)
             elif self.chunks is not None:

@@ -199,8 +199,9 @@ def simulate_fixed_step(config: FormationConfig, duration: float, dt: float,
         if k == steps:
             times.append(model.t)
             states.append(model.points)
-            command = model.admit(commands).u
-            applied.append(bodies.world_velocity(command, model.heading))
+            admission = model.admit(commands)
+            command = admission.u
+            applied.append(admission.velocity)
             frames.append(frame)
             headings.append(model.heading)
             q_body.append(model.q)
@@ -211,7 +212,7 @@ def simulate_fixed_step(config: FormationConfig, duration: float, dt: float,
         if k % stride == 0:
             times.append(report.t_ns / NS_PER_S)
             states.append(report.points)
-            applied.append(bodies.world_velocity(report.admission.u, report.heading))
+            applied.append(report.admission.velocity)
             frames.append(frame)
             headings.append(report.heading)
             q_body.append(report.q)

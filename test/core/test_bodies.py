@@ -89,6 +89,7 @@ def test_saturation_uses_the_heading_of_the_state_the_command_answers():
     expected = unicycle_commands(np.clip(np.array([1.0, 0.0]), -LAW.u_bound, LAW.u_bound),
                                  0.0, L)
     assert np.allclose(admission.u, expected, atol=1e-15)
+    assert np.allclose(admission.velocity, [[LAW.u_bound, 0.0]] * 2, rtol=0, atol=1e-15)
 
 
 def test_actuator_caps_clip_v_and_w():
@@ -98,6 +99,8 @@ def test_actuator_caps_clip_v_and_w():
     commands.store_all([[0.12, 0.5], [0.05, -1.5], [0.05, 0.5]], plant.t_ns)
     admission = plant.admit(commands)
     assert admission.u.tolist() == [[0.1, 0.5], [0.05, -1.0], [0.05, 0.5]]
+    assert np.allclose(admission.velocity, [[0.1, 0.5 * L], [0.05, -L], [0.05, 0.5 * L]],
+                       rtol=0, atol=1e-15)
     assert admission.status.tolist() == [CommandStatus.SATURATED, CommandStatus.SATURATED,
                                          CommandStatus.APPLIED]
 
