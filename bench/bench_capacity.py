@@ -6,7 +6,7 @@ Capacity benchmark: how many robots, at what rate, on this machine (on demand, n
 
 Usage: python bench/bench_capacity.py [--sizes 10 20 50 100] [--rates 20 50]
 [--modes process fleet] [--robots-per-process 25] [--measure 20] [--lockstep]
-[--prefix INSTALL] [--out DIR]
+[--prefix INSTALL] [--out DIR]; or python bench/bench_capacity.py --figure JSON... --out DIR
 
 For each mode, team size N and control rate it runs scripts/launch_formation.sh on the Section 5
 constants with N robots (random start at about 10 robots per m^2, lattice goal 2 m apart),
@@ -19,7 +19,8 @@ steps at which every robot's applied command answered a state at most two contro
 ('fresh'), and the latency from the plant publishing a state to the answer arriving (p50, p99,
 max). With --lockstep it runs lockstep instead (plant.lockstep, as fast as the robots answer)
 and reports steps per second. Prints a Markdown table, writes OUT/capacity.json and a figure of
-the fresh fraction against N (OUT/capacity_fresh.png).
+the fresh fraction against N (OUT/capacity_fresh.png); --figure draws that figure from the
+capacity.json files of earlier runs (one per mode, say) and runs nothing.
 """
 
 import argparse
@@ -71,6 +72,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument('--prefix', default=os.path.join(ROOT, 'install', 'formation_ros'),
                         help='install space of formation_ros (default: %(default)s)')
     parser.add_argument('--out', help='output directory (default: runs/capacity-<date>-<time>)')
+    parser.add_argument('--figure', nargs='+', metavar='JSON',
+                        help='run nothing: draw OUT/capacity_fresh.png from the rows of these '
+                             'capacity.json files of earlier runs (e.g. one per mode)')
     return parser
 
 
@@ -84,7 +88,11 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
         parser.error(f'--rates must be > 0 and at most the plant rate, {PLANT_RATE:g} Hz')
     if not args.measure > 0.0 or not args.startup_timeout > 0.0:
         parser.error('--measure and --startup-timeout must be > 0')
-    if not os.access(os.path.join(args.prefix, 'lib', 'formation_ros', 'plant'), os.X_OK):
+    if args.figure:
+        unreadable = [path for path in args.figure if not os.path.isfile(path)]
+        if unreadable:
+            parser.error(f'--figure: no such file: {unreadable[0]}')
+    elif not os.access(os.path.join(args.prefix, 'lib', 'formation_ros', 'plant'), os.X_OK):
         parser.error(f"no formation_ros install at --prefix '{args.prefix}' (build one with "
                      'colcon, see README)')
     args.prefix = os.path.abspath(args.prefix)
@@ -252,10 +260,27 @@ def write_figure(path: str, rows: Sequence[Mapping[str, Any]]) -> None:
     plt.close(figure)
 
 
+def redraw(paths: Sequence[str], figure: str) -> int:
+    """Draw ``figure`` from the rows of the capacity.json files ``paths``; 2 if one is bad."""
+    rows: List[Dict[str, Any]] = []
+    for path in paths:
+        try:
+            with open(path, encoding='utf-8') as stream:
+                rows.extend(json.load(stream)['rows'])
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            print(f'bench_capacity.py: {path} is not a capacity.json: {exc}', file=sys.stderr)
+            return 2
+    write_figure(figure, rows)
+    print(f'wrote {figure} from {len(rows)} rows')
+    return 0
+
+
 def main(argv: Optional[Sequence[str]] = None) -> int:
     """Run every case, print the table, write JSON and the figure; 0 if every case ran."""
     args = parse_args(argv)
     os.makedirs(args.out, exist_ok=True)
+    if args.figure:
+        return redraw(args.figure, os.path.join(args.out, 'capacity_fresh.png'))
     machine = {'machine': platform.machine(), 'cores': os.cpu_count(),
                'python': platform.python_version(), 'load_before': os.getloadavg()}
     print(f"machine: {machine['machine']}, {machine['cores']} cores, Python "

@@ -267,3 +267,24 @@ def test_capacity_benchmark_refuses_bad_arguments(fake_install, tmp_path):
         assert result.returncode == 2 and says in result.stderr, (args, result.stderr)
     assert 'fresh' in subprocess.run([sys.executable, script, '--help'], capture_output=True,
                                      text=True, timeout=120).stdout
+
+
+def test_capacity_figure_is_drawn_from_earlier_results_alone(tmp_path):
+    script = os.path.join(ROOT, 'bench', 'bench_capacity.py')
+    rows = [{'mode': mode, 'robots': n, 'rate_hz': 20.0, 'fresh_fraction': 0.5 + n / 400.0}
+            for mode in ('process', 'fleet') for n in (10, 20)]
+    paths = []
+    for mode in ('process', 'fleet'):
+        paths.append(tmp_path / f'{mode}.json')
+        paths[-1].write_text(json.dumps({'rows': [r for r in rows if r['mode'] == mode]}))
+    result = subprocess.run([sys.executable, script, '--figure', *map(str, paths), '--out',
+                             str(tmp_path / 'out')], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert (tmp_path / 'out' / 'capacity_fresh.png').stat().st_size > 1000
+    assert 'from 4 rows' in result.stdout
+    (tmp_path / 'bad.json').write_text('[1, 2]')
+    result = subprocess.run([sys.executable, script, '--figure', str(tmp_path / 'bad.json'),
+                             '--out', str(tmp_path / 'out')], capture_output=True, text=True,
+                            timeout=120)
+    assert result.returncode == 2 and 'is not a capacity.json' in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1

@@ -191,7 +191,8 @@ def neighbour_pairs(q: ArrayLike, radius: float,
 
 def team_command(q: ArrayLike, vertices: ArrayLike, sensing_radii: ArrayLike, law: LawParams,
                  frame: Optional[FrameSample] = STATIONARY,
-                 tree: Optional['cKDTree'] = None) -> Command:
+                 tree: Optional['cKDTree'] = None,
+                 pairs: Optional[NDArray[np.intp]] = None) -> Command:
     """
     Control of every robot at once (the vectorised form of :func:`robot_command`).
 
@@ -200,13 +201,16 @@ def team_command(q: ArrayLike, vertices: ArrayLike, sensing_radii: ArrayLike, la
     each robot keeps only those within its own R_i, so a step costs O(N log N).
     Returns a :class:`Command` with (N, dim) arrays. Raises ValueError for a non-finite position
     or robots farther apart than about 1e150 m (the k-d tree cannot search them). tree: a k-d
-    tree of ``q`` (world frame) if the caller has one, so a step builds one tree, not two.
+    tree of ``q`` (world frame) if the caller has one, so a step builds one tree, not two;
+    pairs: the (P, 2) pairs i < j within b of each other, if the caller has them (the plant
+    model keeps them for ``formation_sim``), so they are not searched again.
     """
     q = np.asarray(q, dtype=float)
     radii = np.asarray(sensing_radii, dtype=float)
     n, dim = q.shape
     q_hat = to_frame(q, frame)
-    pairs = neighbour_pairs(q, law.repulsion_radius, tree)
+    if pairs is None:
+        pairs = neighbour_pairs(q, law.repulsion_radius, tree)
     i, j = pairs[:, 0], pairs[:, 1]
     q_hat_ij = q_hat[i] - q_hat[j]
     d2 = np.einsum('kd,kd->k', q_hat_ij, q_hat_ij)

@@ -79,9 +79,10 @@ class RobotSettings:
 
 @dataclass(frozen=True)
 class ReferenceSettings:
-    """The reference node's own parameters."""
+    """The reference node's own parameters, and the plant's step (lockstep sends one ahead)."""
 
     rate: float
+    step_ns: int
 
 
 @dataclass(frozen=True)
@@ -374,7 +375,8 @@ def _own_settings(values: Mapping[str, Any], exe: Exe, n: int,
             wait_for_subscribers=values['wait_for_subscribers'],
             pose_type=PoseType(values['pose_type']))}
     if exe is Exe.REFERENCE:
-        return {'reference_node': ReferenceSettings(rate=values['reference.rate'])}
+        return {'reference_node': ReferenceSettings(
+            rate=values['reference.rate'], step_ns=int(round(NS_PER_S / values['plant.rate'])))}
     if exe is Exe.RECORD:
         return {'recorder': RecorderSettings(path=values['record.path'],
                                              overwrite=values['record.overwrite'],

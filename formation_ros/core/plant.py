@@ -334,7 +334,10 @@ class PlantModel:
     answer; collision_distance: m; max_speed: cap on every world command component, m/s (0:
     none beyond the law's own bound), for point bodies built here. bodies: the kind of body
     (``core.bodies``; default points with ``max_speed``); headings: (N,) start headings, rad
-    (default 0).
+    (default 0). pair_radius: with a value > 0 (``formation_sim`` gives the law's b), the model
+    keeps every pair of control points within it of each new state (:attr:`pairs`, for the law)
+    and, for points when it is at least the collision distance, checks collisions among them
+    instead of searching the tree a second time.
 
     Public state: ``q`` (N, dim) body positions, ``heading`` (N,), ``points`` (N, dim) the
     control points the law acts on, ``tree`` a k-d tree of ``points`` and ``body_tree`` one of
@@ -344,7 +347,8 @@ class PlantModel:
     def __init__(self, start: ArrayLike, sensing_radii: ArrayLike, step_ns: int,
                  law: LawParams, reference: Reference, input_timeout_ns: int,
                  collision_distance: float, max_speed: float = 0.0,
-                 bodies: Optional[Bodies] = None, headings: Optional[ArrayLike] = None):
+                 bodies: Optional[Bodies] = None, headings: Optional[ArrayLike] = None,
+                 pair_radius: float = 0.0):
         """Place the robots at ``start`` (and ``headings``) at time 0."""
         self.body: Bodies = PointBodies(max_speed) if bodies is None else bodies
         self.q = np.array(start, dtype=float)
@@ -361,6 +365,9 @@ class PlantModel:
         self.collision_distance = float(collision_distance)
         self.contact_distance = max(self.collision_distance, self.body.contact_distance)
         self.sensor_radii = self.radii + self.body.sensing_margin
+        self.pair_radius = float(pair_radius)
+        self.pairs: Optional[NDArray[np.intp]] = None
+        """(P, 2) pairs i < j of control points within ``pair_radius`` now (None without it)."""
         self.max_speed = float(max_speed)
         self.bound_tolerance = (BOUND_TOLERANCE_FIXED if reference.is_stationary
                                 else BOUND_TOLERANCE_MOVING)
@@ -544,9 +551,25 @@ class PlantModel:
         return float(np.min(distance[:, 1]))
 
     def _close_pairs(self) -> Set[Tuple[int, int]]:
-        pairs = self.body_tree.query_pairs(self.contact_distance,
-                                           output_type='ndarray').tolist()
-        return {(int(i), int(j)) for i, j in pairs}
+        """
+        Pairs of bodies within the contact distance now (and :attr:`pairs`, when they are kept).
+
+        :attr:`pairs` are those of the control points (the law's); for points they are the
+        bodies' too, so the collisions are found among them when ``pair_radius`` reaches the
+        contact distance.
+        """
+        if self.pair_radius > 0.0:
+            self.pairs = self.tree.query_pairs(self.pair_radius,
+                                               output_type='ndarray').reshape(-1, 2)
+        if (self.pairs is not None and self.body_tree is self.tree
+                and self.pair_radius >= self.contact_distance):
+            diff = self.q[self.pairs[:, 0]] - self.q[self.pairs[:, 1]]
+            close = self.pairs[np.einsum('kd,kd->k', diff, diff)
+                               <= self.contact_distance ** 2].tolist()
+        else:
+            close = self.body_tree.query_pairs(self.contact_distance,
+                                               output_type='ndarray').tolist()
+        return {(int(i), int(j)) for i, j in close}
 
     def _new_collisions(self) -> List[Tuple[int, int, float]]:
         pairs = self._close_pairs()

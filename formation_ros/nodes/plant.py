@@ -377,8 +377,15 @@ class PlantNode(Node):
                 if now - since >= DUPLICATE_GRACE]
 
     def on_markers(self) -> None:
-        """Publish the RViz picture: robots, sensing and repulsion zones, formation, paths."""
+        """
+        Publish the RViz picture: robots, sensing and repulsion zones, formation, paths.
+
+        Only while someone subscribes (RViz, a recorder with ``record.markers``): building the
+        MarkerArray was a quarter of a lockstep plant's time. The paths are kept regardless.
+        """
         self.paths.append(self.model.q)
+        if self.marker_pub.get_subscription_count() == 0:
+            return
         desired = desired_positions(self.config.vertices, self.reference.sample(self.model.t))
         self.marker_pub.publish(formation_markers(
             self.model.q, self.config.sensing_radii, self.law.repulsion_radius, desired,

@@ -12,9 +12,11 @@ header.stamp is the time t of the sample. With ``use_sim_time`` t is the plant's
 without it, t counts from the node's start. The timer runs on the wall clock at
 ``reference.rate``, so samples keep coming (with the same stamp) while the plant holds its clock,
 e.g. while it waits for the robots. In lockstep it publishes one sample for every new value of
-the simulated clock, as soon as the clock moves (a jump callback of its clock arms a one-shot
-timer, ``formation_ros.ros.wake``; the timer at ``reference.rate`` publishes the first sample and
-any it missed). The topic is transient local: a late robot gets the latest sample.
+the simulated clock as soon as the clock moves (a jump callback of its clock arms a one-shot
+timer, ``formation_ros.ros.wake``; the timer at ``reference.rate`` publishes the first sample
+and any it missed), together with the sample of the next step (``plant.rate`` gives it), so
+the robots have it before the state it belongs to. The topic is transient local: a late robot
+gets the latest sample.
 """
 
 from typing import List, Optional
@@ -47,6 +49,7 @@ class ReferenceNode(Node):
         self.dim = config.dim
         self.reference = config.reference()
         self.lockstep = config.lockstep
+        self.step_ns = settings.step_ns
         self.sim_time = self.get_parameter('use_sim_time').value
         self.epoch_ns = 0 if self.sim_time else self.get_clock().now().nanoseconds
         self.last_stamp: Optional[int] = None
@@ -73,10 +76,21 @@ class ReferenceNode(Node):
                                       'the plant state stamps')
 
     def on_timer(self) -> None:
-        """Publish the sample of the current time (in lockstep: once per value of the clock)."""
-        stamp = self.get_clock().now().nanoseconds
-        if self.lockstep and stamp == self.last_stamp:
+        """
+        Publish the sample of the current time.
+
+        In lockstep: once per value of the clock, and the sample of the next step with it, so
+        that it is with the robots before the state it belongs to (the plant's step is known).
+        """
+        now = self.get_clock().now().nanoseconds
+        if not self.lockstep:
+            self._publish(now)
             return
+        for stamp in (now, now + self.step_ns):
+            if self.last_stamp is None or stamp > self.last_stamp:
+                self._publish(stamp)
+
+    def _publish(self, stamp: int) -> None:
         self.last_stamp = stamp
         frame = self.reference.sample((stamp - self.epoch_ns) / fields.NS_PER_S)
         self.pub.publish(encode_odometry(stamp, messages.WORLD_FRAME, messages.FORMATION_FRAME,

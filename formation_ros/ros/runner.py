@@ -22,6 +22,7 @@ have to be set in a ``preexec_fn``, which is unsafe in a launcher whose relay th
 """
 
 import ctypes
+import gc
 import os
 import signal
 import sys
@@ -200,8 +201,11 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
     Start rclpy, build the node(s), spin until SIGINT/SIGTERM, shut down without a traceback.
 
     ``make_nodes`` returns one node or several, which then share one executor (and the one
-    thread of this process). The spin also ends when the launcher named in the environment is
-    gone (see :class:`LauncherWatch`). Returns the exit code: 0; 1 if a node's ``finish()``
+    thread of this process). Everything allocated until then (modules, message classes, the
+    nodes) is moved out of the garbage collector's sight (``gc.freeze``): a profile of the
+    lockstep plant found a fifth of its time in full collections walking those objects. The
+    spin also ends when the launcher named in the environment is gone (see
+    :class:`LauncherWatch`). Returns the exit code: 0; 1 if a node's ``finish()``
     failed (the others still finish); 2 for invalid parameters (one line per bad parameter) or a
     command line rclpy cannot start from.
     """
@@ -220,6 +224,8 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
         executor = make_executor()
         for node in nodes:
             executor.add_node(node)
+        gc.collect()
+        gc.freeze()
         while rclpy.ok() and _StopRequest.signal_name is None:
             executor.spin_once(timeout_sec=SIGNAL_LATENCY)
             if launcher is not None and launcher.gone():

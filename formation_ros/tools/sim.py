@@ -186,7 +186,8 @@ def simulate_fixed_step(config: FormationConfig, duration: float, dt: float,
     bodies = make_bodies(config.body)
     model = PlantModel(config.start, config.sensing_radii, step_ns, law, reference,
                        input_timeout_ns=step_ns, collision_distance=DEFAULT_COLLISION_DISTANCE,
-                       bodies=bodies, headings=config.start_headings)
+                       bodies=bodies, headings=config.start_headings,
+                       pair_radius=law.repulsion_radius)
     commands = Commands.empty(config.num_robots, bodies.command_width(config.dim))
     steps = int(round(duration / dt))
     stride = max(1, int(round(sample_dt / dt)))
@@ -194,7 +195,7 @@ def simulate_fixed_step(config: FormationConfig, duration: float, dt: float,
     for k in range(steps + 1):
         frame = reference.sample(model.t)
         u = team_command(model.points, config.vertices, config.sensing_radii, law, frame,
-                         model.tree).u
+                         model.tree, model.pairs).u
         commands.store_all(bodies.body_command(u, model.heading), model.t_ns)
         if k == steps:
             times.append(model.t)

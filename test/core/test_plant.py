@@ -6,7 +6,7 @@
 import math
 import os
 
-from formation_ros.core.law import make_law, team_command
+from formation_ros.core.law import make_law, neighbour_pairs, team_command
 from formation_ros.core.params import load_config
 from formation_ros.core.plant import (Commands, CommandStatus, PlantModel, random_start,
                                       start_positions, StartSpec)
@@ -204,3 +204,22 @@ def test_random_start_with_its_grid_equals_comparing_with_every_point(n, dim, ra
                                                                       separation, seed):
     assert np.array_equal(random_start(n, dim, radius, separation, seed),
                           brute_force_start(n, dim, radius, separation, seed))
+
+
+def test_pairs_kept_for_the_law_are_its_pairs_and_give_the_same_collisions():
+    rng = np.random.default_rng(4)
+    start = rng.uniform(-1.0, 1.0, (60, 2))
+    start[1] = start[0] + [0.0205, 0.0]
+    plain, keeping = (PlantModel(start, np.full(60, 1.0), MS, LAW, FIXED, 50 * MS, 1e-3,
+                                 pair_radius=radius) for radius in (0.0, LAW.repulsion_radius))
+    assert plain.pairs is None
+    commands = Commands.empty(60, 2)
+    for _ in range(20):
+        assert np.array_equal(keeping.pairs, neighbour_pairs(keeping.q, LAW.repulsion_radius))
+        u = rng.uniform(-0.2, 0.2, (60, 2))
+        u[0], u[1] = [0.5, 0.0], [-0.5, 0.0]
+        commands.store_all(u, plain.t_ns)
+        reports = plain.advance(commands), keeping.advance(commands)
+        assert reports[0].collisions == reports[1].collisions
+        assert np.array_equal(plain.q, keeping.q)
+    assert plain.counts.collisions == keeping.counts.collisions > 0

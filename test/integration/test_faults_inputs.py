@@ -51,18 +51,20 @@ def test_a_reference_on_wall_time_is_refused_and_the_team_waits(processes, insta
 
 
 def test_forged_commands_are_refused_or_saturated(processes, install, probe, tmp_path):
-    """A command from the future counts as zero; one of 1e9 m/s is saturated at c M1."""
+    """A command from the future counts as zero; 1e9 m/s is saturated; garbage bytes counted."""
     out = tmp_path / 'plant'
     processes.start(node(install, 'plant', SQUARE, '-p', 'plant.wait_for_robots:=false',
                          '-p', f'plant.output_dir:={out}'))
     future = probe.create_publisher(TwistStamped, '/robot_1/cmd_vel', qos.COMMAND)
     huge = probe.create_publisher(TwistStamped, '/robot_2/cmd_vel', qos.COMMAND)
+    garbage = probe.create_publisher(TwistStamped, '/robot_3/cmd_vel', qos.COMMAND)
     clock = SimClock(probe)
 
     def send():
         now = max(0, int(clock.seconds * 1e9))
         future.publish(messages.twist_stamped(np.array([0.5, 0.0]), 2_000_000_000 * 10 ** 9, 2))
         huge.publish(messages.twist_stamped(np.array([1e9, -1e9]), now, 2))
+        garbage.publish(b'\x00\x01\x00\x00' + bytes(range(9)))
         return clock.seconds >= 3.0
 
     assert probe.spin_until(send, START_UP), processes.log('plant')
@@ -72,6 +74,8 @@ def test_forged_commands_are_refused_or_saturated(processes, install, probe, tmp
     assert stats['by_robot']['future'].get('1', 0) > 0, stats
     assert stats['by_robot']['saturated'].get('2', 0) > 0, stats
     assert stats['bound_violations'] > 0
+    assert stats['malformed_command_messages'].get('3', 0) > 0, stats
+    assert stats['by_robot']['missing'].get('3', 0) == stats['steps'], stats
     trajectory = Trajectory.load(str(out / 'trajectory.npz'))
     assert np.ptp(trajectory.q[:, 0, :], axis=0).max() == 0.0
     step = np.abs(np.diff(trajectory.q[:, 1, :], axis=0)) / np.diff(trajectory.t)[:, None]
@@ -79,10 +83,11 @@ def test_forged_commands_are_refused_or_saturated(processes, install, probe, tmp
     assert step.max() > 0.9 * BOUND
     log = processes.log('plant')
     assert log.count('after the present state') == 1 and log.count('saturating it') == 1
+    assert log.count('not a TwistStamped') == 1, log
 
 
 def test_robot_ignores_forged_poses_and_floods(processes, install, probe):
-    """Wrong frame, 10,000 neighbours, an impossible reference: counted, logged once each."""
+    """Wrong frame, 10,000 neighbours, a bad reference, garbage bytes: logged once each."""
     config = load_config(SQUARE)
     start_robots(processes, install, 1, sim_time=False)
     pose_pub = probe.create_publisher(PoseStamped, '/robot_1/pose', qos.STATE)
@@ -105,13 +110,14 @@ def test_robot_ignores_forged_poses_and_floods(processes, install, probe):
         good = ((messages.pose_stamped(np.array([0.2, -0.1]), stamp, 2), pose_pub),
                 (messages.pose_array(np.array([[0.6, 0.2]]), stamp, 2), neighbours_pub),
                 (messages.reference_odometry(None, stamp, 2), reference_pub))
-        forged = ((forged_pose, pose_pub), (flood, neighbours_pub), (fast, reference_pub))
+        forged = ((forged_pose, pose_pub), (flood, neighbours_pub), (fast, reference_pub),
+                  (b'\x00\x01\x00\x00\x07', pose_pub))
         for message, publisher in (forged if len(ticks) % 3 == 0 else good):
             publisher.publish(message)
         log = processes.log('robot_1')
         if not logged_at and all(reason in log for reason in (
                 "a frame other than 'world'", 'more neighbours than there are robots',
-                'a speed or turn rate')):
+                'a speed or turn rate', 'not a whole message of its type')):
             logged_at.append(len(heard))
         return bool(logged_at) and len(heard) > logged_at[0] + 20
 
@@ -123,7 +129,7 @@ def test_robot_ignores_forged_poses_and_floods(processes, install, probe):
     assert all(np.max(np.abs(u - expected)) < 1e-12 for u in answers), answers[:5]
     log = processes.log('robot_1')
     for reason in ("a frame other than 'world'", 'more neighbours than there are robots',
-                   'a speed or turn rate'):
+                   'a speed or turn rate', 'not a whole message of its type'):
         assert log.count(reason) == 1, (reason, log)
     assert processes.running('robot_1')
 
