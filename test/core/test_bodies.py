@@ -193,3 +193,18 @@ def test_chunks_keep_the_body_arrays(tmp_path):
     points.append(0.0, np.zeros((3, 2)), np.zeros((3, 2)))
     points.flush()
     assert read_body_chunks(points.folder) is None
+
+
+def test_kept_pairs_are_the_hand_points_and_bodies_still_collide_on_their_own():
+    q = [[0.0, 0.0], [0.4005, 0.0], [0.9, 0.0]]
+    bodies = UnicycleBodies(L, 0.2)
+    plant = PlantModel(np.array(q), np.full(3, 1.0), MS, LAW, FIXED, 50 * MS, 1e-3,
+                       bodies=bodies, headings=[math.pi, 0.0, 0.0], pair_radius=0.5)
+    hands = hand_points(np.array(q), np.array([math.pi, 0.0, 0.0]), L)
+    assert sorted(map(tuple, plant.pairs.tolist())) == [
+        (i, j) for i in range(3) for j in range(i + 1, 3)
+        if np.linalg.norm(hands[i] - hands[j]) <= 0.5]
+    commands = Commands.empty(3, 2)
+    commands.store_all([[-0.05, 0.0], [-0.05, 0.0], [0.0, 0.0]], 0)
+    report = plant.advance(commands)
+    assert [c[:2] for c in report.collisions] == [(0, 1)]
