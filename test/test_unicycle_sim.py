@@ -9,9 +9,10 @@ import os
 import subprocess
 import sys
 
+from formation_ros.core.declarations import Exe
 from formation_ros.core.law import log_potential, team_command
 from formation_ros.core.metrics import dis_min_series, formation_errors
-from formation_ros.core.params import load_config, validate
+from formation_ros.core.params import load_config, validate, validate_for_every_executable
 from formation_ros.core.params_file import load_params_file
 from formation_ros.core.safety import guaranteed_min_distance
 from formation_ros.core.trajectory import ARRAYS, BODY_ARRAYS, Trajectory
@@ -195,3 +196,11 @@ def test_cli_refuses_unicycles_in_3d(tmp_path):
     done = run_sim(str(path), '--check')
     assert done.returncode == 2
     assert "parameter 'body.kind': unicycle needs dim 2" in done.stderr
+
+
+@pytest.mark.parametrize('path', [HEXAGON, CIRCLE])
+def test_shipped_unicycle_files_are_valid_for_every_node(path):
+    checked = validate_for_every_executable(load_params_file(path))
+    assert all(config.body.is_unicycle for config in checked.values())
+    assert checked[Exe.ROBOT].body.hand_distance == 0.08
+    assert checked[Exe.PLANT].start_headings is not None
