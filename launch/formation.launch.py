@@ -12,6 +12,11 @@ from that file. The first node to exit ends the launch::
     ros2 launch formation_ros formation.launch.py params_file:=my.yaml
     ros2 launch formation_ros formation.launch.py record:=runs/bag output_dir:=runs/out
     ros2 launch formation_ros formation.launch.py robots_per_process:=10   # fleet processes
+    ros2 launch formation_ros formation.launch.py discovery:=subnet domain_id:=7
+
+As with scripts/launch_formation.sh, the nodes stay on this computer
+(ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST) unless the environment sets a range or
+``discovery`` is ``subnet``; ``domain_id`` sets ROS_DOMAIN_ID (0 to 232).
 
 It runs until Ctrl-C; ``formation_report`` reads the bag or the output directory afterwards.
 """
@@ -28,6 +33,22 @@ import yaml
 PACKAGE = 'formation_ros'
 
 
+def network_environment(discovery, domain_id):
+    """Return the variables that set the nodes' discovery range and domain."""
+    env = {}
+    if discovery:
+        if discovery not in ('localhost', 'subnet'):
+            raise ValueError(f"discovery must be 'localhost' or 'subnet', got '{discovery}'")
+        env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = discovery.upper()
+    elif not os.environ.get('ROS_AUTOMATIC_DISCOVERY_RANGE'):
+        env['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
+    if domain_id:
+        if not (domain_id.isdigit() and int(domain_id) <= 232):
+            raise ValueError(f"domain_id must be a whole number from 0 to 232, got '{domain_id}'")
+        env['ROS_DOMAIN_ID'] = str(int(domain_id))
+    return env
+
+
 def formation_nodes(context):
     """Return the nodes for the launch arguments' parameters file, bag path and output dir."""
     params_file = LaunchConfiguration('params_file').perform(context)
@@ -39,10 +60,12 @@ def formation_nodes(context):
     with open(params_file) as stream:
         num_robots = yaml.safe_load(stream)['/**']['ros__parameters']['num_robots']
     subscribers = 2 if record else 1
+    env = network_environment(LaunchConfiguration('discovery').perform(context),
+                              LaunchConfiguration('domain_id').perform(context))
 
     def node(executable, *overrides, namespace=None, arguments=None):
         return Node(package=PACKAGE, executable=executable, namespace=namespace,
-                    arguments=arguments,
+                    arguments=arguments, additional_env=env,
                     parameters=[params_file, *filter(None, overrides)], output='screen',
                     on_exit=Shutdown(reason=f'{executable} exited'))
 
@@ -78,5 +101,10 @@ def generate_launch_description():
                                           'plant_stats.json (empty: nowhere)'),
         DeclareLaunchArgument('robots_per_process', default_value='1',
                               description="robots per process (above 1: 'fleet' processes)"),
+        DeclareLaunchArgument('discovery', default_value='',
+                              description="'localhost' or 'subnet' (empty: the environment's "
+                                          'ROS_AUTOMATIC_DISCOVERY_RANGE, else localhost)'),
+        DeclareLaunchArgument('domain_id', default_value='',
+                              description="ROS_DOMAIN_ID of the nodes (empty: the environment's)"),
         OpaqueFunction(function=formation_nodes),
     ])

@@ -30,4 +30,4 @@ if [[ -n "$prefix" ]] || ! command -v ros2 >/dev/null 2>&1 \
   PYTHONPATH="$(IFS=:; echo "${sites[*]}")${PYTHONPATH:+:$PYTHONPATH}"
   export PYTHONPATH
 fi
-exec "${python[@]}" -m formation_ros.tools.launcher "$@"
+exec "${python[@]}" -m "${FORMATION_LAUNCHER_MODULE:-formation_ros.tools.launcher}" "$@"

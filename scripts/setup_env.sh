@@ -14,22 +14,27 @@ Creates a Python virtual environment (default: .venv in the repository) and inst
 formation_ros with everything it needs from PyPI: numpy, scipy, matplotlib, PyYAML, the ROS 2
 Jazzy wheels (rclpy with Fast DDS, common_interfaces), colcon, pytest and the ament linters.
 Nothing needs to be sourced afterwards. A second run only reinstalls when requirements.txt
-changed (or with --force).
+changed (or with --force). Run as root on a Debian or Ubuntu machine, it also installs the
+'nftables' package (the 'nft' command) with apt-get when it is missing: the multi-host tests
+drop packets with it (--no-system skips this).
 
 Options:
   --venv DIR     where to create the environment (default: \$FORMATION_VENV or .venv)
   --python EXE   interpreter to build it from, Python 3.10 to 3.13 (default: python3)
   --force        reinstall even if requirements.txt did not change
+  --no-system    do not install system packages (nftables), even as root
   -h, --help     show this help
 USAGE
 }
 
 force=0
+system=1
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --venv) VENV="${2:?--venv needs a directory}"; shift 2 ;;
     --python) PYTHON="${2:?--python needs an interpreter}"; shift 2 ;;
     --force) force=1; shift ;;
+    --no-system) system=0; shift ;;
     -h|--help) usage; exit 0 ;;
     *) echo "setup_env.sh: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
@@ -43,6 +48,32 @@ if ! "$PYTHON" -c 'import sys; sys.exit(not ((3, 10) <= sys.version_info[:2] <= 
   echo "setup_env.sh: the ROS 2 Jazzy wheels need Python 3.10 to 3.13;" \
        "$("$PYTHON" --version 2>&1) found (use --python)" >&2
   exit 1
+fi
+
+install_nftables() {
+  command -v nft >/dev/null 2>&1 && return 0
+  if [[ "$(id -u)" -ne 0 ]]; then
+    echo "setup_env.sh: 'nft' not found and not root: the multi-host tests will be skipped" \
+         "(as root, or: sudo apt-get install nftables)"
+    return 0
+  fi
+  if ! command -v apt-get >/dev/null 2>&1; then
+    echo "setup_env.sh: 'nft' not found and no apt-get: install nftables by hand for the" \
+         "multi-host tests"
+    return 0
+  fi
+  echo "setup_env.sh: installing nftables (apt-get) for the multi-host tests"
+  if ! DEBIAN_FRONTEND=noninteractive apt-get install -y -qq nftables >/dev/null 2>&1; then
+    DEBIAN_FRONTEND=noninteractive apt-get update -qq >/dev/null 2>&1 || true
+    if ! DEBIAN_FRONTEND=noninteractive apt-get install -y -qq nftables >/dev/null 2>&1; then
+      echo "setup_env.sh: apt-get could not install nftables: the multi-host tests that drop" \
+           "packets will be skipped" >&2
+    fi
+  fi
+}
+
+if [[ $system -eq 1 ]]; then
+  install_nftables
 fi
 
 stamp="$VENV/.formation_ros_requirements"

@@ -213,7 +213,8 @@ def test_launch_file_declares_its_arguments_and_defaults_to_section5(launch_file
                 for action in description.args[0] if action.args}
     assert declared == {
         'params_file': os.path.join(ROOT, 'config', 'paper_section5.yaml'),
-        'record': '', 'output_dir': '', 'robots_per_process': '1'}
+        'record': '', 'output_dir': '', 'robots_per_process': '1', 'discovery': '',
+        'domain_id': ''}
 
 
 def test_launch_file_spreads_robots_over_fleet_processes(launch_file):
@@ -276,3 +277,30 @@ def test_launch_file_without_output_dir_sets_none(launch_file):
     nodes = launched_nodes(launch_file, params_file=os.path.join(ROOT, 'config', 'square_4.yaml'))
     (plant,) = [node for node in nodes if node.kwargs['executable'] == 'plant']
     assert node_parameters(plant)[1] == {}
+
+
+@pytest.mark.parametrize('given, arguments, expected', [
+    ({}, {}, {'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST'}),
+    ({'ROS_AUTOMATIC_DISCOVERY_RANGE': 'SUBNET'}, {}, {}),
+    ({'ROS_AUTOMATIC_DISCOVERY_RANGE': 'SUBNET'}, {'discovery': 'localhost'},
+     {'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST'}),
+    ({}, {'discovery': 'subnet', 'domain_id': '7'},
+     {'ROS_AUTOMATIC_DISCOVERY_RANGE': 'SUBNET', 'ROS_DOMAIN_ID': '7'}),
+])
+def test_launch_file_sets_discovery_and_domain(launch_file, monkeypatch, given, arguments,
+                                               expected):
+    monkeypatch.delenv('ROS_AUTOMATIC_DISCOVERY_RANGE', raising=False)
+    for name, value in given.items():
+        monkeypatch.setenv(name, value)
+    square = os.path.join(ROOT, 'config', 'square_4.yaml')
+    nodes = launched_nodes(launch_file, params_file=square, **arguments)
+    assert len(nodes) == 6
+    assert all(node.kwargs['additional_env'] == expected for node in nodes)
+
+
+@pytest.mark.parametrize('arguments', [{'discovery': 'wan'}, {'domain_id': '233'},
+                                       {'domain_id': '-1'}])
+def test_launch_file_refuses_a_bad_discovery_or_domain(launch_file, arguments):
+    with pytest.raises(ValueError, match='discovery must be|domain_id must be'):
+        launched_nodes(launch_file, params_file=os.path.join(ROOT, 'config', 'square_4.yaml'),
+                       **arguments)

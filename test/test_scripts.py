@@ -10,7 +10,7 @@ import sys
 import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-SCRIPTS = ('setup_env.sh', 'demo.sh', 'run_tests.sh', 'launch_formation.sh')
+SCRIPTS = ('setup_env.sh', 'demo.sh', 'run_tests.sh', 'launch_formation.sh', 'hosts.sh')
 
 
 def run(script, *args):
@@ -82,6 +82,8 @@ signal.signal(signal.SIGINT, lambda *_: (print('closing', me, flush=True), sys.e
 up = os.environ['FAKE_UP_DIR']
 open(os.path.join(up, me), 'w').close()
 print('up', os.environ.get('FORMATION_LAUNCHER_PID'), flush=True)
+print('network', *(os.environ.get(name, '-') for name in (
+    'ROS_DOMAIN_ID', 'ROS_AUTOMATIC_DISCOVERY_RANGE', 'ROS_LOCALHOST_ONLY')), flush=True)
 if me == os.environ.get('FAKE_DIES'):
     deadline = time.monotonic() + 60.0
     while len(os.listdir(up)) < 6 and time.monotonic() < deadline:
@@ -220,3 +222,88 @@ def test_fleet_command_line():
         parse_command_line(['fleet', '--ros-args', '-p', 'x:=1'])
     with pytest.raises(UsageError, match="'__ns:=/a' cannot be used"):
         parse_command_line(['fleet', '--robots', '1', '--ros-args', '-r', '__ns:=/a'])
+
+
+@pytest.mark.parametrize('given, options, expected', [
+    ({}, {}, ('LOCALHOST', None, None)),
+    ({'ROS_AUTOMATIC_DISCOVERY_RANGE': 'SUBNET'}, {}, ('SUBNET', None, None)),
+    ({'ROS_AUTOMATIC_DISCOVERY_RANGE': ''}, {}, ('LOCALHOST', None, None)),
+    ({'ROS_AUTOMATIC_DISCOVERY_RANGE': 'SUBNET', 'ROS_LOCALHOST_ONLY': '1'},
+     {'discovery': 'localhost'}, ('LOCALHOST', None, None)),
+    ({'ROS_LOCALHOST_ONLY': '1'}, {'discovery': 'subnet'}, ('SUBNET', None, None)),
+    ({'ROS_DOMAIN_ID': '5'}, {}, ('LOCALHOST', '5', None)),
+    ({'ROS_DOMAIN_ID': '5'}, {'domain_id': 0}, ('LOCALHOST', '0', None)),
+    ({}, {'domain_id': 232, 'discovery': 'subnet'}, ('SUBNET', '232', None)),
+])
+def test_launcher_sets_discovery_and_domain_for_the_nodes(given, options, expected):
+    from formation_ros.tools.launcher import discovery_environment, Options
+    base = dict(given, PATH='/bin')
+    env = discovery_environment(Options('p.yaml', **options), base)
+    assert (env['ROS_AUTOMATIC_DISCOVERY_RANGE'], env.get('ROS_DOMAIN_ID'),
+            env.get('ROS_LOCALHOST_ONLY')) == expected
+    assert env['PATH'] == '/bin' and base == dict(given, PATH='/bin')
+
+
+@pytest.mark.parametrize('option, value, says', [
+    ('--discovery', 'internet', '--discovery must be one of localhost, subnet'),
+    ('--discovery', 'LOCALHOST', '--discovery must be one of localhost, subnet'),
+    ('--domain-id', '233', '--domain-id must be a whole number from 0 to 232'),
+    ('--domain-id', '-1', '--domain-id must be a whole number from 0 to 232'),
+    ('--domain-id', '7.0', '--domain-id must be a whole number from 0 to 232'),
+    ('--domain-id', '1000', '--domain-id must be a whole number from 0 to 232'),
+    ('--domain-id', '', '--domain-id needs a number'),
+])
+def test_launcher_refuses_a_bad_discovery_or_domain(option, value, says):
+    result = run('launch_formation.sh', os.path.join(ROOT, 'config', 'square_4.yaml'),
+                 option, value)
+    assert result.returncode == 2
+    assert result.stderr == f'launch_formation.sh: {says}, got {value!r}\n' if value else \
+        result.stderr == f'launch_formation.sh: {says}\n', result.stderr
+
+
+@pytest.mark.parametrize('options, given, expected', [
+    ((), {}, '71 LOCALHOST -'),
+    (('--discovery', 'subnet', '--domain-id', '0'), {'ROS_LOCALHOST_ONLY': '1'}, '0 SUBNET -'),
+    ((), {'ROS_AUTOMATIC_DISCOVERY_RANGE': 'SUBNET'}, '71 SUBNET -'),
+])
+def test_every_node_gets_the_discovery_settings(fake_install, monkeypatch, options, given,
+                                                expected):
+    monkeypatch.setenv('ROS_DOMAIN_ID', '71')
+    monkeypatch.delenv('ROS_AUTOMATIC_DISCOVERY_RANGE', raising=False)
+    for name, value in given.items():
+        monkeypatch.setenv(name, value)
+    result = launch_fake(fake_install, 'plant', *options)
+    assert 'plant ended on its own (exit code 3)' in result.stderr, result.stderr
+    lines = [line.split('] network ')[1] for line in result.stdout.splitlines()
+             if '] network ' in line]
+    assert lines == [expected] * 6, result.stdout
+    head = result.stdout.splitlines()[0]
+    domain, discovery = expected.split()[:2]
+    assert head.endswith(f'; ROS_DOMAIN_ID {domain}, discovery {discovery.lower()}'), head
+
+
+@pytest.mark.parametrize('args, says', [
+    (('--robot-hosts', '0'), '--robot-hosts must be a whole number from 1 to 100'),
+    (('--loss', '101'), '--loss must be a whole number from 0 to 100'),
+    (('--loss', 'some'), '--loss must be a whole number from 0 to 100'),
+    (('--discovery', 'localhost'), '--discovery cannot be given'),
+    (('--cleanup', 'x.yaml'), '--cleanup takes no other arguments'),
+    (('--domain-id', '300'), '--domain-id must be a whole number from 0 to 232'),
+])
+def test_hosts_script_refuses_bad_options(args, says):
+    result = run('hosts.sh', os.path.join(ROOT, 'config', 'square_4.yaml'), *args)
+    assert result.returncode == 2
+    assert result.stderr.startswith(f'hosts.sh: {says}'), result.stderr
+    assert len(result.stderr.splitlines()) == 1
+
+
+def test_hosts_places_plant_and_robots():
+    from formation_ros.tools.hosts import host_names, host_of, spread
+    assert host_names(2) == ['plant', 'robots_1', 'robots_2']
+    assert spread(5, 2) == [[1, 3, 5], [2, 4]]
+    assert spread(2, 3) == [[1], [2], []]
+    for name in ('plant', 'reference', 'record'):
+        assert host_of(name, 2) == 'plant'
+    for robots, host in zip(spread(7, 3), host_names(3)[1:]):
+        assert {host_of(f'robot_{i}', 3) for i in robots} == {host}
+    assert host_of('fleet_3', 2) == 'robots_1'

@@ -47,6 +47,7 @@ from formation_ros.core.trajectory import (CHUNKS_DIR, ChunkWriter, read_body_ch
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import CdrError, encode_clock, read_twist_stamped, StateEncoder
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
+from formation_ros.ros.liveliness import PeerLiveliness
 from formation_ros.ros.markers import formation_markers, Paths
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
@@ -116,14 +117,17 @@ class PlantNode(Node):
         self.state_encoder = StateEncoder(self.n, self.dim, messages.WORLD_FRAME)
         self.malformed = np.zeros(self.n, dtype=np.int64)
         self.pose_pubs, self.neighbour_pubs = [], []
+        self.command_liveliness: List[PeerLiveliness] = []
         for i in range(1, self.n + 1):
             self.pose_pubs.append(self.create_publisher(
                 PoseStamped, topics.robot_topic(i, topics.POSE), qos.STATE))
             self.neighbour_pubs.append(self.create_publisher(
                 PoseArray, topics.robot_topic(i, topics.NEIGHBOURS), qos.STATE))
+            self.command_liveliness.append(PeerLiveliness())
             self.command_subs.append(self.create_subscription(
                 TwistStamped, topics.robot_topic(i, topics.CMD_VEL),
-                lambda data, index=i - 1: self.on_command(index, data), qos.COMMAND, raw=True))
+                lambda data, index=i - 1: self.on_command(index, data), qos.COMMAND, raw=True,
+                event_callbacks=self.command_liveliness[-1].callbacks()))
         self.clock_pub = self.create_publisher(ClockMsg, topics.CLOCK, qos.CLOCK)
         self.diagnostics_pub = self.create_publisher(
             DiagnosticArray, topics.DIAGNOSTICS, qos.DIAGNOSTICS)
@@ -342,6 +346,10 @@ class PlantNode(Node):
             if robots:
                 values[f'robots with {status.name.lower().replace("_", "-")} commands'] = \
                     ', '.join(f'{robot}: {steps}' for robot, steps in robots.items())
+        states = [peer.state() for peer in self.command_liveliness]
+        for state in ('alive', 'lost'):
+            robots = [str(i + 1) for i, s in enumerate(states) if s == state]
+            values[f'robots with {state} cmd_vel'] = ', '.join(robots) or 'none'
         shared = self._shared_command_topics(now)
         for robot in shared:
             self.once.start(f'publishers-{robot}', f'robot {robot}: its cmd_vel has more than '
@@ -355,6 +363,9 @@ class PlantNode(Node):
                                        f'{len(shared)} cmd_vel topics with several publishers')
         elif self.waiting:
             level, message = 'ok', 'waiting for the robots'
+        elif 'lost' in states:
+            level, message = 'warn', (f"{states.count('lost')} robots gone "
+                                      '(cmd_vel liveliness lost)')
         elif not self.lockstep and rate < 0.9 * target:
             level, message = 'warn', f'stepping at {rate:.1f} Hz of {target:.1f} Hz'
         else:

@@ -111,13 +111,13 @@ class RobotNode(Node):
         self.wait_subscribers = settings.wait_for_subscribers
 
         if settings.pose_type is PoseType.ODOMETRY:
-            self.create_subscription(Odometry, topics.POSE, self.on_odometry, qos.STATE,
+            self.create_subscription(Odometry, topics.POSE, self.on_odometry, qos.STATE_INPUT,
                                      raw=True)
         else:
-            self.create_subscription(PoseStamped, topics.POSE, self.on_pose, qos.STATE,
+            self.create_subscription(PoseStamped, topics.POSE, self.on_pose, qos.STATE_INPUT,
                                      raw=True)
-        self.create_subscription(PoseArray, topics.NEIGHBOURS, self.on_neighbours, qos.STATE,
-                                 raw=True)
+        self.create_subscription(PoseArray, topics.NEIGHBOURS, self.on_neighbours,
+                                 qos.STATE_INPUT, raw=True)
         self.create_subscription(Odometry, topics.REFERENCE, self.on_reference, qos.REFERENCE,
                                  raw=True)
         self.cmd_pub = self.create_publisher(TwistStamped, topics.CMD_VEL, qos.COMMAND)

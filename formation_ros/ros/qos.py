@@ -5,12 +5,18 @@
 Quality of service of every formation topic, in one place.
 
 * Commands (``cmd_vel``): reliable, keep last 10, volatile; a lost command would leave a
-  robot coasting on the previous one.
+  robot coasting on the previous one. Liveliness automatic with a lease of
+  :data:`LIVELINESS_LEASE` (1 s): the plant hears within a second that a robot's process
+  died or its link was cut (``formation_ros.ros.liveliness``).
 * References (``/formation/reference``): reliable, keep last 10, transient local, so a node
   that joins late still gets the latest samples (and the fixed reference is never missed).
 * State (``pose``, ``neighbors``): best effort, keep last 1; at 50 to 100 Hz a stale sample is
   useless and a resent one would arrive late. In lockstep the plant resends a state that was not
-  answered.
+  answered. The plant offers the liveliness lease :data:`LIVELINESS_LEASE` (``STATE``); robots
+  subscribe asking for none (``STATE_INPUT``), so they hear any publisher of poses and
+  neighbours, a localisation system or range-sensor driver with the ROS default QoS too. A
+  robot notices a silent plant by its watchdog instead (``input_timeout``, 0.5 s by default:
+  it publishes zero and its ``/diagnostics`` says so).
 * Clock (``/clock``): reliable, keep last 1; it matches rclpy's best-effort time source and
   reliable subscribers such as a recorder.
 * Diagnostics (``/diagnostics``): reliable, keep last 10, volatile, as diagnostic tools expect.
@@ -20,20 +26,38 @@ Quality of service of every formation topic, in one place.
 The recorder subscribes with the publishers' reliability and durability but a deep history
 (:func:`recording`): a sample that waits a moment for a busy recorder is stored, not
 overwritten by the next one.
+
+Matching: a subscriber that asks for a liveliness lease only matches publishers that offer
+at most that lease, and only a subscriber that asks for one is told when a publisher's lease
+runs out. The plant asks for the lease on every ``cmd_vel`` (robots offer it), so a robot whose
+process died or whose link was cut shows as lost within the lease; a ``cmd_vel`` publisher
+with the ROS default (no lease), e.g. ``ros2 topic pub`` without ``--qos-liveliness automatic
+--qos-liveliness-lease-duration 1``, does not reach the plant. The recorder and tools such as
+``ros2 topic echo`` ask for no lease (infinite) and match any publisher.
 """
 
 from formation_ros.ros.topics import QosKind
-from rclpy.qos import DurabilityPolicy, HistoryPolicy, QoSProfile, ReliabilityPolicy
+from rclpy.duration import Duration
+from rclpy.qos import (DurabilityPolicy, HistoryPolicy, LivelinessPolicy, QoSProfile,
+                       ReliabilityPolicy)
+
+LIVELINESS_LEASE = 1.0
+"""Liveliness lease of commands and states, s: a dead peer is noticed within it."""
 
 
-def _profile(depth, reliability, durability):
+def _profile(depth, reliability, durability, lease=None):
+    if lease is None:
+        return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=depth,
+                          reliability=reliability, durability=durability)
     return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=depth, reliability=reliability,
-                      durability=durability)
+                      durability=durability, liveliness=LivelinessPolicy.AUTOMATIC,
+                      liveliness_lease_duration=Duration(seconds=lease))
 
 
-COMMAND = _profile(10, ReliabilityPolicy.RELIABLE, DurabilityPolicy.VOLATILE)
+COMMAND = _profile(10, ReliabilityPolicy.RELIABLE, DurabilityPolicy.VOLATILE, LIVELINESS_LEASE)
 REFERENCE = _profile(10, ReliabilityPolicy.RELIABLE, DurabilityPolicy.TRANSIENT_LOCAL)
-STATE = _profile(1, ReliabilityPolicy.BEST_EFFORT, DurabilityPolicy.VOLATILE)
+STATE = _profile(1, ReliabilityPolicy.BEST_EFFORT, DurabilityPolicy.VOLATILE, LIVELINESS_LEASE)
+STATE_INPUT = _profile(1, ReliabilityPolicy.BEST_EFFORT, DurabilityPolicy.VOLATILE)
 CLOCK = _profile(1, ReliabilityPolicy.RELIABLE, DurabilityPolicy.VOLATILE)
 DIAGNOSTICS = _profile(10, ReliabilityPolicy.RELIABLE, DurabilityPolicy.VOLATILE)
 MARKERS = _profile(1, ReliabilityPolicy.RELIABLE, DurabilityPolicy.TRANSIENT_LOCAL)
@@ -45,6 +69,10 @@ RECORDING_DEPTH = 1000
 
 
 def recording(profile: QoSProfile) -> QoSProfile:
-    """Return ``profile`` with the recorder's deep history (same reliability and durability)."""
+    """
+    Return ``profile`` with the recorder's deep history (same reliability and durability).
+
+    It asks for no liveliness lease, so it matches every publisher, whatever lease it offers.
+    """
     return _profile(max(profile.depth, RECORDING_DEPTH), profile.reliability,
                     profile.durability)

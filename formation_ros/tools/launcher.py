@@ -28,7 +28,7 @@ import signal
 import subprocess
 import sys
 import time
-from typing import Mapping, Optional, Sequence, TextIO
+from typing import Callable, Mapping, Optional, Sequence, TextIO
 
 from formation_ros.tools.supervise import describe_returncode, ProcessSpec, Supervisor
 
@@ -42,11 +42,16 @@ MAX_RESTARTS = 5
 ESSENTIAL = ('plant', 'reference', 'record')
 LAUNCHER_PID_ENV = 'FORMATION_LAUNCHER_PID'
 LAUNCHER_START_ENV = 'FORMATION_LAUNCHER_START'
+DISCOVERY = ('localhost', 'subnet')
+DISCOVERY_ENV = 'ROS_AUTOMATIC_DISCOVERY_RANGE'
+DOMAIN_ENV = 'ROS_DOMAIN_ID'
+MAX_DOMAIN_ID = 232
 
 USAGE = """\
 Usage: scripts/launch_formation.sh PARAMS.yaml [--duration S] [--out DIR] [--record DIR]
                                    [--on-exit continue|stop|respawn]
                                    [--robots-per-process K] [--prefix DIR]
+                                   [--discovery localhost|subnet] [--domain-id N]
 
 Starts the plant, the reference node and N robot nodes (N = num_robots in PARAMS.yaml), robot i
 in namespace /robot_<i>, all with the same parameters file, the reference node on the plant's
@@ -80,6 +85,15 @@ Options:
                  --on-exit, a fleet process counts as its robots: respawn restarts all of them
   --prefix DIR   install space of formation_ros (default: found from 'ros2', AMENT_PREFIX_PATH
                  or ./install/formation_ros)
+  --discovery RANGE
+                 how far the nodes look for each other (sets ROS_AUTOMATIC_DISCOVERY_RANGE
+                 in their environment): localhost: this computer only; subnet: every
+                 computer on the local network (needed when nodes run on several
+                 machines). Default: ROS_AUTOMATIC_DISCOVERY_RANGE as set in the
+                 environment, else localhost
+  --domain-id N  ROS 2 domain of the nodes, 0 to 232 (sets ROS_DOMAIN_ID; 0 to 101 is the
+                 range that is safe on every Linux machine). Default: ROS_DOMAIN_ID as set
+                 in the environment, else 0
   -h, --help     show this help
 
 Executables: 'ros2 run formation_ros <exe>' where the ros2 command knows the package, else
@@ -125,13 +139,16 @@ class Options:
     prefix: Optional[str] = None
     on_exit: str = 'continue'
     robots_per_process: int = 1
+    discovery: Optional[str] = None
+    domain_id: Optional[int] = None
 
 
 def parse_args(argv: Sequence[str]) -> Optional[Options]:
     """Parse the command line as the shell launcher always has; None for --help."""
     needs = {'duration': 'seconds', 'out': 'a directory', 'record': 'a directory',
              'prefix': 'a directory', 'on-exit': '|'.join(ON_EXIT),
-             'robots-per-process': 'a number of robots'}
+             'robots-per-process': 'a number of robots', 'discovery': '|'.join(DISCOVERY),
+             'domain-id': 'a number'}
     values: dict[str, Optional[str]] = dict.fromkeys(needs)
     params = None
     args = list(argv)
@@ -163,9 +180,38 @@ def parse_args(argv: Sequence[str]) -> Optional[Options]:
     if not re.fullmatch(r'[1-9][0-9]*', per_process):
         raise UsageError('--robots-per-process must be a whole number >= 1, '
                          f"got '{per_process}'")
+    discovery = values['discovery']
+    if discovery is not None and discovery not in DISCOVERY:
+        raise UsageError(f"--discovery must be one of {', '.join(DISCOVERY)}, got '{discovery}'")
+    domain_id = values['domain-id']
+    if domain_id is not None and not (re.fullmatch(r'[0-9]{1,3}', domain_id)
+                                      and int(domain_id) <= MAX_DOMAIN_ID):
+        raise UsageError(f'--domain-id must be a whole number from 0 to {MAX_DOMAIN_ID}, '
+                         f"got '{domain_id}'")
     prefix = values['prefix'] or os.environ.get('FORMATION_PREFIX') or None
     return Options(params, None if duration is None else float(duration), values['out'],
-                   values['record'], prefix, on_exit, int(per_process))
+                   values['record'], prefix, on_exit, int(per_process), discovery,
+                   None if domain_id is None else int(domain_id))
+
+
+def discovery_environment(options: Options, base: Mapping[str, str]) -> dict[str, str]:
+    """
+    Return ``base`` with the nodes' discovery range and domain set as ``options`` say.
+
+    ``--discovery`` sets ROS_AUTOMATIC_DISCOVERY_RANGE (LOCALHOST or SUBNET) and drops the
+    deprecated ROS_LOCALHOST_ONLY, which would contradict it; without it a range already in
+    ``base`` is kept, and LOCALHOST is set where there is none (so a run on one computer stays
+    there; ROS's own default is SUBNET). ``--domain-id`` sets ROS_DOMAIN_ID.
+    """
+    env = dict(base)
+    if options.discovery is not None:
+        env[DISCOVERY_ENV] = options.discovery.upper()
+        env.pop('ROS_LOCALHOST_ONLY', None)
+    elif not env.get(DISCOVERY_ENV):
+        env[DISCOVERY_ENV] = 'LOCALHOST'
+    if options.domain_id is not None:
+        env[DOMAIN_ENV] = str(options.domain_id)
+    return env
 
 
 def check_paths(options: Options) -> Options:
@@ -302,7 +348,7 @@ class Launch:
         self.install = install
         self.num_robots = num_robots
         self.wall_seconds = wall_seconds
-        self.env = install.environment(os.environ)
+        self.env = discovery_environment(options, install.environment(os.environ))
         self.env.update(watch_environment(os.getpid()))
         self.supervisor = Supervisor(echo=sys.stdout, env=self.env)
         self.interrupted: Optional[str] = None
@@ -375,9 +421,13 @@ class Launch:
             if self._died(left):
                 return
 
+    def place(self, spec: ProcessSpec) -> ProcessSpec:
+        """Return the spec to start for node ``spec`` (itself; hosts.py runs it elsewhere)."""
+        return spec
+
     def _start(self, spec: ProcessSpec) -> bool:
         try:
-            self.supervisor.start(spec)
+            self.supervisor.start(self.place(spec))
         except OSError as exc:
             self.failure = f'cannot start {spec.name}: {exc}'
             return False
@@ -463,19 +513,25 @@ def say(message: str, stream: Optional[TextIO] = None) -> None:
         pass
 
 
-def main(argv: Optional[Sequence[str]] = None) -> int:
-    """Run the launcher with ``argv`` (default: the command line); return the exit code."""
+def main(argv: Optional[Sequence[str]] = None, make: Optional[Callable[..., 'Launch']] = None,
+         usage: str = USAGE) -> int:
+    """
+    Run the launcher with ``argv`` (default: the command line); return the exit code.
+
+    make: the class of the run (default :class:`Launch`; ``formation_ros.tools.hosts`` runs
+    the nodes on several hosts with a subclass), usage: the text of ``--help``.
+    """
     try:
         options = parse_args(sys.argv[1:] if argv is None else argv)
         if options is None:
-            print(USAGE, end='')
+            print(usage, end='')
             return 0
         options = check_paths(options)
         install = find_install(options.prefix, os.environ)
         num_robots, wall_seconds = read_parameters(options.params)
     except UsageError as exc:
         if exc.args[0] is None:
-            print(USAGE, end='', file=sys.stderr)
+            print(usage, end='', file=sys.stderr)
         else:
             say(exc.args[0])
         return 2
@@ -492,9 +548,11 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     per_process = options.robots_per_process
     processes = ('' if per_process == 1 else
                  f' in {-(-num_robots // per_process)} fleet processes of up to {per_process}')
-    say(f'{num_robots} robots{processes} from {options.params} ({install.describe()}), {span}',
-        sys.stdout)
-    return Launch(options, install, num_robots, wall_seconds).run()
+    network = discovery_environment(options, os.environ)
+    say(f'{num_robots} robots{processes} from {options.params} ({install.describe()}), {span}; '
+        f"ROS_DOMAIN_ID {network.get(DOMAIN_ENV) or '0'}, discovery "
+        f'{network[DISCOVERY_ENV].lower()}', sys.stdout)
+    return (make or Launch)(options, install, num_robots, wall_seconds).run()
 
 
 def _ros2_knows_package(env: Mapping[str, str]) -> bool:
