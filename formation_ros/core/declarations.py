@@ -73,6 +73,20 @@ class JumpKind(Choice):
     SMOOTH = 'smooth'
 
 
+class BodyKind(Choice):
+    """The robots' bodies: ``body.kind``."""
+
+    POINT = 'point'
+    UNICYCLE = 'unicycle'
+
+
+class PoseType(Choice):
+    """The message a robot reads its own pose from: ``pose_type``."""
+
+    POSE_STAMPED = 'pose_stamped'
+    ODOMETRY = 'odometry'
+
+
 class ReferenceKind(Choice):
     """Desired formation trajectory: ``reference.kind``."""
 
@@ -180,6 +194,24 @@ DECLARATIONS = (
     Param('formation.vertices', Kind.DOUBLE_ARRAY, REQUIRED,
           "Flat list of num_robots x dim values: robot i's place in the formation frame, m.",
           low=at_least(-LENGTH_LIMIT), high=at_least(LENGTH_LIMIT)),
+    Param('body.kind', Kind.STRING, BodyKind.POINT.value,
+          "The robots' bodies: 'point' (q' = u, eq. 1) or 'unicycle' (differential drive, "
+          'commanded with (v, w) through a hand point; dim 2 only).', choices=_choices(BodyKind)),
+    Param('body.hand_distance', Kind.DOUBLE, None,
+          'Unicycles: distance l of the hand point ahead of the axle centre, m (the law acts '
+          'on the hand points).', low=above(0.0), high=at_least(LENGTH_LIMIT)),
+    Param('body.radius', Kind.DOUBLE, 0.0,
+          'Radius of a body about its position (the axle centre of a unicycle), m: two bodies '
+          'closer than twice this are logged as a collision.', low=at_least(0.0),
+          high=at_least(LENGTH_LIMIT), users=START),
+    Param('body.max_linear', Kind.DOUBLE, None,
+          'Unicycles: actuator limit on |v|, m/s; a file whose bound sqrt(2) c M1 '
+          'exceeds it is refused, and the plant clips |v| to it.', low=above(0.0),
+          high=at_least(SPEED_LIMIT), users=START),
+    Param('body.max_angular', Kind.DOUBLE, None,
+          'Unicycles: actuator limit on |w|, rad/s; a file whose bound '
+          'sqrt(2) c M1 / l exceeds it is refused, and the plant clips |w| to it.',
+          low=above(0.0), high=at_least(SPEED_LIMIT), users=START),
     Param('start.positions', Kind.DOUBLE_ARRAY, None,
           'Flat list of num_robots x dim start positions, m (or use start.random_*).',
           low=at_least(-LENGTH_LIMIT), high=at_least(LENGTH_LIMIT), users=START),
@@ -188,6 +220,10 @@ DECLARATIONS = (
           high=at_least(LENGTH_LIMIT), users=START),
     Param('start.min_separation', Kind.DOUBLE, None,
           'Random start: smallest distance between two robots, m.', low=above(0.0),
+          high=at_least(LENGTH_LIMIT), users=START),
+    Param('start.headings', Kind.DOUBLE_ARRAY, None,
+          'Unicycles: num_robots start headings, rad, counter-clockwise from +x (default: random '
+          'with a random start, else 0).', low=at_least(-LENGTH_LIMIT),
           high=at_least(LENGTH_LIMIT), users=START),
     Param('start.seed', Kind.INT, 0, 'Random start: seed of the random generator.',
           low=at_least(0), high=at_least(2 ** 31 - 1), users=START),
@@ -220,6 +256,11 @@ DECLARATIONS = (
     Param('input_timeout', Kind.DOUBLE, 0.5,
           'A robot publishes zero when no new pose, neighbours or reference arrived for this '
           'long, s (wall clock; not in lockstep).', low=above(0.0), users=ROBOT),
+    Param('pose_type', Kind.STRING, PoseType.POSE_STAMPED.value,
+          "Message type of a robot's 'pose' topic: 'pose_stamped' (geometry_msgs/PoseStamped, "
+          "what the plant publishes) or 'odometry' (nav_msgs/Odometry, e.g. a real base's "
+          'localisation, remapped onto pose).', choices=_choices(PoseType),
+          users=frozenset({Exe.ROBOT})),
     Param('wait_for_subscribers', Kind.INT, 1,
           'A robot sends its first command only once cmd_vel has this many subscribers (the '
           'plant; 2 when a recorder listens too).', low=at_least(0), high=at_least(1000),

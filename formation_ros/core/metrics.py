@@ -112,3 +112,28 @@ def compute_metrics(t: ArrayLike, q: ArrayLike, u: ArrayLike, u_hat: ArrayLike,
     }
     metrics.update(extra or {})
     return metrics
+
+
+def body_metrics(q_body: ArrayLike, body_command: ArrayLike, u_bound: float,
+                 hand_distance: float, body_radius: float) -> dict[str, Any]:
+    """
+    Return the metrics.json keys of a unicycle run (docs/equations.md, U5 and U6).
+
+    q_body: (T, N, 2) axle centres, m; body_command: (T, N, 2) (v, w) held, m/s and rad/s;
+    u_bound: c * M1, m/s; hand_distance: l, m; body_radius: m. ``v_bound`` and
+    ``omega_bound`` are sqrt(2) c M1 and sqrt(2) c M1 / l, what the law's bounded part can ask
+    for; ``min_body_distance`` is the closest approach of two axle centres (bodies touch
+    below twice the radius).
+    """
+    commands = np.asarray(body_command, dtype=float)
+    v_bound = math.sqrt(2.0) * u_bound
+    return {
+        'body_kind': 'unicycle',
+        'hand_distance': float(hand_distance),
+        'body_radius': float(body_radius),
+        'min_body_distance': float(np.min(dis_min_series(q_body))),
+        'max_abs_v': float(np.max(np.abs(commands[..., 0]))),
+        'max_abs_omega': float(np.max(np.abs(commands[..., 1]))),
+        'v_bound': v_bound,
+        'omega_bound': v_bound / hand_distance,
+    }

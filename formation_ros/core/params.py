@@ -17,16 +17,22 @@ from dataclasses import dataclass, field
 import math
 from typing import Any, Dict, List, Mapping, Optional, Tuple, Union
 
-from formation_ros.core.declarations import (check_values, Exe, JumpKind, ParamError, PsiKind,
-                                             ReferenceKind)
-from formation_ros.core.law import LawParams, make_law
+from formation_ros.core.bodies import BodySettings, POINT_BODY, random_headings
+from formation_ros.core.declarations import (BodyKind, check_values, Exe, JumpKind, ParamError,
+                                             PoseType, PsiKind, ReferenceKind)
+from formation_ros.core.frames import desired_positions, from_frame_velocity
+from formation_ros.core.law import LawParams, make_law, PSI_FUNCTIONS
 from formation_ros.core.params_file import load_params_file, PathText
 from formation_ros.core.plant import NS_PER_S, start_positions, StartSpec
 from formation_ros.core.reference import Reference
+from formation_ros.core.unicycle import hand_points
 import numpy as np
 from numpy.typing import NDArray
 
 Problems = List[Tuple[str, str]]
+TRACKING_SAMPLES = 721
+HAND_POINTS_APART = 1e-9
+"""Hand points closer than this at the start (m) are one point: the law has no direction."""
 
 
 @dataclass(frozen=True)
@@ -68,6 +74,7 @@ class RobotSettings:
     control_rate: float
     input_timeout: float
     wait_for_subscribers: int
+    pose_type: PoseType = PoseType.POSE_STAMPED
 
 
 @dataclass(frozen=True)
@@ -96,6 +103,8 @@ class FormationConfig:
     plant and the recorder; None for the others), reference_origin (dim,), reference_velocity
     (dim,). plant / robot / reference_node / recorder: the executable's own settings (None for
     the others). values: the flat checked values with defaults (to write back as a file).
+    body: the robots' bodies (``body.*``); start_headings: (N,) start headings in rad of
+    unicycles (for the executables that get a start; None for point bodies).
     """
 
     num_robots: int
@@ -122,6 +131,8 @@ class FormationConfig:
     reference_node: Optional[ReferenceSettings] = None
     recorder: Optional[RecorderSettings] = None
     values: Dict[str, Any] = field(default_factory=dict, repr=False)
+    body: BodySettings = POINT_BODY
+    start_headings: Optional[NDArray[np.float64]] = None
 
     def law(self) -> LawParams:
         """Return the control law constants (``core.law.LawParams``)."""
@@ -224,6 +235,120 @@ def _reference_problems(values: Mapping[str, Any], dim: int, problems: Problems)
         problems.append(('reference.speed', f'must be > 0 for a {kind.value}'))
 
 
+def _down(value: float) -> float:
+    """Round down to 4 significant digits (a gain suggested as fitting must fit)."""
+    scale = 10.0 ** (math.floor(math.log10(value)) - 3)
+    return math.floor(value / scale) * scale
+
+
+def _up(value: float) -> float:
+    """Round up to 4 significant digits."""
+    scale = 10.0 ** (math.floor(math.log10(value)) - 3)
+    return math.ceil(value / scale) * scale
+
+
+def _body(values: Mapping[str, Any], dim: int, problems: Problems) -> BodySettings:
+    """Check ``body.*`` and build the :class:`BodySettings` (docs/equations.md, U5)."""
+    kind = BodyKind(values['body.kind'])
+    l_value = values.get('body.hand_distance')
+    if kind is BodyKind.POINT:
+        for name in ('body.hand_distance', 'body.max_linear', 'body.max_angular',
+                     'start.headings'):
+            if values.get(name) is not None:
+                problems.append((name, 'applies only to body.kind unicycle'))
+        return BodySettings(radius=values.get('body.radius', 0.0))
+    if dim != 2:
+        problems.append(('body.kind', f'unicycle needs dim 2 (a differential-drive robot moves '
+                                      f'in the plane), got dim {dim}'))
+    if values.get('plant.max_speed', 0.0) > 0.0:
+        problems.append(('plant.max_speed', 'is for point bodies; give unicycles '
+                                            'body.max_linear and body.max_angular'))
+    if l_value is None:
+        problems.append(('body.hand_distance', 'is required for body.kind unicycle (l > 0, m)'))
+        return BodySettings(kind=kind, hand_distance=1.0)
+    psi_bound = PSI_FUNCTIONS[values['controller.psi']][1]
+    gain = values['controller.gain']
+    v_bound = math.sqrt(2.0) * gain * psi_bound
+    max_linear, max_angular = values.get('body.max_linear'), values.get('body.max_angular')
+    if max_linear is not None and v_bound > max_linear:
+        problems.append(('body.max_linear', f'the law bound sqrt(2) c M1 = {v_bound:.4g} m/s '
+                                            f'exceeds body.max_linear = {max_linear:g} m/s: '
+                                            'controller.gain <= '
+                                            f'{_down(max_linear / (math.sqrt(2.0) * psi_bound)):g}'
+                                            ' would fit'))
+    if max_angular is not None and v_bound / l_value > max_angular:
+        fit_gain = _down(max_angular * l_value / (math.sqrt(2.0) * psi_bound))
+        problems.append(('body.max_angular', 'the law bound sqrt(2) c M1 / l = '
+                                             f'{v_bound / l_value:.4g} rad/s exceeds '
+                                             f'body.max_angular = {max_angular:g} rad/s: '
+                                             f'controller.gain <= {fit_gain:g} or '
+                                             'body.hand_distance >= '
+                                             f'{_up(v_bound / max_angular):g} m would fit'))
+    return BodySettings(kind=kind, hand_distance=l_value, radius=values.get('body.radius', 0.0),
+                        max_linear=max_linear, max_angular=max_angular)
+
+
+def _tracking_problems(body: BodySettings, vertices: NDArray[np.float64],
+                       reference: Reference, duration: float, problems: Problems) -> None:
+    """
+    Refuse a moving formation whose vertices need more speed than ``body.max_linear``.
+
+    At the formation each hand point moves with its vertex, at the feed-forward of eq. (25)
+    (``from_frame_velocity`` with u_hat = 0); |v| is at least that speed, so no gain can make a
+    unicycle slower than its vertex. Sampled at 721 times over the run.
+    """
+    if body.max_linear is None or reference.is_stationary:
+        return
+    fastest = 0.0
+    for t in np.linspace(0.0, duration, TRACKING_SAMPLES):
+        frame = reference.sample(float(t))
+        speeds = np.linalg.norm(from_frame_velocity(np.zeros_like(vertices),
+                                                    desired_positions(vertices, frame), frame),
+                                axis=1)
+        fastest = max(fastest, float(np.max(speeds)))
+    if fastest > body.max_linear:
+        problems.append(('body.max_linear', f'the formation moves its vertices at up to '
+                                            f'{fastest:.4g} m/s along this reference, more '
+                                            f'than body.max_linear = {body.max_linear:g} m/s: '
+                                            'a reference '
+                                            f'{_up(fastest / body.max_linear):g} times slower '
+                                            '(or vertices nearer its path) would fit'))
+
+
+def _headings(values: Mapping[str, Any], body: BodySettings, n: int,
+              problems: Problems) -> Optional[NDArray[np.float64]]:
+    """Start headings of unicycles: given, random with a random start, else 0."""
+    if not body.is_unicycle:
+        return None
+    given = values.get('start.headings')
+    if given is not None:
+        if len(given) != n:
+            problems.append(('start.headings', f'must hold num_robots = {n} values, '
+                                               f'got {len(given)}'))
+            return np.zeros(n)
+        return np.array(given, dtype=float)
+    if values.get('start.positions') is None:
+        return random_headings(n, values['start.seed'])
+    return np.zeros(n)
+
+
+def _body_geometry(body: BodySettings, start: NDArray[np.float64],
+                   headings: Optional[NDArray[np.float64]], problems: Problems) -> None:
+    """Bodies must not overlap at the start, nor two hand points coincide."""
+    if len(start) < 2:
+        return
+    gap, i, j = _closest_pair(start)
+    if body.radius > 0.0 and gap < 2.0 * body.radius:
+        problems.append(('body.radius', f'bodies of radius {body.radius:g} m overlap at the '
+                                        f'start: robots {i} and {j} are {gap:g} m apart '
+                                        f'(< 2 x {body.radius:g} m)'))
+    if headings is not None and body.is_unicycle:
+        gap, i, j = _closest_pair(hand_points(start, headings, body.hand_distance))
+        if gap < HAND_POINTS_APART:
+            problems.append(('start.headings', f'robots {i} and {j} start with their hand '
+                                               f'points at the same point ({gap:.3g} m apart)'))
+
+
 def _own_settings(values: Mapping[str, Any], exe: Exe, n: int,
                   problems: Problems) -> Dict[str, Any]:
     """Build the executable's own settings object, as keyword arguments of FormationConfig."""
@@ -247,7 +372,8 @@ def _own_settings(values: Mapping[str, Any], exe: Exe, n: int,
         return {'robot': RobotSettings(
             robot_id=values['robot_id'], control_rate=values['control_rate'],
             input_timeout=values['input_timeout'],
-            wait_for_subscribers=values['wait_for_subscribers'])}
+            wait_for_subscribers=values['wait_for_subscribers'],
+            pose_type=PoseType(values['pose_type']))}
     if exe is Exe.REFERENCE:
         return {'reference_node': ReferenceSettings(
             rate=values['reference.rate'], step_ns=int(round(NS_PER_S / values['plant.rate'])))}
@@ -285,6 +411,14 @@ def validate(raw: Mapping[str, Any], executable: Union[Exe, str] = Exe.SIM) -> F
     origin = _vector(values, 'reference.origin', dim, problems)
     velocity = _vector(values, 'reference.velocity', dim, problems)
     own = _own_settings(values, exe, n, problems)
+    body = _body(values, dim, problems)
+    headings = _headings(values, body, n, problems) if start is not None else None
+    if start is not None and not problems:
+        _body_geometry(body, start, headings, problems)
+    if body.is_unicycle and vertices is not None and not problems:
+        _tracking_problems(body, vertices, Reference(
+            values['reference.kind'], dim, origin, velocity, values['reference.radius'],
+            values['reference.speed'], values['reference.pitch']), values['duration'], problems)
     if problems or vertices is None:
         raise ParamError(problems)
     return FormationConfig(
@@ -296,7 +430,7 @@ def validate(raw: Mapping[str, Any], executable: Union[Exe, str] = Exe.SIM) -> F
         reference_velocity=velocity, reference_radius=values['reference.radius'],
         reference_speed=values['reference.speed'], reference_pitch=values['reference.pitch'],
         duration=values['duration'], lockstep=values.get('plant.lockstep', False),
-        values=values, **own)
+        values=values, body=body, start_headings=headings, **own)
 
 
 def load_config(path: PathText,

@@ -5,7 +5,10 @@
 The robots' bodies and sensors, without ROS: one model for ``formation_sim --dt`` and the plant.
 
 Bodies are single integrators, q_i' = u_i (eq. 1), stepped with zero-order hold: the command
-admitted for a robot is held over the step, ``q(t + dt) = q(t) + dt u``. Time is kept in integer
+admitted for a robot is held over the step, ``q(t + dt) = q(t) + dt u``; or differential-drive
+unicycles commanded with (v, w) through their hand points, stepped exactly over the step
+(``core.bodies``, ``core.unicycle``: everything that depends on the kind of body is there, and
+the law acts on the bodies' control points: q itself, or the hand points). Time is kept in integer
 nanoseconds, as message stamps are, so the simulator and the plant node step through exactly the
 same instants.
 
@@ -16,16 +19,20 @@ Each step the model
   ``input_timeout`` old (else ``STALE``) and not newer than the present state (else
   ``FUTURE``); a command that does not count is replaced by zero. One that counts but asks for
   more than the law can produce is clipped (``SATURATED``): its bounded part u_hat of eq. (14)
-  (recovered through eq. (25) for a moving reference) to c M1, and every world component to
-  ``max_speed`` when that is set;
+  (recovered through eq. (25) for a moving reference; for a unicycle from the velocity its
+  (v, w) gives its hand point at the heading of the state it answers) to c M1, then to the
+  actuator caps: every world component to ``max_speed`` when that is set (points), |v| and |w| to
+  ``body.max_linear`` and ``body.max_angular`` (unicycles);
 * audits the bound (:meth:`PlantModel.advance`): a new command above c M1 is counted once and
   reported;
-* integrates and checks collisions: a pair closer than ``collision_distance`` is counted once
-  when it comes closer;
-* senses (:meth:`PlantModel.neighbours`): what each robot's range sensor sees, the other robots
-  strictly within its R_i, from one k-d tree per step.
+* integrates and checks collisions: a pair of bodies closer than ``collision_distance`` (or
+  twice the body radius) is counted once when it comes closer;
+* senses (:meth:`PlantModel.neighbours`): what each robot's range sensor sees, the other bodies
+  strictly within its R_i (R_i + 2 l for unicycles, so that it sees every hand point within R_i
+  of its own), from one k-d tree per step.
 
-Positions are rows: ``q`` has shape (N, dim), in m; commands (N, dim) in m/s.
+Positions are rows: ``q`` has shape (N, dim), in m; headings (N,) in rad; commands (N, dim) in m/s
+for points, (N, 2) holding (v, w) in m/s and rad/s for unicycles.
 """
 
 from collections import OrderedDict
@@ -33,6 +40,7 @@ from dataclasses import dataclass, field
 import enum
 from typing import Dict, List, Optional, Set, Tuple, TYPE_CHECKING
 
+from formation_ros.core.bodies import Bodies, PointBodies
 from formation_ros.core.frames import from_frame_velocity, to_frame_velocity
 from formation_ros.core.law import LawParams
 from formation_ros.core.reference import Reference
@@ -103,14 +111,17 @@ class Admission:
     """
     What counts for one step.
 
-    u: (N, dim) commands held over the step, m/s; status: (N,) :class:`CommandStatus` codes;
-    largest_u_hat: (N,) largest |u_hat| component of each command as sent (0 where it did not
-    count), m/s.
+    u: (N, dim) commands held over the step, m/s ((N, 2) (v, w) for unicycles); status: (N,)
+    :class:`CommandStatus` codes; largest_u_hat: (N,) largest |u_hat| component of each command
+    as sent (0 where it did not count), m/s; velocity: (N, dim) the control-point velocity each
+    held command stands for, world frame, m/s: ``u`` itself for points, R(th) (v, l w) at the
+    heading of the state it answers for unicycles (what the robot's law asked for).
     """
 
     u: NDArray[np.float64]
     status: NDArray[np.int8]
     largest_u_hat: NDArray[np.float64]
+    velocity: NDArray[np.float64]
 
     @property
     def counted(self) -> NDArray[np.bool_]:
@@ -125,10 +136,12 @@ class StepReport:
     """
     One step: the state it started from and what happened.
 
-    t_ns, q: time and positions (N, dim) before the step; admission: the commands held over it;
-    violations: (robot index, largest |u_hat| component in m/s) of new commands above the
-    bound; collisions: (i, j, distance in m) of pairs that came closer than the collision
-    distance during the step (indices 0-based, i < j).
+    t_ns, q: time and body positions (N, dim) before the step; admission: the commands held
+    over it; violations: (robot index, largest |u_hat| component in m/s) of new commands above
+    the bound; collisions: (i, j, distance in m) of pairs of bodies that came closer than the
+    collision distance during the step (indices 0-based, i < j); points, heading: the control
+    points (N, dim; q itself for points, the hand points of unicycles) and headings (N,) before
+    the step.
     """
 
     t_ns: int
@@ -136,6 +149,8 @@ class StepReport:
     admission: Admission
     violations: List[Tuple[int, float]]
     collisions: List[Tuple[int, int, float]]
+    points: NDArray[np.float64]
+    heading: NDArray[np.float64]
 
 
 @dataclass
@@ -317,17 +332,28 @@ class PlantModel:
     control law constants (for the bound c M1); reference: the desired trajectory (to recover
     u_hat when auditing the bound); input_timeout_ns: the oldest state stamp a command may
     answer; collision_distance: m; max_speed: cap on every world command component, m/s (0:
-    none beyond the law's own bound); pair_radius: with a value of at least the collision
-    distance (``formation_sim`` gives the law's b), the model keeps every pair within it of each
-    new state (:attr:`pairs`, for the law) and checks collisions among them instead of
-    searching the tree a second time.
+    none beyond the law's own bound), for point bodies built here. bodies: the kind of body
+    (``core.bodies``; default points with ``max_speed``); headings: (N,) start headings, rad
+    (default 0). pair_radius: with a value > 0 (``formation_sim`` gives the law's b), the model
+    keeps every pair of control points within it of each new state (:attr:`pairs`, for the law)
+    and, for points when it is at least the collision distance, checks collisions among them
+    instead of searching the tree a second time.
+
+    Public state: ``q`` (N, dim) body positions, ``heading`` (N,), ``points`` (N, dim) the
+    control points the law acts on, ``tree`` a k-d tree of ``points`` and ``body_tree`` one of
+    ``q`` (the same object for points).
     """
 
     def __init__(self, start: ArrayLike, sensing_radii: ArrayLike, step_ns: int,
                  law: LawParams, reference: Reference, input_timeout_ns: int,
-                 collision_distance: float, max_speed: float = 0.0, pair_radius: float = 0.0):
-        """Place the robots at ``start`` at time 0."""
+                 collision_distance: float, max_speed: float = 0.0,
+                 bodies: Optional[Bodies] = None, headings: Optional[ArrayLike] = None,
+                 pair_radius: float = 0.0):
+        """Place the robots at ``start`` (and ``headings``) at time 0."""
+        self.body: Bodies = PointBodies(max_speed) if bodies is None else bodies
         self.q = np.array(start, dtype=float)
+        self.heading = (np.zeros(len(self.q)) if headings is None
+                        else np.array(headings, dtype=float))
         self.radii = np.array(sensing_radii, dtype=float)
         self.num_robots, self.dim = self.q.shape
         if step_ns <= 0:
@@ -337,23 +363,32 @@ class PlantModel:
         self.reference = reference
         self.input_timeout_ns = int(input_timeout_ns)
         self.collision_distance = float(collision_distance)
+        self.contact_distance = max(self.collision_distance, self.body.contact_distance)
+        self.sensor_radii = self.radii + self.body.sensing_margin
         self.pair_radius = float(pair_radius)
         self.pairs: Optional[NDArray[np.intp]] = None
-        """(P, 2) pairs i < j within ``pair_radius`` of each other now (None without it)."""
+        """(P, 2) pairs i < j of control points within ``pair_radius`` now (None without it)."""
         self.max_speed = float(max_speed)
         self.bound_tolerance = (BOUND_TOLERANCE_FIXED if reference.is_stationary
                                 else BOUND_TOLERANCE_MOVING)
         self.t_ns = 0
         from scipy.spatial import cKDTree  # here: a robot imports this module, not the tree
         self._tree_type = cKDTree
-        self.tree = cKDTree(self.q)
+        self._moved()
         self.counts = PlantCounts(status_steps=np.zeros((len(CommandStatus), self.num_robots),
                                                         dtype=np.int64))
-        self._states: 'OrderedDict[int, NDArray[np.float64]]' = OrderedDict([(0, self.q)])
+        self._states: 'OrderedDict[int, NDArray[np.float64]]' = OrderedDict([(0, self.points)])
+        self._headings: 'OrderedDict[int, NDArray[np.float64]]' = OrderedDict([(0, self.heading)])
         self._states_kept = min(MAX_STATES_KEPT, 2 + self.input_timeout_ns // self.step_ns)
         self._audited = np.full(self.num_robots, -1, dtype=np.int64)
         self._robots = np.arange(self.num_robots)
         self._colliding = self._close_pairs()
+
+    def _moved(self) -> None:
+        """Update the control points and the k-d trees after the bodies moved."""
+        self.points = self.body.control_points(self.q, self.heading)
+        self.tree = self._tree_type(self.points)
+        self.body_tree = self.tree if self.points is self.q else self._tree_type(self.q)
 
     @property
     def t(self) -> float:
@@ -386,13 +421,47 @@ class PlantModel:
         u = np.where(counted[:, None], commands.u, 0.0)
         largest = np.zeros(self.num_robots)
         if np.any(counted):
-            self._saturate(u, commands.stamp_ns, counted, status, largest)
-        return Admission(u=u, status=status, largest_u_hat=largest)
+            velocity = self._saturate(u, commands.stamp_ns, counted, status, largest)
+        else:
+            velocity = self.body.world_velocity(u, self.heading)
+        return Admission(u=u, status=status, largest_u_hat=largest, velocity=velocity)
 
-    def _saturate(self, u: NDArray[np.float64], stamps: NDArray[np.int64],
+    def _saturate(self, command: NDArray[np.float64], stamps: NDArray[np.int64],
                   counted: NDArray[np.bool_], status: NDArray[np.int8],
-                  largest: NDArray[np.float64]) -> None:
-        """Clip the counted commands (in place) to the law's bound and to max_speed."""
+                  largest: NDArray[np.float64]) -> NDArray[np.float64]:
+        """
+        Clip the counted commands (in place) to the law's bound and to the actuator caps.
+
+        The bound applies to the velocity a command gives the control point (the command itself
+        for points; R(th) (v, l w) at the heading of the answered state for unicycles). Returns
+        those velocities after clipping, (N, dim) (``command`` itself for points).
+        """
+        body = self.body
+        heading = self._answered_headings(stamps, counted) if body.has_heading else self.heading
+        u = body.world_velocity(command, heading)
+        over = self._clip_to_law(u, stamps, counted, largest)
+        if u is not command and np.any(over):
+            command[over] = body.body_command(u[over], heading[over])
+        capped = body.cap(command, counted)
+        if u is not command and np.any(capped):
+            u[capped] = body.world_velocity(command[capped], heading[capped])
+        over |= capped
+        status[over] = CommandStatus.SATURATED
+        return u
+
+    def _answered_headings(self, stamps: NDArray[np.int64],
+                           counted: NDArray[np.bool_]) -> NDArray[np.float64]:
+        """Return each robot's heading at the state its command answers (N,)."""
+        heading = np.array(self.heading)
+        for stamp in np.unique(stamps[counted]):
+            rows = counted & (stamps == stamp)
+            heading[rows] = self._headings[self._state_key(int(stamp))][rows]
+        return heading
+
+    def _clip_to_law(self, u: NDArray[np.float64], stamps: NDArray[np.int64],
+                     counted: NDArray[np.bool_],
+                     largest: NDArray[np.float64]) -> NDArray[np.bool_]:
+        """Clip (in place) control-point velocities whose u_hat exceeds c M1; return which."""
         bound = self.law.u_bound
         limit = bound + self.bound_tolerance
         if self.reference.is_stationary:
@@ -413,32 +482,33 @@ class PlantModel:
                     u[index] = from_frame_velocity(np.clip(u_hat[clip], -bound, bound),
                                                    state[clip], frame)
                     over[index] = True
-        if self.max_speed > 0.0:
-            capped = counted & np.any(np.abs(u) > self.max_speed, axis=1)
-            u[capped] = np.clip(u[capped], -self.max_speed, self.max_speed)
-            over |= capped
-        status[over] = CommandStatus.SATURATED
+        return over
+
+    def _state_key(self, stamp_ns: int) -> int:
+        """Return the time of the kept state a command stamped ``stamp_ns`` answers."""
+        if stamp_ns in self._states:
+            return stamp_ns
+        earlier = [t for t in self._states if t <= stamp_ns]
+        return max(earlier) if earlier else next(iter(self._states))
 
     def _state_at(self, stamp_ns: int) -> NDArray[np.float64]:
-        """Return the state a command stamped ``stamp_ns`` answers (or the one before it)."""
-        state = self._states.get(stamp_ns)
-        if state is not None:
-            return state
-        earlier = [t for t in self._states if t <= stamp_ns]
-        return self._states[max(earlier)] if earlier else next(iter(self._states.values()))
+        """Return the control points of the state a command stamped ``stamp_ns`` answers."""
+        return self._states[self._state_key(stamp_ns)]
 
     def advance(self, commands: Commands) -> StepReport:
-        """Admit the commands, audit the bound, step q' = u over dt, check collisions."""
+        """Admit the commands, audit the bound, step the bodies over dt, check collisions."""
         admission = self.admit(commands)
         counted = admission.counted
         violations = self._audit(commands, admission, counted)
-        t_ns, q = self.t_ns, self.q
-        self.q = q + self.dt * admission.u
+        t_ns, q, points, heading = self.t_ns, self.q, self.points, self.heading
+        self.q, self.heading = self.body.step(q, heading, admission.u, self.dt)
         self.t_ns += self.step_ns
-        self.tree = self._tree_type(self.q)
-        self._states[self.t_ns] = self.q
+        self._moved()
+        self._states[self.t_ns] = self.points
+        self._headings[self.t_ns] = self.heading
         while len(self._states) > self._states_kept:
             self._states.popitem(last=False)
+            self._headings.popitem(last=False)
         counts = self.counts
         counts.steps += 1
         counts.status_steps[admission.status, self._robots] += 1
@@ -449,35 +519,56 @@ class PlantModel:
         counts.age_steps[age_bin] += 1
         collisions = self._new_collisions()
         counts.collisions += len(collisions)
-        return StepReport(t_ns, q, admission, violations, collisions)
+        return StepReport(t_ns, q, admission, violations, collisions, points, heading)
 
     def sensed_pairs(self) -> Tuple[NDArray[np.intp], NDArray[np.intp]]:
-        """Every robot's range sensor now: (observer, seen) pairs, see :func:`sensed_pairs`."""
-        return sensed_pairs(self.tree, self.q, self.radii)
+        """
+        Every robot's range sensor now: (observer, seen) pairs, see :func:`sensed_pairs`.
+
+        A sensor sees bodies, strictly within R_i for points and R_i + 2 l for unicycles
+        (``sensor_radii``), so that it sees every hand point within R_i of its own.
+        """
+        return sensed_pairs(self.body_tree, self.q, self.sensor_radii)
 
     def neighbours(self) -> List[NDArray[np.intp]]:
-        """Robot i's range sensor: indices of the other robots strictly within R_i, each sorted."""
+        """Robot i's range sensor: indices of the other bodies it sees, each sorted."""
         observer, seen = self.sensed_pairs()
         splits = np.searchsorted(observer, np.arange(1, self.num_robots))
         return np.split(seen, splits)
 
     def closest_pair_distance(self) -> float:
-        """Smallest distance between two robots now, m (inf for a single robot)."""
+        """Smallest distance between two control points now, m (inf for a single robot)."""
         if self.num_robots < 2:
             return float('inf')
-        distance, _ = self.tree.query(self.q, k=2)
+        distance, _ = self.tree.query(self.points, k=2)
+        return float(np.min(distance[:, 1]))
+
+    def closest_body_distance(self) -> float:
+        """Smallest distance between two body positions now, m (inf for a single robot)."""
+        if self.num_robots < 2:
+            return float('inf')
+        distance, _ = self.body_tree.query(self.q, k=2)
         return float(np.min(distance[:, 1]))
 
     def _close_pairs(self) -> Set[Tuple[int, int]]:
-        """Pairs within the collision distance now (and :attr:`pairs`, when they are kept)."""
-        if self.pair_radius > 0.0 and self.pair_radius >= self.collision_distance:
+        """
+        Pairs of bodies within the contact distance now (and :attr:`pairs`, when they are kept).
+
+        :attr:`pairs` are those of the control points (the law's); for points they are the
+        bodies' too, so the collisions are found among them when ``pair_radius`` reaches the
+        contact distance.
+        """
+        if self.pair_radius > 0.0:
             self.pairs = self.tree.query_pairs(self.pair_radius,
                                                output_type='ndarray').reshape(-1, 2)
+        if (self.pairs is not None and self.body_tree is self.tree
+                and self.pair_radius >= self.contact_distance):
             diff = self.q[self.pairs[:, 0]] - self.q[self.pairs[:, 1]]
             close = self.pairs[np.einsum('kd,kd->k', diff, diff)
-                               <= self.collision_distance ** 2].tolist()
+                               <= self.contact_distance ** 2].tolist()
         else:
-            close = self.tree.query_pairs(self.collision_distance, output_type='ndarray').tolist()
+            close = self.body_tree.query_pairs(self.contact_distance,
+                                               output_type='ndarray').tolist()
         return {(int(i), int(j)) for i, j in close}
 
     def _new_collisions(self) -> List[Tuple[int, int, float]]:

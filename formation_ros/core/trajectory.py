@@ -5,13 +5,15 @@
 
 from dataclasses import dataclass
 import os
-from typing import List, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from formation_ros.core.frames import desired_positions, FrameSample, to_frame_velocity
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 ARRAYS = ('t', 'q', 'u', 'u_hat', 'q_desired', 'q_od')
+BODY_ARRAYS = ('heading', 'q_body', 'body_command')
+"""Arrays of a unicycle run, beside :data:`ARRAYS` (which then describe the hand points)."""
 
 
 @dataclass(frozen=True)
@@ -22,6 +24,10 @@ class Trajectory:
     t: (T,) s; q, q_desired: (T, N, dim) m; u: (T, N, dim) world-frame commands, m/s;
     u_hat: (T, N, dim) bounded formation-frame commands of eq. (14), m/s;
     q_od: (T, dim) the reference centre, m.
+
+    For unicycles q, u and u_hat are those of the hand points (what the law controls), and
+    heading (T, N) in rad, q_body (T, N, 2) the axle centres in m and body_command (T, N, 2)
+    the (v, w) held, in m/s and rad/s, describe the bodies; all three are None for points.
     """
 
     t: NDArray[np.float64]
@@ -30,6 +36,9 @@ class Trajectory:
     u_hat: NDArray[np.float64]
     q_desired: NDArray[np.float64]
     q_od: NDArray[np.float64]
+    heading: Optional[NDArray[np.float64]] = None
+    q_body: Optional[NDArray[np.float64]] = None
+    body_command: Optional[NDArray[np.float64]] = None
 
     @property
     def num_robots(self) -> int:
@@ -43,12 +52,14 @@ class Trajectory:
 
     def save(self, path: str) -> None:
         """
-        Write the arrays to ``path`` (a .npz file, not compressed).
+        Write the arrays to ``path`` (a .npz file, not compressed); body arrays when present.
 
         Float trajectories compress by a few per cent only, and zlib was a tenth of a 1000-robot
         formation_sim run; ``np.load`` reads either kind.
         """
-        np.savez(path, **{name: getattr(self, name) for name in ARRAYS})
+        arrays = {name: getattr(self, name) for name in ARRAYS + BODY_ARRAYS
+                  if getattr(self, name) is not None}
+        np.savez(path, **arrays)
 
     @classmethod
     def from_frames(cls, t: ArrayLike, q: ArrayLike, u: ArrayLike,
@@ -76,7 +87,8 @@ class Trajectory:
             missing = [name for name in ARRAYS if name not in data]
             if missing:
                 raise ValueError(f"{path}: missing arrays {', '.join(missing)}")
-            return cls(**{name: data[name] for name in ARRAYS})
+            return cls(**{name: data[name] for name in ARRAYS + BODY_ARRAYS
+                          if name in data})
 
 
 CHUNKS_DIR = 'trajectory_chunks'
@@ -88,7 +100,8 @@ class ChunkWriter:
 
     A process that keeps its samples only here holds at most one chunk in memory, and a run cut
     short (even by SIGKILL) loses at most the chunk not yet written: :func:`read_chunks` reads
-    back every complete file. t in s; q, u (N, dim).
+    back every complete file. t in s; q, u (N, dim); for unicycles also heading (N,), q_body
+    (N, 2) and body_command (N, 2) (:data:`BODY_ARRAYS`, read back by :func:`read_body_chunks`).
     """
 
     def __init__(self, folder: str):
@@ -99,12 +112,15 @@ class ChunkWriter:
         self._t: List[float] = []
         self._q: List[NDArray[np.float64]] = []
         self._u: List[NDArray[np.float64]] = []
+        self._body: Dict[str, List[NDArray[np.float64]]] = {name: [] for name in BODY_ARRAYS}
 
-    def append(self, t: float, q: ArrayLike, u: ArrayLike) -> None:
-        """Keep one sample until the next :meth:`flush`."""
+    def append(self, t: float, q: ArrayLike, u: ArrayLike, **body: ArrayLike) -> None:
+        """Keep one sample until the next :meth:`flush`; body: the :data:`BODY_ARRAYS`."""
         self._t.append(float(t))
         self._q.append(np.array(q, dtype=float))
         self._u.append(np.array(u, dtype=float))
+        for name, value in body.items():
+            self._body[name].append(np.array(value, dtype=float))
 
     def flush(self) -> None:
         """Write the samples kept so far as the next chunk (atomically: a rename)."""
@@ -112,11 +128,16 @@ class ChunkWriter:
             return
         path = os.path.join(self.folder, f'{self.count:06d}.npz')
         partial = path + '.part'
+        arrays: Dict[str, Any] = {'t': np.array(self._t), 'q': np.array(self._q),
+                                  'u': np.array(self._u)}
+        arrays.update({name: np.array(values) for name, values in self._body.items()
+                       if len(values) == len(self._t)})
         with open(partial, 'wb') as stream:
-            np.savez(stream, t=np.array(self._t), q=np.array(self._q), u=np.array(self._u))
+            np.savez(stream, **arrays)
         os.replace(partial, path)
         self.count += 1
         self._t, self._q, self._u = [], [], []
+        self._body = {name: [] for name in BODY_ARRAYS}
 
 
 def _chunk_files(folder: str) -> List[str]:
@@ -142,3 +163,21 @@ def read_chunks(folder: str) -> Tuple[NDArray[np.float64], NDArray[np.float64],
     if not t:
         raise ValueError(f'{folder}: no trajectory chunk')
     return np.concatenate(t), np.concatenate(q), np.concatenate(u)
+
+
+def read_body_chunks(folder: str) -> Optional[Dict[str, NDArray[np.float64]]]:
+    """
+    Read back the :data:`BODY_ARRAYS` of the chunks in ``folder``: {name: (T, ...)}.
+
+    None when the chunks hold none (point bodies). Call after :func:`read_chunks` succeeded.
+    """
+    parts: Dict[str, List[NDArray[np.float64]]] = {name: [] for name in BODY_ARRAYS}
+    for name in _chunk_files(folder):
+        with np.load(os.path.join(folder, name)) as data:
+            if not all(key in data for key in BODY_ARRAYS):
+                return None
+            for key in BODY_ARRAYS:
+                parts[key].append(data[key])
+    if not parts[BODY_ARRAYS[0]]:
+        return None
+    return {key: np.concatenate(values) for key, values in parts.items()}

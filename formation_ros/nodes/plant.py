@@ -20,9 +20,16 @@ the collision check. This node only moves messages in and out:
 
 With ``plant.lockstep`` it steps only when every robot has answered the latest state, which
 makes a run reproduce ``formation_sim --dt 1/plant.rate``.
+
+Unicycles (``body.kind: unicycle``): each pose carries the robot's heading as its orientation,
+and so does every neighbour in ``neighbors``, which lists the bodies within R_i + 2 l (so that a
+robot sees every hand point within R_i of its own); a command is read in the robot's body frame
+(``robot_<i>/base_link``: linear.x = v, angular.z = w, as diff_drive_controller takes it) and
+admitted by the model like any other.
 """
 
 from collections import OrderedDict
+from dataclasses import replace
 import json
 import os
 import shutil
@@ -30,11 +37,13 @@ import time
 from typing import Any, Dict, List, Optional
 
 from diagnostic_msgs.msg import DiagnosticArray
+from formation_ros.core.bodies import make_bodies
 from formation_ros.core.declarations import Exe
 from formation_ros.core.frames import desired_positions
 from formation_ros.core.plant import (Commands, CommandStatus, DurationHistogram, NS_PER_S,
                                       PLANT_STATS_FILE, PlantModel, StepReport)
-from formation_ros.core.trajectory import CHUNKS_DIR, ChunkWriter, read_chunks, Trajectory
+from formation_ros.core.trajectory import (CHUNKS_DIR, ChunkWriter, read_body_chunks,
+                                           read_chunks, Trajectory)
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import CdrError, encode_clock, read_twist_stamped, StateEncoder
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
@@ -73,10 +82,17 @@ class PlantNode(Node):
         self.law = config.law()
         self.reference = config.reference()
         self.n, self.dim = config.num_robots, config.dim
+        self.bodies = make_bodies(config.body, settings.max_speed)
+        self.unicycles = config.body.is_unicycle
         self.model = PlantModel(config.start, config.sensing_radii, settings.step_ns, self.law,
                                 self.reference, settings.input_timeout_ns,
-                                settings.collision_distance, settings.max_speed)
-        self.commands = Commands.empty(self.n, self.dim)
+                                settings.collision_distance, settings.max_speed,
+                                bodies=self.bodies, headings=config.start_headings)
+        self.commands = Commands.empty(self.n, self.bodies.command_width(self.dim))
+        self.command_frames = [messages.body_frame(i) if self.unicycles else None
+                               for i in range(1, self.n + 1)]
+        self.wrong_frame = np.zeros(self.n, dtype=np.int64)
+        self.closest_body = self.model.closest_body_distance()
         self.status = np.full(self.n, CommandStatus.MISSING, dtype=np.int8)
         self.lockstep = config.lockstep
         self.publish_every = 1 if self.lockstep else settings.steps_per_publish
@@ -143,7 +159,18 @@ class PlantNode(Node):
                                                   f'that are not a TwistStamped ({exc}; logged '
                                                   'once, counted in diagnostics)', 'error')
             return
-        self.commands.store(index, command.linear[:self.dim], command.stamp_ns)
+        frame = self.command_frames[index]
+        if frame is not None:
+            if command.frame_id != frame:
+                self.wrong_frame[index] += 1
+                self.once.start(f'frame-{index}', f'robot {index + 1}: ignoring cmd_vel in frame '
+                                                  f'{command.frame_id!r}: a unicycle takes (v, '
+                                                  f'w) in its body frame {frame!r} (logged '
+                                                  'once, counted in diagnostics)', 'error')
+                return
+            self.commands.store(index, (command.linear[0], command.angular[2]), command.stamp_ns)
+        else:
+            self.commands.store(index, command.linear[:self.dim], command.stamp_ns)
         self.arrived_ns[index] = time.monotonic_ns()
         if self.lockstep:
             self.step_wake.arm()
@@ -198,7 +225,13 @@ class PlantNode(Node):
                                  float(np.max(report.admission.largest_u_hat)))
         if (self.model.counts.steps - 1) % self.publish_every == 0:
             self.closest = min(self.closest, self.model.closest_pair_distance())
-            if self.chunks is not None:
+            self.closest_body = min(self.closest_body, self.model.closest_body_distance())
+            if self.chunks is not None and self.unicycles:
+                self.chunks.append(report.t_ns / NS_PER_S, report.points,
+                                   report.admission.velocity,
+                                   heading=report.heading, q_body=report.q,
+                                   body_command=report.admission.u)
+            elif self.chunks is not None:
                 self.chunks.append(report.t_ns / NS_PER_S, report.q, report.admission.u)
         self._log(report)
 
@@ -213,10 +246,12 @@ class PlantNode(Node):
                 f'robot {robot + 1}: command component {value:.6g} m/s above the bound '
                 f'c*M1 = {self.law.u_bound:.6g} m/s '
                 f'({self.model.counts.bound_violations} so far)', throttle_duration_sec=1.0)
+        limit = ('2 x body.radius or plant.collision_distance'
+                 if self.model.body.contact_distance > 0.0 else 'plant.collision_distance')
         for i, j, distance in report.collisions:
             self.get_logger().error(
                 f'collision: robots {i + 1} and {j + 1} are {distance:.3g} m apart at t = '
-                f'{self.model.t:.3f} s (< plant.collision_distance)')
+                f'{self.model.t:.3f} s (< {limit})')
 
     def _log_status(self, i: int, status: CommandStatus, t_ns: int) -> None:
         age = (t_ns - int(self.commands.stamp_ns[i])) / NS_PER_S
@@ -250,7 +285,9 @@ class PlantNode(Node):
         while len(self.published_ns) > PUBLISHES_TIMED:
             self.published_ns.popitem(last=False)
         observer, seen = self.model.sensed_pairs()
-        poses, arrays = self.state_encoder.encode(self.model.q, observer, seen, self.model.t_ns)
+        poses, arrays = self.state_encoder.encode(
+            self.model.q, observer, seen, self.model.t_ns,
+            self.model.heading if self.unicycles else None)
         for publisher, message in zip(self.pose_pubs, poses):
             publisher.publish(message)
         for publisher, message in zip(self.neighbour_pubs, arrays):
@@ -292,9 +329,14 @@ class PlantNode(Node):
                   'step rate achieved [Hz]': rate,
                   'step rate target [Hz]': 'lockstep' if self.lockstep else target,
                   'min pair distance [m]': self.model.closest_pair_distance(),
+                  **({'min body distance [m]': self.model.closest_body_distance()}
+                     if self.unicycles else {}),
                   'bound c*M1 [m/s]': self.law.u_bound,
                   'oldest command counted [s]': counts.oldest_counted_ns / NS_PER_S}
         values.update({name.replace('_', ' '): count for name, count in counts.totals().items()})
+        if np.any(self.wrong_frame):
+            values['robots with cmd_vel in a frame other than their base_link'] = ', '.join(
+                f'{i + 1}: {count}' for i, count in enumerate(self.wrong_frame.tolist()) if count)
         if np.any(self.malformed):
             values['robots with malformed cmd_vel messages'] = ', '.join(
                 f'{i + 1}: {count}' for i, count in enumerate(self.malformed.tolist()) if count)
@@ -370,7 +412,9 @@ class PlantNode(Node):
         except ValueError:
             return None
         frames = [self.reference.sample(time_s) for time_s in t]
-        return Trajectory.from_frames(t, q, u, frames, self.config.vertices)
+        trajectory = Trajectory.from_frames(t, q, u, frames, self.config.vertices)
+        body = read_body_chunks(self.chunks.folder) if self.unicycles else None
+        return trajectory if body is None else replace(trajectory, **body)
 
     def finish(self) -> None:
         """Log a summary of the run; with ``plant.output_dir`` write trajectory and counters."""
@@ -381,11 +425,12 @@ class PlantNode(Node):
         counts = self.model.counts
         totals = counts.totals()
         desired = desired_positions(self.config.vertices, self.reference.sample(self.model.t))
-        error = float(np.max(np.linalg.norm(self.model.q - desired, axis=1)))
+        error = float(np.max(np.linalg.norm(self.model.points - desired, axis=1)))
+        bodies = f', min body distance {self.closest_body:.4g} m' if self.unicycles else ''
         self.get_logger().info(
             f"plant: {totals['steps']} steps ({self.model.t:.2f} s simulated in {wall:.1f} s), "
-            f'final max error {error:.3g} m, min pair distance {self.closest:.4g} m, max '
-            f'|u_hat| {self.largest_u_hat:.4g} m/s (bound {self.law.u_bound:.4g}), '
+            f'final max error {error:.3g} m, min pair distance {self.closest:.4g} m{bodies}, '
+            f'max |u_hat| {self.largest_u_hat:.4g} m/s (bound {self.law.u_bound:.4g}), '
             f"{totals['collisions']} collisions, {totals['bound_violations']} commands above "
             f"the bound, {totals['stale_command_steps']} stale commands")
         output_dir = self.settings.output_dir
@@ -406,6 +451,10 @@ class PlantNode(Node):
             'max_ms': self.latency.largest_ns / 1e6}
         stats['by_robot'] = {status.name.lower(): counts.by_robot(status)
                              for status in CommandStatus if status is not CommandStatus.APPLIED}
+        if self.unicycles:
+            stats['min_body_distance'] = self.closest_body
+        stats['wrong_frame_command_messages'] = {
+            i + 1: count for i, count in enumerate(self.wrong_frame.tolist()) if count}
         stats['malformed_command_messages'] = {
             i + 1: count for i, count in enumerate(self.malformed.tolist()) if count}
         with open(os.path.join(output_dir, PLANT_STATS_FILE), 'w', encoding='utf-8') as stream:

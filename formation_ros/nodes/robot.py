@@ -19,6 +19,13 @@ a state whose neighbours were lost. The command is stamped with the stamp of the
 computed from, so the plant can tell how old it is (and, in lockstep, which state it answers).
 Every input is read from its serialized bytes and the command written as bytes
 (``formation_ros.ros.cdr``): rclpy's own conversions were most of a robot's time.
+
+A unicycle (``body.kind: unicycle``, docs/equations.md U1-U5) reads its heading from its pose's
+orientation and its neighbours' from theirs, runs the law on its own hand point and the
+neighbours' hand points within R_i, and publishes (v, w) in its body frame
+(``robot_<i>/base_link``: linear.x = v, angular.z = w), as diff_drive_controller takes it. With
+``pose_type: odometry`` the pose comes from a nav_msgs/Odometry (a real base's localisation)
+instead of a PoseStamped.
 """
 
 from collections import deque
@@ -28,9 +35,11 @@ import time
 from typing import Dict, List, Optional, Tuple
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros.core.declarations import Exe
+from formation_ros.core.declarations import Exe, PoseType
 from formation_ros.core.frames import advance, FrameSample
 from formation_ros.core.law import Command, robot_command
+from formation_ros.core.unicycle import (hand_points, headings_from_quaternions,
+                                         unicycle_commands)
 from formation_ros.ros import fields, messages, qos, topics
 from formation_ros.ros.cdr import (CdrError, encode_twist_stamped, OdometryData, PoseArrayData,
                                    PoseData, read_odometry, read_pose_array, read_pose_stamped,
@@ -81,6 +90,11 @@ class RobotNode(Node):
         self.timeout_ns = int(settings.input_timeout * fields.NS_PER_S)
         self.num_robots = config.num_robots
         self.speed_limit, self.turn_limit = config.reference().rate_limits()
+        self.unicycle = config.body.is_unicycle
+        self.hand_distance = config.body.hand_distance
+        self.command_frame = (messages.body_frame(settings.robot_id) if self.unicycle
+                              else messages.WORLD_FRAME)
+        self.last_body_command: Optional[NDArray[np.float64]] = None
         self.sim_time = bool(self.get_parameter('use_sim_time').value)
         self.once = OnceLog(self.get_logger())
         self.steady = Clock(clock_type=ClockType.STEADY_TIME)
@@ -96,8 +110,12 @@ class RobotNode(Node):
         self.waiting = True
         self.wait_subscribers = settings.wait_for_subscribers
 
-        self.create_subscription(PoseStamped, topics.POSE, self.on_pose, qos.STATE_INPUT,
-                                 raw=True)
+        if settings.pose_type is PoseType.ODOMETRY:
+            self.create_subscription(Odometry, topics.POSE, self.on_odometry, qos.STATE_INPUT,
+                                     raw=True)
+        else:
+            self.create_subscription(PoseStamped, topics.POSE, self.on_pose, qos.STATE_INPUT,
+                                     raw=True)
         self.create_subscription(PoseArray, topics.NEIGHBOURS, self.on_neighbours,
                                  qos.STATE_INPUT, raw=True)
         self.create_subscription(Odometry, topics.REFERENCE, self.on_reference, qos.REFERENCE,
@@ -115,6 +133,8 @@ class RobotNode(Node):
             f'robot {self.index + 1}/{config.num_robots}: vertex {np.round(self.vertex, 4)}, '
             f'R_i = {self.sensing_radius:g} m, b = {config.repulsion_radius:g} m, '
             f'bound c*M1 = {self.law.u_bound:.4g} m/s, '
+            + (f'unicycle, hand point {self.hand_distance:g} m ahead, commands in '
+               f'{self.command_frame}, ' if self.unicycle else '')
             + ('lockstep' if self.lockstep else f'{settings.control_rate:g} Hz'))
 
     @staticmethod
@@ -160,6 +180,19 @@ class RobotNode(Node):
         except CdrError as exc:
             self._reject('pose', Reason.MALFORMED, f' ({exc})')
             return
+        self._store_pose(pose)
+
+    def on_odometry(self, data: bytes) -> None:
+        """Store the latest own pose, read from a serialized nav_msgs/Odometry."""
+        try:
+            odometry = read_odometry(data)
+        except CdrError as exc:
+            self._reject('pose', Reason.MALFORMED, f' ({exc})')
+            return
+        self._store_pose(PoseData(odometry.stamp_ns, odometry.frame_id, odometry.position,
+                                  odometry.orientation))
+
+    def _store_pose(self, pose: PoseData) -> None:
         if self._check('pose', pose.frame_id, pose.stamp_ns, pose.finite):
             self.pose = pose
             self.pose_count += 1
@@ -176,8 +209,9 @@ class RobotNode(Node):
         except CdrError as exc:
             self._reject('neighbour', Reason.MALFORMED, f' ({exc})')
             return
-        if self._check('neighbour', heard.frame_id, heard.stamp_ns,
-                       bool(np.all(np.isfinite(heard.positions)))):
+        finite = bool(np.all(np.isfinite(heard.positions))
+                      and (not self.unicycle or np.all(np.isfinite(heard.orientations))))
+        if self._check('neighbour', heard.frame_id, heard.stamp_ns, finite):
             self.neighbours = heard
             self.received_ns['neighbour'] = self._now_ns()
             self.answer.arm()
@@ -228,19 +262,49 @@ class RobotNode(Node):
         frame = self._reference_for(stamp_ns, exact)
         if frame is None:
             return None
-        neighbours = self.neighbours.positions[:, :self.dim]
-        self.last = robot_command(self._own_position(), self.vertex, neighbours,
+        self.last = robot_command(self._own_position(), self.vertex, self._neighbour_points(),
                                   self.sensing_radius, self.law, frame)
-        return self.last.u
+        if not self.unicycle:
+            return self.last.u
+        self.last_body_command = unicycle_commands(self.last.u, self._own_heading(),
+                                                   self.hand_distance)
+        return self.last_body_command
+
+    def _own_heading(self) -> float:
+        assert self.pose is not None
+        return float(headings_from_quaternions(self.pose.orientation))
 
     def _own_position(self) -> NDArray[np.float64]:
+        """Return the point the law acts on: own position, or own hand point (unicycles)."""
         assert self.pose is not None
-        return np.array(self.pose.position[:self.dim])
+        position = np.array(self.pose.position[:self.dim])
+        if self.unicycle:
+            return hand_points(position, self._own_heading(), self.hand_distance)
+        return position
+
+    def _neighbour_points(self) -> NDArray[np.float64]:
+        """Return the neighbours' positions, or their hand points (unicycles): (K, dim)."""
+        assert self.neighbours is not None
+        positions = self.neighbours.positions[:, :self.dim]
+        if self.unicycle:
+            return hand_points(positions, headings_from_quaternions(self.neighbours.orientations),
+                               self.hand_distance)
+        return positions
 
     def _publish_command(self, u: Optional[NDArray[np.float64]], stamp_ns: int) -> None:
-        """Publish ``u`` ((dim,) m/s; None: zero) answering the state stamped ``stamp_ns``."""
-        self.cmd_pub.publish(encode_twist_stamped(
-            stamp_ns, messages.WORLD_FRAME, np.zeros(self.dim) if u is None else u))
+        """
+        Publish a command answering the state stamped ``stamp_ns`` (None: zero).
+
+        u: (dim,) m/s in the world frame, or for a unicycle (v, w) in its body frame.
+        """
+        if self.unicycle:
+            v, w = (0.0, 0.0) if u is None else (float(u[0]), float(u[1]))
+            message = encode_twist_stamped(stamp_ns, self.command_frame, (v, 0.0, 0.0),
+                                           (0.0, 0.0, w))
+        else:
+            message = encode_twist_stamped(stamp_ns, messages.WORLD_FRAME,
+                                           np.zeros(self.dim) if u is None else u)
+        self.cmd_pub.publish(message)
 
     def on_state(self) -> None:
         """
@@ -319,8 +383,7 @@ class RobotNode(Node):
                                               else (now - self.received_ns[name]) / 1e9)
                   for name in INPUTS}
         if self.neighbours is not None and self.pose is not None:
-            gaps = np.linalg.norm(self.neighbours.positions[:, :self.dim]
-                                  - self._own_position(), axis=1)
+            gaps = np.linalg.norm(self._neighbour_points() - self._own_position(), axis=1)
             values['neighbours heard'] = len(gaps)
             values['neighbours within R_i'] = int(np.count_nonzero(gaps < self.sensing_radius))
             values['neighbours within b'] = int(np.count_nonzero(gaps < self.law.repulsion_radius))
@@ -328,6 +391,9 @@ class RobotNode(Node):
             values['max |u| component [m/s]'] = float(np.max(np.abs(self.last.u)))
             values['max |u_hat| component [m/s]'] = float(np.max(np.abs(self.last.u_hat)))
         values['bound c*M1 [m/s]'] = self.law.u_bound
+        if self.last_body_command is not None:
+            values['|v| [m/s]'] = abs(float(self.last_body_command[0]))
+            values['|w| [rad/s]'] = abs(float(self.last_body_command[1]))
         values.update({f'rejected {name} messages ({reason.value})': count
                        for (name, reason), count in self.rejected.items()})
         if self.waiting:

@@ -24,9 +24,10 @@ is not a whole message (:class:`CdrError`); writers write little endian with zer
 from dataclasses import dataclass
 import math
 import struct
-from typing import List, Sequence, Tuple
+from typing import List, Optional, Sequence, Tuple
 
 from formation_ros.core.frames import frame_from_pose, FrameSample
+from formation_ros.core.unicycle import quaternions_from_headings
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -49,11 +50,16 @@ class TooManyPoses(CdrError):
 
 @dataclass(frozen=True)
 class PoseArrayData:
-    """What a PoseArray carries for this package: stamp (ns), frame, positions (K, 3) in m."""
+    """
+    What a PoseArray carries for this package: stamp (ns), frame, positions (K, 3) in m.
+
+    orientations: (K, 4) quaternions (x, y, z, w) of the poses (the headings of unicycles).
+    """
 
     stamp_ns: int
     frame_id: str
     positions: NDArray[np.float64]
+    orientations: NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -177,8 +183,9 @@ def read_pose_array(data: bytes, max_poses: int) -> PoseArrayData:
         raise CdrError(f'cut short: {count} poses do not fit in {len(reader.view)} bytes')
     values = np.frombuffer(reader.view, dtype=np.dtype(np.float64).newbyteorder(reader.endian),
                            count=count * POSE_DOUBLES, offset=offset)
-    positions = values.reshape(count, POSE_DOUBLES)[:, :3].astype(np.float64)
-    return PoseArrayData(stamp_ns, frame_id, positions)
+    poses = values.reshape(count, POSE_DOUBLES)
+    return PoseArrayData(stamp_ns, frame_id, poses[:, :3].astype(np.float64),
+                         poses[:, 3:].astype(np.float64))
 
 
 def read_pose_stamped(data: bytes) -> PoseData:
@@ -266,11 +273,15 @@ def encode_clock(stamp_ns: int) -> bytes:
     return LITTLE + struct.pack('<iI', stamp_ns // NS_PER_S, stamp_ns % NS_PER_S)
 
 
+Encoded = Tuple[List[bytes], List[bytes]]
+
+
 class StateEncoder:
     """
     The plant's state messages of all robots at once: poses and range-sensor readings as bytes.
 
-    Every robot's pose is 7 float64 (x, y, z, identity quaternion) in one (N, 7) array; a
+    Every robot's pose is 7 float64 (x, y, z, quaternion: identity, or the heading of a
+    unicycle) in one (N, 7) array; a
     PoseStamped is a fixed prefix and that row, a PoseArray a prefix with its count and the rows
     of the robots it lists, taken with one numpy index for all arrays together.
     """
@@ -283,14 +294,18 @@ class StateEncoder:
         self.rows[:, 6] = 1.0
 
     def encode(self, q: NDArray[np.float64], observer: NDArray[np.intp],
-               seen: NDArray[np.intp], stamp_ns: int) -> Tuple[List[bytes], List[bytes]]:
+               seen: NDArray[np.intp], stamp_ns: int,
+               headings: Optional[NDArray[np.float64]] = None) -> Encoded:
         """
         Return (poses, arrays): robot i's serialized PoseStamped and PoseArray at ``stamp_ns``.
 
         q: (N, dim) positions, m; (observer, seen): every sensed pair, sorted by observer
-        (``core.plant.sensed_pairs``): robot ``observer[k]`` sees robot ``seen[k]``.
+        (``core.plant.sensed_pairs``): robot ``observer[k]`` sees robot ``seen[k]``;
+        headings: (N,) rad about +z, written as the orientations (None: identity).
         """
         self.rows[:, :self.dim] = q
+        if headings is not None:
+            self.rows[:, 3:] = quaternions_from_headings(headings)
         header = encode_header(stamp_ns, self.frame_id)
         pose_prefix = header + _pad(len(header), 8)
         poses = [pose_prefix + row for row in map(bytes, self.rows)]

@@ -16,6 +16,12 @@ from nav_msgs.msg import Odometry
 
 WORLD_FRAME = 'world'
 FORMATION_FRAME = 'formation'
+BODY_FRAME = 'base_link'
+
+
+def body_frame(robot_id):
+    """Return robot ``robot_id``'s body frame, ``robot_<i>/base_link`` (unicycle commands)."""
+    return f'robot_{int(robot_id)}/{BODY_FRAME}'
 
 
 def ns_to_stamp(ns):

@@ -16,7 +16,7 @@ record by record with the ``mcap`` library's record parsers, keeps every record 
 files beside it.
 """
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from io import BytesIO
 import os
 import re
@@ -28,6 +28,7 @@ from typing import Any, Dict, List, Optional, Tuple
 from formation_ros.core.frames import advance, FrameSample
 from formation_ros.core.params import FormationConfig
 from formation_ros.core.trajectory import Trajectory
+from formation_ros.core.unicycle import hand_points, hand_velocity, headings_from_quaternions
 from formation_ros.ros import topics as names
 from formation_ros.ros.bag_writer import BagError, BagWriter, PARAMS_FILE, TYPESTORE
 from formation_ros.ros.fields import frame_of, NS_PER_S, position_of, stamp_to_ns, velocity_of
@@ -459,22 +460,33 @@ def trajectory_from_topics(recorded: Recorded,
     the command robot i sent for that state (or its latest earlier one, zero before its first);
     desired positions come from the recorded reference samples (or, if none were recorded, from
     the reference in the parameters) and the formation vertices. Returns (Trajectory, info).
+    Unicycles: the headings are the poses' orientations, the commands (v, w) are linear.x and
+    angular.z, and q, u are those of the hand points (``Trajectory`` with its body arrays).
     """
     n, dim = config.num_robots, config.dim
+    unicycles = config.body.is_unicycle
     poses: Dict[int, Dict[int, Any]] = {}
+    headings: Dict[int, Dict[int, float]] = {}
     for i in range(1, n + 1):
         for _, message in recorded.get(names.robot_topic(i, names.POSE), []):
-            poses.setdefault(stamp_to_ns(message.header.stamp), {})[i - 1] = \
-                position_of(message, dim)
+            stamp = stamp_to_ns(message.header.stamp)
+            poses.setdefault(stamp, {})[i - 1] = position_of(message, dim)
+            if unicycles:
+                o = message.pose.orientation
+                headings.setdefault(stamp, {})[i - 1] = float(
+                    headings_from_quaternions([o.x, o.y, o.z, o.w]))
     stamps = sorted(stamp for stamp, seen in poses.items() if len(seen) == n)
     if len(stamps) < 2:
         raise BagError('fewer than two moments with the poses of all robots recorded')
     q = np.array([[poses[stamp][i] for i in range(n)] for stamp in stamps])
-    u = np.zeros((len(stamps), n, dim))
+    width = 2 if unicycles else dim
+    u = np.zeros((len(stamps), n, width))
     for i in range(1, n + 1):
         commands = {}
         for _, message in recorded.get(names.robot_topic(i, names.CMD_VEL), []):
-            commands[stamp_to_ns(message.header.stamp)] = velocity_of(message, dim)
+            commands[stamp_to_ns(message.header.stamp)] = (
+                (message.twist.linear.x, message.twist.angular.z) if unicycles
+                else velocity_of(message, dim))
         if not commands:
             continue
         known = np.array(sorted(commands))
@@ -482,9 +494,18 @@ def trajectory_from_topics(recorded: Recorded,
         values = np.array([commands[int(k)] for k in known])
         u[:, i - 1] = np.where((index >= 0)[:, None], values[np.maximum(index, 0)], 0.0)
     frames, source = _frames_at(stamps, recorded.get(names.REFERENCE, []), config)
-    trajectory = Trajectory.from_frames(np.array(stamps) / NS_PER_S, q, u, frames,
+    if not unicycles:
+        trajectory = Trajectory.from_frames(np.array(stamps) / NS_PER_S, q, u, frames,
+                                            config.vertices)
+        return trajectory, {'reference_source': source}
+    heading = np.array([[headings[stamp][i] for i in range(n)] for stamp in stamps])
+    l_value = config.body.hand_distance
+    trajectory = Trajectory.from_frames(np.array(stamps) / NS_PER_S,
+                                        hand_points(q, heading, l_value),
+                                        hand_velocity(u, heading, l_value), frames,
                                         config.vertices)
-    return trajectory, {'reference_source': source}
+    return (replace(trajectory, heading=heading, q_body=q, body_command=u),
+            {'reference_source': source})
 
 
 def plant_status(recorded: Recorded) -> Dict[str, int]:

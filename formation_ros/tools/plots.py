@@ -21,6 +21,9 @@ import matplotlib.pyplot as plt  # noqa: E402, I100
 FIGURES = ('trajectories.png', 'distances.png', 'controls.png', 'formation_error.png')
 MAX_PATHS = 200
 THICK = 2.2
+HEADING_MARKS = 12
+"""Bodies drawn along each unicycle's path, at equal intervals of time."""
+MAX_HEADING_ROBOTS = 30
 
 
 def _polygon(points):
@@ -46,6 +49,8 @@ def plot_trajectories(traj, path, title='Trajectories'):
                 color='k' if i == 0 else None)
     ax.plot(*coords(_polygon(desired[-1])), color='tab:red', linewidth=1.2,
             label='desired formation (end)')
+    if traj.heading is not None and traj.q_body is not None:
+        _draw_headings(ax, traj, shown)
     ax.scatter(*coords(q[0]), marker='o', s=14, color='tab:blue', label='start')
     ax.scatter(*coords(q[-1]), marker='x', s=24, color='k', label='end')
     if n <= 30:
@@ -58,11 +63,26 @@ def plot_trajectories(traj, path, title='Trajectories'):
     else:
         ax.set_aspect('equal', adjustable='datalim')
         ax.grid(True, alpha=0.3)
-    ax.set_title(f'{title}: N = {n}, robot 1 thick')
+    what = 'hand points, bodies as arrows, ' if traj.heading is not None else ''
+    ax.set_title(f'{title}: N = {n}, {what}robot 1 thick')
     ax.legend(loc='best', fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def _draw_headings(ax, traj, shown):
+    """Arrows from each axle centre along its heading, at HEADING_MARKS times of the run."""
+    marks = np.unique(np.linspace(0, len(traj.t) - 1, HEADING_MARKS).astype(int))
+    robots = shown[:MAX_HEADING_ROBOTS]
+    q_body = traj.q_body[np.ix_(marks, robots)]
+    heading = traj.heading[np.ix_(marks, robots)]
+    span = max(float(np.ptp(traj.q[..., 0])), float(np.ptp(traj.q[..., 1])), 1e-9)
+    length = 0.04 * span
+    ax.quiver(q_body[..., 0].ravel(), q_body[..., 1].ravel(),
+              length * np.cos(heading).ravel(), length * np.sin(heading).ravel(),
+              angles='xy', scale_units='xy', scale=1.0, width=0.004, color='tab:green',
+              label=f'body and heading ({len(marks)} times)')
 
 
 def plot_distances(traj, law, path):
@@ -121,6 +141,34 @@ def plot_controls(traj, u_bound, path):
     plt.close(fig)
 
 
+def plot_unicycle_controls(traj, metrics, path):
+    """Plot v and w of every unicycle (robot 1 thick, envelope of all) against bounds (U5)."""
+    t, command = traj.t, traj.body_command
+    fig, axes = plt.subplots(2, 1, figsize=(8, 7.2), sharex=True)
+    rows = [('v [m/s]', 0, metrics['v_bound'], 'sqrt(2) c M1', metrics.get('max_linear'),
+             'body.max_linear'),
+            ('w [rad/s]', 1, metrics['omega_bound'], 'sqrt(2) c M1 / l',
+             metrics.get('max_angular'), 'body.max_angular')]
+    for ax, (label, column, bound, bound_name, limit, limit_name) in zip(axes, rows):
+        envelope = np.max(np.abs(command[..., column]), axis=1)
+        ax.fill_between(t, -envelope, envelope, color='0.85', label='max |value|, all robots')
+        ax.plot(t, command[:, 0, column], color='k', linewidth=1.4, label='robot 1')
+        for sign in (1.0, -1.0):
+            ax.axhline(sign * bound, color='tab:red', linestyle='--',
+                       label=f'+- {bound_name}' if sign > 0 else None)
+            if limit is not None:
+                ax.axhline(sign * limit, color='tab:purple', linestyle=':',
+                           label=f'+- {limit_name}' if sign > 0 else None)
+        ax.set_ylabel(label)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8, loc='upper right')
+    axes[0].set_title('Unicycle commands (v, w) against their bounds')
+    axes[-1].set_xlabel('t [s]')
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def plot_formation_error(traj, metrics, path):
     """Largest and mean ||q_i - q_i,desired|| over time, the 0.05 m band and the settle time."""
     errors = formation_errors(traj.q, traj.q_desired)
@@ -148,6 +196,9 @@ def write_figures(traj, law, metrics, out_dir):
     paths = [os.path.join(out_dir, name) for name in FIGURES]
     plot_trajectories(traj, paths[0])
     plot_distances(traj, law, paths[1])
-    plot_controls(traj, metrics['u_bound'], paths[2])
+    if traj.body_command is not None and 'v_bound' in metrics:
+        plot_unicycle_controls(traj, metrics, paths[2])
+    else:
+        plot_controls(traj, metrics['u_bound'], paths[2])
     plot_formation_error(traj, metrics, paths[3])
     return paths

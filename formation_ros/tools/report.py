@@ -22,6 +22,7 @@ that says what is wrong.
 """
 
 import argparse
+from dataclasses import replace
 import json
 import os
 import sys
@@ -31,7 +32,7 @@ from formation_ros.core.declarations import ParamError
 from formation_ros.core.params import FormationConfig, load_config, validate
 from formation_ros.core.params_file import parse_params_text
 from formation_ros.core.plant import PLANT_STATS_FILE
-from formation_ros.core.trajectory import CHUNKS_DIR, read_chunks, Trajectory
+from formation_ros.core.trajectory import CHUNKS_DIR, read_body_chunks, read_chunks, Trajectory
 from formation_ros.ros import topics as names
 from formation_ros.ros.bag_writer import BagError, PARAMS_FILE
 from formation_ros.tools.bag import (bag_params_text, mcap_files, METADATA, plant_status,
@@ -102,6 +103,9 @@ def _load_chunks(path: str, params: str, chunks: str, notes: Optional[List[str]]
     reference = config.reference()
     trajectory = Trajectory.from_frames(t, q, u, [reference.sample(s) for s in t],
                                         config.vertices)
+    body = read_body_chunks(chunks) if config.body.is_unicycle else None
+    if body is not None:
+        trajectory = replace(trajectory, **body)
     if notes is not None:
         notes.append(f'{path}: no trajectory.npz (the plant did not finish): rebuilt '
                      f'{len(t)} samples up to t = {t[-1]:.2f} s from {CHUNKS_DIR}/')

@@ -7,9 +7,15 @@ Offline simulator ``formation_sim``: the closed loop q' = u of eqs. (1), (14), (
 Default: adaptive RK45 at rtol 1e-8 (the paper's continuous-time system). ``--dt`` switches to a
 fixed step with the command held over each step (zero-order hold), which is what the plant node
 does. Writes trajectory.npz, metrics.json, a copy of the parameters and the figures.
+
+Unicycles (``body.kind: unicycle``): RK45 integrates the unicycles' own equations (U1) with the
+law acting on their hand points (the ideal continuous-time system: no actuator caps); ``--dt``
+steps the plant model, which holds (v, w) over each step, integrates the arcs exactly and
+clips to ``body.max_linear`` / ``body.max_angular``.
 """
 
 import argparse
+from dataclasses import replace
 import json
 import math
 import os
@@ -19,15 +25,18 @@ import tempfile
 import time
 from typing import Optional, Sequence, TextIO, Tuple
 
+from formation_ros.core.bodies import make_bodies
 from formation_ros.core.declarations import DEFAULT_COLLISION_DISTANCE, Exe, ParamError
 from formation_ros.core.frames import desired_positions
 from formation_ros.core.law import team_command
-from formation_ros.core.metrics import compute_metrics
+from formation_ros.core.metrics import body_metrics, compute_metrics
 from formation_ros.core.params import (FormationConfig, load_config,
                                        validate_for_every_executable)
 from formation_ros.core.params_file import load_params_file
 from formation_ros.core.plant import Commands, NS_PER_S, PlantModel
+from formation_ros.core.safety import guaranteed_min_distance
 from formation_ros.core.trajectory import Trajectory
+from formation_ros.core.unicycle import hand_points, unicycle_commands, unicycle_rates
 import numpy as np
 from scipy.integrate import solve_ivp
 
@@ -105,6 +114,8 @@ def simulate(config: FormationConfig, duration: Optional[float] = None,
     progress = progress or Progress(duration, quiet=True)
     if dt is not None:
         return simulate_fixed_step(config, duration, dt, sample_dt, progress)
+    if config.body.is_unicycle:
+        return simulate_unicycles(config, duration, sample_dt, progress)
     law = config.law()
     reference = config.reference()
     n, dim = config.num_robots, config.dim
@@ -125,6 +136,42 @@ def simulate(config: FormationConfig, duration: Optional[float] = None,
     return _assemble(solution.t, states, config, law, reference)
 
 
+def simulate_unicycles(config: FormationConfig, duration: float, sample_dt: float,
+                       progress: Progress) -> Trajectory:
+    """
+    Integrate the unicycles (U1) with RK45, each commanded through its hand point (U4).
+
+    The state is every axle centre and heading; the law sees the hand points (U2). In
+    continuous time the hand points then move exactly as the paper's points, p' = u (U3).
+    """
+    law = config.law()
+    reference = config.reference()
+    n = config.num_robots
+    l_value = config.body.hand_distance
+    assert config.start is not None and config.start_headings is not None
+
+    def rhs(t: float, y: np.ndarray) -> np.ndarray:
+        progress.update(t)
+        q, heading = y[:2 * n].reshape(n, 2), y[2 * n:]
+        u = team_command(hand_points(q, heading, l_value), config.vertices, config.sensing_radii,
+                         law, reference.sample(t)).u
+        q_rate, heading_rate = unicycle_rates(heading, unicycle_commands(u, heading, l_value))
+        return np.concatenate([q_rate.ravel(), heading_rate])
+
+    times = sample_times(duration, sample_dt)
+    start = np.concatenate([config.start.ravel(), config.start_headings])
+    solution = solve_ivp(rhs, (0.0, duration), start, method='RK45', t_eval=times, rtol=RTOL,
+                         atol=ATOL)
+    if not solution.success:
+        raise RuntimeError(f'RK45 failed: {solution.message}')
+    q_body = solution.y[:2 * n].T.reshape(-1, n, 2)
+    heading = solution.y[2 * n:].T
+    trajectory = _assemble(solution.t, hand_points(q_body, heading, l_value), config, law,
+                           reference)
+    return replace(trajectory, heading=heading, q_body=q_body,
+                   body_command=unicycle_commands(trajectory.u, heading, l_value))
+
+
 def simulate_fixed_step(config: FormationConfig, duration: float, dt: float,
                         sample_dt: float, progress: Progress) -> Trajectory:
     """
@@ -136,38 +183,66 @@ def simulate_fixed_step(config: FormationConfig, duration: float, dt: float,
     law = config.law()
     reference = config.reference()
     step_ns = int(round(dt * NS_PER_S))
+    bodies = make_bodies(config.body)
     model = PlantModel(config.start, config.sensing_radii, step_ns, law, reference,
                        input_timeout_ns=step_ns, collision_distance=DEFAULT_COLLISION_DISTANCE,
+                       bodies=bodies, headings=config.start_headings,
                        pair_radius=law.repulsion_radius)
-    commands = Commands.empty(config.num_robots, config.dim)
+    commands = Commands.empty(config.num_robots, bodies.command_width(config.dim))
     steps = int(round(duration / dt))
     stride = max(1, int(round(sample_dt / dt)))
-    times, states, applied, frames = [], [], [], []
+    times, states, applied, frames, headings, q_body, held = [], [], [], [], [], [], []
     for k in range(steps + 1):
         frame = reference.sample(model.t)
-        commands.store_all(team_command(model.q, config.vertices, config.sensing_radii, law,
-                                        frame, model.tree, model.pairs).u, model.t_ns)
+        u = team_command(model.points, config.vertices, config.sensing_radii, law, frame,
+                         model.tree, model.pairs).u
+        commands.store_all(bodies.body_command(u, model.heading), model.t_ns)
         if k == steps:
             times.append(model.t)
-            states.append(model.q)
-            applied.append(model.admit(commands).u)
+            states.append(model.points)
+            admission = model.admit(commands)
+            command = admission.u
+            applied.append(admission.velocity)
             frames.append(frame)
+            headings.append(model.heading)
+            q_body.append(model.q)
+            held.append(command)
             break
         progress.update(model.t)
         report = model.advance(commands)
         if k % stride == 0:
             times.append(report.t_ns / NS_PER_S)
-            states.append(report.q)
-            applied.append(report.admission.u)
+            states.append(report.points)
+            applied.append(report.admission.velocity)
             frames.append(frame)
-    return Trajectory.from_frames(times, states, applied, frames, config.vertices)
+            headings.append(report.heading)
+            q_body.append(report.q)
+            held.append(report.admission.u)
+    trajectory = Trajectory.from_frames(times, states, applied, frames, config.vertices)
+    if not bodies.has_heading:
+        return trajectory
+    return replace(trajectory, heading=np.array(headings), q_body=np.array(q_body),
+                   body_command=np.array(held))
 
 
 def run_metrics(trajectory: Trajectory, config: FormationConfig, integrator: str) -> dict:
     """metrics.json content for a simulated trajectory."""
     extra = {'reference_kind': config.reference_kind.value, 'integrator': integrator}
+    if trajectory.q_body is not None and trajectory.body_command is not None:
+        body = config.body
+        extra.update(body_metrics(trajectory.q_body, trajectory.body_command,
+                                  config.law().u_bound, body.hand_distance, body.radius))
+        extra.update({'max_linear': body.max_linear, 'max_angular': body.max_angular,
+                      'guaranteed_min_hand_point_distance': guaranteed_min_distance(
+                          trajectory.q[0], config.vertices, config.law(),
+                          config.reference().sample(float(trajectory.t[0])))})
     return compute_metrics(trajectory.t, trajectory.q, trajectory.u, trajectory.u_hat,
                            trajectory.q_desired, config.law().u_bound, extra)
+
+
+def _limit(metrics: dict, name: str, unit: str) -> str:
+    value = metrics.get(name)
+    return '' if value is None else f', body.{name} = {value:g} {unit}'
 
 
 def format_summary(metrics: dict, out_dir: Optional[str] = None) -> str:
@@ -185,6 +260,22 @@ def format_summary(metrics: dict, out_dir: Optional[str] = None) -> str:
         f"(bound c*M1 = {metrics['u_bound']:.4g} m/s, {metrics['bound_violations']} above)",
         f"  max |u| component: {metrics['max_abs_u_component']:.4g} m/s",
     ]
+    if metrics.get('body_kind') == 'unicycle':
+        touching = 2.0 * metrics['body_radius']
+        guaranteed = metrics['guaranteed_min_hand_point_distance']
+        contact = 'bodies touched' if metrics['min_body_distance'] < touching else 'no contact'
+        lines[3] = lines[3].replace('min pair distance', 'min hand-point distance')
+        lines += [
+            f"  closest body approach: {metrics['min_body_distance']:.4g} m ({contact}; "
+            f'2 x body.radius = {touching:.4g} m)',
+            '  guaranteed by the potential from this start (docs/equations.md, U6): hand '
+            f'points >= {guaranteed:.4g} m apart, so bodies >= '
+            f"{guaranteed - 2.0 * metrics['hand_distance']:.4g} m",
+            f"  max |v|: {metrics['max_abs_v']:.4g} m/s (sqrt(2) c M1 = "
+            f"{metrics['v_bound']:.4g} m/s{_limit(metrics, 'max_linear', 'm/s')}), "
+            f"max |w|: {metrics['max_abs_omega']:.4g} rad/s (sqrt(2) c M1 / l = "
+            f"{metrics['omega_bound']:.4g} rad/s{_limit(metrics, 'max_angular', 'rad/s')})",
+        ]
     if out_dir:
         lines.append(f'  results in {out_dir}')
     return '\n'.join(lines)

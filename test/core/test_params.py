@@ -161,3 +161,127 @@ def test_section5_file_is_plain_yaml_for_ros():
     params = document['/**']['ros__parameters']
     assert isinstance(params['controller']['gain'], float)
     assert all(isinstance(v, float) for v in params['formation']['vertices'])
+
+
+def unicycles(**changes):
+    """Return the Section 5 file as unicycles within TurtleBot3 Burger limits, changed."""
+    raw = base()
+    raw.update({'body.kind': 'unicycle', 'body.hand_distance': 0.08, 'body.radius': 0.05,
+                'controller.gain': 0.09, 'body.max_linear': 0.22, 'body.max_angular': 2.84})
+    for key, value in changes.items():
+        if value is None:
+            raw.pop(key, None)
+        else:
+            raw[key] = value
+    return raw
+
+
+def test_point_bodies_are_the_default_and_unchanged():
+    config = validate(base())
+    assert config.body.kind == 'point' and not config.body.is_unicycle
+    assert config.start_headings is None and config.body.radius == 0.0
+
+
+def test_unicycles_get_seeded_random_headings_and_keep_the_point_start():
+    config = validate(unicycles())
+    assert config.body.is_unicycle and config.body.hand_distance == 0.08
+    assert (config.body.max_linear, config.body.max_angular) == (0.22, 2.84)
+    assert np.array_equal(config.start, validate(base()).start)
+    headings = config.start_headings
+    assert headings.shape == (10,) and np.all((headings >= -math.pi) & (headings < math.pi))
+    assert np.array_equal(headings, validate(unicycles()).start_headings)
+    assert not np.allclose(headings, validate(unicycles(**{'start.seed': 5})).start_headings)
+    assert len(np.unique(np.round(headings, 6))) == 10
+
+
+def test_unicycle_headings_given_or_zero_with_given_positions():
+    given = [0.1 * k for k in range(10)]
+    assert np.array_equal(validate(unicycles(**{'start.headings': given})).start_headings,
+                          given)
+    explicit = unicycles(**{'start.random_radius': None, 'start.min_separation': None,
+                            'start.positions': [float(v) for k in range(10) for v in (k, 0.0)]})
+    assert np.array_equal(validate(explicit).start_headings, np.zeros(10))
+    assert validate({**unicycles(), 'robot_id': 2}, 'reference').start_headings is None
+
+
+def test_turtlebot_limits_refuse_a_gain_that_exceeds_them_and_say_what_fits():
+    with pytest.raises(ParamError) as info:
+        validate(unicycles(**{'controller.gain': 2.0}))
+    lines = str(info.value).splitlines()
+    linear = [line for line in lines if "'body.max_linear'" in line]
+    angular = [line for line in lines if "'body.max_angular'" in line]
+    assert len(linear) == 1 and len(angular) == 1
+    assert 'sqrt(2) c M1 = 4.443 m/s exceeds body.max_linear = 0.22 m/s' in linear[0]
+    assert 'controller.gain <= 0.09903 would fit' in linear[0]
+    assert 'controller.gain <= 0.1022 or body.hand_distance >= 1.565 m would fit' in angular[0]
+    fits = unicycles(**{'controller.gain': 0.09903})
+    assert validate(fits).body.max_linear == 0.22
+    slower = unicycles(**{'controller.gain': 0.09903, 'body.max_angular': 2.0})
+    with pytest.raises(ParamError, match='body.hand_distance >= 0.11 m would fit'):
+        validate(slower)
+    validate(unicycles(**{'controller.gain': 0.09903, 'body.max_angular': 2.0,
+                          'body.hand_distance': 0.11}))
+
+
+UNICYCLE_CASES = [
+    ('body.kind', {'dim': 3, 'formation.vertices': [float(k) for k in range(30)],
+                   'start.min_separation': 0.1}, 'unicycle needs dim 2'),
+    ('body.kind', {'body.kind': 'tank'}, 'point, unicycle'),
+    ('body.hand_distance', {'body.hand_distance': None}, 'is required for body.kind unicycle'),
+    ('body.hand_distance', {'body.hand_distance': 0.0}, 'must be > 0'),
+    ('body.radius', {'body.radius': -0.1}, 'must be >= 0'),
+    ('body.radius', {'body.radius': 0.2}, 'overlap at the start'),
+    ('start.headings', {'start.headings': [0.0] * 9}, 'num_robots = 10'),
+    ('start.headings', {'start.headings': [0.0, 1] + [0.0] * 8}, 'write 1.0'),
+    ('plant.max_speed', {'plant.max_speed': 1.0}, 'body.max_linear'),
+    ('body.max_angular', {'body.hand_distance': 0.05}, 'body.hand_distance >= 0.0704 m'),
+]
+
+
+@pytest.mark.parametrize('name,changes,message', UNICYCLE_CASES,
+                         ids=[f'{c[0]}-{i}' for i, c in enumerate(UNICYCLE_CASES)])
+def test_bad_unicycle_parameter_named_with_what_is_allowed(name, changes, message):
+    with pytest.raises(ParamError) as info:
+        validate(unicycles(**changes), 'plant' if name == 'plant.max_speed' else 'formation_sim')
+    assert f"parameter '{name}'" in str(info.value) and message in str(info.value)
+
+
+@pytest.mark.parametrize('name', ['body.hand_distance', 'body.max_linear', 'body.max_angular',
+                                  'start.headings'])
+def test_unicycle_parameters_are_refused_for_point_bodies(name):
+    raw = base()
+    raw[name] = [0.0] * 10 if name == 'start.headings' else 0.1
+    with pytest.raises(ParamError, match=f"'{re.escape(name)}': applies only to body.kind "
+                                         'unicycle'):
+        validate(raw)
+
+
+def test_hand_points_that_coincide_at_the_start_are_refused():
+    positions = [0.0, 0.0, 0.16] + [0.0] + [float(v) for k in range(2, 10) for v in (k, 5.0)]
+    raw = unicycles(**{'start.random_radius': None, 'start.min_separation': None,
+                       'start.positions': positions,
+                       'start.headings': [0.0, math.pi] + [0.0] * 8, 'body.radius': 0.0})
+    with pytest.raises(ParamError, match='robots 1 and 2 start with their hand points at the '
+                                         'same point'):
+        validate(raw)
+
+
+def test_a_formation_moving_faster_than_the_robots_can_is_refused():
+    circle = load_params_file(os.path.join(CONFIG_DIR, 'unicycle_circle_2d.yaml'))
+    assert validate(circle).reference_kind == 'circle'
+    circle['reference.speed'] = 0.25
+    with pytest.raises(ParamError) as info:
+        validate(circle)
+    text = str(info.value)
+    vertices = np.array(circle['formation.vertices']).reshape(-1, 2)
+    fastest = 0.25 / 4.0 * np.max(np.hypot(vertices[:, 0], 4.0 + np.abs(vertices[:, 1])))
+    assert f"'body.max_linear': the formation moves its vertices at up to {fastest:.4g} m/s" \
+        in text
+    factor = math.ceil(fastest / 0.22 * 1000) / 1000
+    assert f'a reference {factor:g} times slower (or vertices nearer its path) would fit' in text
+    circle['reference.speed'] = 0.25 / factor
+    validate(circle)
+    line = load_params_file(os.path.join(CONFIG_DIR, 'unicycle_2d.yaml'))
+    line.update({'reference.kind': 'line', 'reference.velocity': [0.3, 0.0]})
+    with pytest.raises(ParamError, match='up to 0.3 m/s'):
+        validate(line)

@@ -1,0 +1,167 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+The kinds of robot body the plant model integrates: points (eq. 1) and unicycles.
+
+:class:`~formation_ros.core.plant.PlantModel` keeps every robot's body position q (N, dim) in m
+and heading (N,) in rad (zero and unused for points) and delegates to one body object what
+depends on the kind:
+
+* the **control point** the law acts on: q itself for a point, the hand point
+  ``p = q + l (cos th, sin th)`` of a unicycle (core/unicycle.py, U2);
+* the **command** a robot sends: the world velocity u (N, dim) of a point, (v, w) (N, 2) of a
+  unicycle; :meth:`world_velocity` turns a command into the velocity of the control point, which
+  the model admits against the law's bound, and :meth:`body_command` turns such a velocity back
+  (U3, U4);
+* the **step** with the command held over dt: ``q += dt u`` for a point, the exact arc of
+  :func:`formation_ros.core.unicycle.zoh_step` for a unicycle;
+* the **actuator caps** a command is clipped to (``plant.max_speed`` per world component for
+  points; ``body.max_linear`` on |v| and ``body.max_angular`` on |w| for unicycles);
+* the **contact distance** of two bodies (``2 body.radius``) and the **sensing margin**: a
+  range sensor sees bodies, so a unicycle's sensor must reach ``R_i + 2 l`` to see every hand
+  point within R_i of its own.
+"""
+
+from dataclasses import dataclass
+from typing import Optional, Tuple, Union
+
+from formation_ros.core.declarations import BodyKind
+from formation_ros.core.unicycle import hand_points, hand_velocity, unicycle_commands, zoh_step
+import numpy as np
+from numpy.typing import NDArray
+
+Float = NDArray[np.float64]
+HEADING_SEED_OFFSET = 1
+"""Random headings come from the generator seeded with (start.seed, this), so the random
+positions of a seed stay those of a point team."""
+
+
+@dataclass(frozen=True)
+class BodySettings:
+    """
+    The robots' bodies (``body.*``).
+
+    kind: :class:`BodyKind`; hand_distance: l in m (unicycles); radius: body radius in m (0:
+    none); max_linear (m/s), max_angular (rad/s): actuator limits of a unicycle, None if not
+    given.
+    """
+
+    kind: BodyKind = BodyKind.POINT
+    hand_distance: float = 0.0
+    radius: float = 0.0
+    max_linear: Optional[float] = None
+    max_angular: Optional[float] = None
+
+    @property
+    def is_unicycle(self) -> bool:
+        """Tell whether the robots are unicycles."""
+        return self.kind is BodyKind.UNICYCLE
+
+
+POINT_BODY = BodySettings()
+
+
+class PointBodies:
+    """Single integrators q' = u (eq. 1); the control point is the body position."""
+
+    has_heading = False
+    sensing_margin = 0.0
+
+    def __init__(self, max_speed: float = 0.0, radius: float = 0.0):
+        """Cap every world command component at ``max_speed`` m/s (0: no cap); radius in m."""
+        self.max_speed = float(max_speed)
+        self.contact_distance = 2.0 * float(radius)
+
+    def command_width(self, dim: int) -> int:
+        """Return the number of values in one robot's command: dim."""
+        return dim
+
+    def control_points(self, q: Float, heading: Float) -> Float:
+        """Return the points the law acts on: q itself (N, dim), not copied."""
+        return q
+
+    def world_velocity(self, command: Float, heading: Float) -> Float:
+        """Return the velocity of the control point: the command itself, not copied."""
+        return command
+
+    def body_command(self, u: Float, heading: Float) -> Float:
+        """Return the command that gives the control point velocity u: u itself."""
+        return u
+
+    def step(self, q: Float, heading: Float, command: Float, dt: float) -> Tuple[Float, Float]:
+        """Zero-order hold over dt: (q + dt u, heading)."""
+        return q + dt * command, heading
+
+    def cap(self, command: Float, rows: NDArray[np.bool_]) -> NDArray[np.bool_]:
+        """Clip (in place) the ``rows`` whose components exceed max_speed; return which."""
+        if self.max_speed <= 0.0:
+            return np.zeros(len(command), dtype=bool)
+        capped: NDArray[np.bool_] = rows & np.any(np.abs(command) > self.max_speed, axis=1)
+        command[capped] = np.clip(command[capped], -self.max_speed, self.max_speed)
+        return capped
+
+
+class UnicycleBodies:
+    """
+    Differential-drive robots (core/unicycle.py): commands (v, w), control point the hand point.
+
+    hand_distance: l in m; radius: body radius in m; max_linear (m/s), max_angular (rad/s):
+    caps on |v| and |w| (None: none beyond the law's bound).
+    """
+
+    has_heading = True
+
+    def __init__(self, hand_distance: float, radius: float = 0.0,
+                 max_linear: Optional[float] = None, max_angular: Optional[float] = None):
+        """Keep the constants (checked by core/params.py)."""
+        if not hand_distance > 0.0:
+            raise ValueError(f'hand_distance must be > 0, got {hand_distance!r}')
+        self.hand_distance = float(hand_distance)
+        self.contact_distance = 2.0 * float(radius)
+        self.sensing_margin = 2.0 * self.hand_distance
+        self.limits = np.array([np.inf if max_linear is None else float(max_linear),
+                                np.inf if max_angular is None else float(max_angular)])
+
+    def command_width(self, dim: int) -> int:
+        """Return the number of values in one robot's command: 2, (v, w)."""
+        return 2
+
+    def control_points(self, q: Float, heading: Float) -> Float:
+        """Return the hand points (N, 2), m."""
+        return hand_points(q, heading, self.hand_distance)
+
+    def world_velocity(self, command: Float, heading: Float) -> Float:
+        """Return the hand points' velocities R(th) (v, l w) (N, 2), m/s."""
+        return hand_velocity(command, heading, self.hand_distance)
+
+    def body_command(self, u: Float, heading: Float) -> Float:
+        """Return (v, w) (N, 2) that move the hand points with velocities u."""
+        return unicycle_commands(u, heading, self.hand_distance)
+
+    def step(self, q: Float, heading: Float, command: Float, dt: float) -> Tuple[Float, Float]:
+        """Exact zero-order-hold step of the unicycles over dt: (q, heading) after it."""
+        return zoh_step(q, heading, command, dt)
+
+    def cap(self, command: Float, rows: NDArray[np.bool_]) -> NDArray[np.bool_]:
+        """Clip (in place) |v| and |w| of the ``rows`` to the actuator caps; return which."""
+        capped: NDArray[np.bool_] = rows & np.any(np.abs(command) > self.limits, axis=1)
+        command[capped] = np.clip(command[capped], -self.limits, self.limits)
+        return capped
+
+
+Bodies = Union[PointBodies, UnicycleBodies]
+
+
+def make_bodies(settings: BodySettings, max_speed: float = 0.0) -> Bodies:
+    """Build the body object of ``settings`` (``max_speed``: plant.max_speed, points only)."""
+    if settings.is_unicycle:
+        return UnicycleBodies(settings.hand_distance, settings.radius, settings.max_linear,
+                              settings.max_angular)
+    return PointBodies(max_speed, settings.radius)
+
+
+def random_headings(n: int, seed: int) -> Float:
+    """Return n headings uniform in [-pi, pi), rad, from the generator of (seed, 1): (n,)."""
+    rng = np.random.default_rng([seed, HEADING_SEED_OFFSET])
+    return np.asarray(rng.uniform(-np.pi, np.pi, n), dtype=float)
