@@ -25,7 +25,6 @@ from formation_ros.core.frames import FrameSample, STATIONARY
 from formation_ros.core.law import beta, LawParams, log_potential
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.optimize import brentq
 
 
 def guaranteed_min_distance(q0: ArrayLike, vertices: ArrayLike, law: LawParams,
@@ -48,6 +47,7 @@ def guaranteed_min_distance(q0: ArrayLike, vertices: ArrayLike, law: LawParams,
     def gap(distance: float) -> float:
         return float(beta(np.array(distance * distance), law)) - floor
 
+    from scipy.optimize import brentq  # only unicycle runs ask; formation_sim starts faster
     return float(brentq(gap, 0.0, b, xtol=1e-12 * b, rtol=1e-12))
 
 

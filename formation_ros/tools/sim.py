@@ -38,7 +38,6 @@ from formation_ros.core.safety import guaranteed_min_distance
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.core.unicycle import hand_points, unicycle_commands, unicycle_rates
 import numpy as np
-from scipy.integrate import solve_ivp
 
 RTOL = 1e-8
 ATOL = 1e-10
@@ -128,6 +127,7 @@ def simulate(config: FormationConfig, duration: Optional[float] = None,
                             frame).u.ravel()
 
     times = sample_times(duration, sample_dt)
+    from scipy.integrate import solve_ivp  # RK45 only: a --dt run does not load it
     solution = solve_ivp(rhs, (0.0, duration), config.start.ravel(), method='RK45',
                          t_eval=times, rtol=RTOL, atol=ATOL)
     if not solution.success:
@@ -160,6 +160,7 @@ def simulate_unicycles(config: FormationConfig, duration: float, sample_dt: floa
 
     times = sample_times(duration, sample_dt)
     start = np.concatenate([config.start.ravel(), config.start_headings])
+    from scipy.integrate import solve_ivp  # RK45 only: a --dt run does not load it
     solution = solve_ivp(rhs, (0.0, duration), start, method='RK45', t_eval=times, rtol=RTOL,
                          atol=ATOL)
     if not solution.success:
