@@ -32,7 +32,7 @@ from collections import deque
 import enum
 import math
 import time
-from typing import Dict, List, Optional, Tuple
+from typing import Callable, Dict, List, Optional, Tuple, TypeVar
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.declarations import Exe, PoseType
@@ -56,6 +56,7 @@ from numpy.typing import NDArray
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 
+Read = TypeVar('Read')
 REFERENCE_BUFFER = 64
 RATE_TOLERANCE = 1e-3
 INPUTS = ('pose', 'neighbour', 'reference')
@@ -173,24 +174,28 @@ class RobotNode(Node):
         self.once.end(f'{name}-{Reason.CLOCK.name}', f'{name} messages on this clock again')
         return True
 
+    def _read(self, name: str, reader: Callable[[bytes], Read], data: bytes) -> Optional[Read]:
+        """Return ``reader(data)``; None, counted and logged once, if the bytes do not fit it."""
+        try:
+            return reader(data)
+        except TooManyPoses as exc:
+            self._reject(name, Reason.TOO_MANY, f' ({exc})')
+        except CdrError as exc:
+            self._reject(name, Reason.MALFORMED, f' ({exc})')
+        return None
+
     def on_pose(self, data: bytes) -> None:
         """Store the latest own pose, read from the serialized PoseStamped."""
-        try:
-            pose = read_pose_stamped(data)
-        except CdrError as exc:
-            self._reject('pose', Reason.MALFORMED, f' ({exc})')
-            return
-        self._store_pose(pose)
+        pose = self._read('pose', read_pose_stamped, data)
+        if pose is not None:
+            self._store_pose(pose)
 
     def on_odometry(self, data: bytes) -> None:
         """Store the latest own pose, read from a serialized nav_msgs/Odometry."""
-        try:
-            odometry = read_odometry(data)
-        except CdrError as exc:
-            self._reject('pose', Reason.MALFORMED, f' ({exc})')
-            return
-        self._store_pose(PoseData(odometry.stamp_ns, odometry.frame_id, odometry.position,
-                                  odometry.orientation))
+        odometry = self._read('pose', read_odometry, data)
+        if odometry is not None:
+            self._store_pose(PoseData(odometry.stamp_ns, odometry.frame_id, odometry.position,
+                                      odometry.orientation))
 
     def _store_pose(self, pose: PoseData) -> None:
         if self._check('pose', pose.frame_id, pose.stamp_ns, pose.finite):
@@ -199,15 +204,13 @@ class RobotNode(Node):
             self.received_ns['pose'] = self._now_ns()
             self.answer.arm()
 
+    def _read_neighbours(self, data: bytes) -> PoseArrayData:
+        return read_pose_array(data, self.num_robots - 1)
+
     def on_neighbours(self, data: bytes) -> None:
         """Store the latest sensed neighbour positions, read from the serialized PoseArray."""
-        try:
-            heard = read_pose_array(data, self.num_robots - 1)
-        except TooManyPoses as exc:
-            self._reject('neighbour', Reason.TOO_MANY, f' ({exc})')
-            return
-        except CdrError as exc:
-            self._reject('neighbour', Reason.MALFORMED, f' ({exc})')
+        heard = self._read('neighbour', self._read_neighbours, data)
+        if heard is None:
             return
         finite = bool(np.all(np.isfinite(heard.positions))
                       and (not self.unicycle or np.all(np.isfinite(heard.orientations))))
@@ -218,10 +221,8 @@ class RobotNode(Node):
 
     def on_reference(self, data: bytes) -> None:
         """Store a reference sample (a few are kept to match state stamps in lockstep)."""
-        try:
-            msg = read_odometry(data)
-        except CdrError as exc:
-            self._reject('reference', Reason.MALFORMED, f' ({exc})')
+        msg = self._read('reference', read_odometry, data)
+        if msg is None:
             return
         if msg.frame_id != messages.WORLD_FRAME:
             self._reject('reference', Reason.FRAME, f' (got {msg.frame_id!r})')
