@@ -4,10 +4,12 @@
 """
 Whether a subscription's publishers are alive, from DDS liveliness (the lease of ``qos.py``).
 
-The publishers of ``cmd_vel``, ``pose`` and ``neighbors`` offer a liveliness lease of
-:data:`formation_ros.ros.qos.LIVELINESS_LEASE` and their subscribers ask for it, so DDS tells a
-subscriber within that lease when a publisher stopped showing signs of life (its process was
-killed, its host lost power or its link was cut), and again when it is back. A
+The robots' ``cmd_vel`` publishers offer a liveliness lease of
+:data:`formation_ros.ros.qos.LIVELINESS_LEASE` and the plant's subscribers ask for it, so DDS
+tells the plant within that lease when a robot stopped showing signs of life (its process was
+killed, its host lost power or its link was cut), and again when it is back. (The plant offers
+the lease on ``pose`` and ``neighbors`` too, but robots ask for none there: they hear any
+publisher, and notice a silent plant by their watchdog.) A
 :class:`PeerLiveliness` stores what the subscription's liveliness events say; the node's
 diagnostics timer reports it. Without liveliness the dead process's publisher stays listed
 until DDS drops its participant, about 20 s later.
