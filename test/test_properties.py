@@ -477,7 +477,7 @@ def test_extreme_values_in_range_checks_are_param_errors():
     raw = dump_params_text({**load_params_file(CONFIG), 'start.min_separation': 1e200})
     for exe in Exe:
         assert load_for(parse_params_text(raw, 'huge.yaml'), exe) is None or exe in (
-            Exe.ROBOT, Exe.REFERENCE)
+            Exe.ROBOT, Exe.REFERENCE, Exe.RELAY)
 
 
 def test_distinct_tiny_vertices_are_told_apart():

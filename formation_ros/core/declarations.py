@@ -35,6 +35,10 @@ class Kind(enum.Enum):
     STRING = 'string'
     BOOL = 'bool'
     DOUBLE_ARRAY = 'double_array'
+    STRING_ARRAY = 'string_array'
+
+
+ARRAYS = (Kind.DOUBLE_ARRAY, Kind.STRING_ARRAY)
 
 
 class Exe(enum.Enum):
@@ -45,6 +49,7 @@ class Exe(enum.Enum):
     PLANT = 'plant'
     REFERENCE = 'reference'
     RECORD = 'record'
+    RELAY = 'relay'
 
 
 class Choice(str, enum.Enum):
@@ -84,6 +89,27 @@ class PoseType(Choice):
     """The message a robot reads its own pose from: ``pose_type``."""
 
     POSE_STAMPED = 'pose_stamped'
+    ODOMETRY = 'odometry'
+
+
+class CommandType(Choice):
+    """The message a robot publishes its command as: ``command.type``."""
+
+    TWIST_STAMPED = 'twist_stamped'
+    TWIST = 'twist'
+
+
+class CommandFrame(Choice):
+    """The frame of a robot's command: ``command.frame``."""
+
+    WORLD = 'world'
+    BODY = 'body'
+
+
+class SourceType(Choice):
+    """The message the relay reads a measured pose from: ``relay.source_type``."""
+
+    POSE = 'pose'
     ODOMETRY = 'odometry'
 
 
@@ -128,6 +154,9 @@ ALL = frozenset(Exe)
 START = frozenset({Exe.SIM, Exe.PLANT, Exe.RECORD})
 PLANT = frozenset({Exe.PLANT, Exe.RECORD})
 ROBOT = frozenset({Exe.ROBOT, Exe.RECORD})
+COMMAND = frozenset({Exe.ROBOT, Exe.PLANT, Exe.RECORD})
+RELAY = frozenset({Exe.RELAY})
+DEFAULT_WORLD_FRAME = 'world'
 
 
 @dataclass(frozen=True)
@@ -171,6 +200,10 @@ DECLARATIONS = (
           low=at_least(2), high=at_least(100000)),
     Param('dim', Kind.INT, 2, 'Dimension n of the workspace: 2 or 3.', low=at_least(2),
           high=at_least(3)),
+    Param('world_frame', Kind.STRING, DEFAULT_WORLD_FRAME,
+          'Frame id of every formation message (poses, neighbours, reference, world-frame '
+          "commands); messages in another frame are refused. A mocap system's frame, e.g. "
+          "'map' or 'mocap'."),
     Param('sensing_radius', Kind.DOUBLE, REQUIRED, 'Sensing radius R_i of every robot, m.',
           low=above(0.0), high=at_least(LENGTH_LIMIT)),
     Param('sensing_radii', Kind.DOUBLE_ARRAY, None,
@@ -261,6 +294,16 @@ DECLARATIONS = (
           "what the plant publishes) or 'odometry' (nav_msgs/Odometry, e.g. a real base's "
           'localisation, remapped onto pose).', choices=_choices(PoseType),
           users=frozenset({Exe.ROBOT})),
+    Param('command.type', Kind.STRING, CommandType.TWIST_STAMPED.value,
+          "Message a robot publishes on cmd_vel: 'twist_stamped' (geometry_msgs/TwistStamped, "
+          "stamped with the state it answers) or 'twist' (geometry_msgs/Twist, for bases that "
+          'take no stamp); the plant subscribes with the same type.',
+          choices=_choices(CommandType), users=COMMAND),
+    Param('command.frame', Kind.STRING, None,
+          "Frame of a robot's command: 'world' (default for points: u in world_frame) or "
+          "'body' (robot_<i>/base_link, rotated by the pose's orientation: holonomic bases "
+          'that take body-frame velocities; unicycles always command (v, w) in their body '
+          'frame).', choices=_choices(CommandFrame), users=COMMAND),
     Param('wait_for_subscribers', Kind.INT, 1,
           'A robot sends its first command only once cmd_vel has this many subscribers (the '
           'plant; 2 when a recorder listens too).', low=at_least(0), high=at_least(1000),
@@ -286,6 +329,22 @@ DECLARATIONS = (
           'Cap on every component of an applied command, m/s (world frame); 0: no cap beyond '
           "the law's own bound (u_hat within c*M1 at the state a command answers).",
           low=at_least(0.0), users=PLANT),
+    Param('plant.actuator_lag', Kind.DOUBLE, 0.0,
+          "Time constant of a first-order lag between a robot's admitted command and its "
+          "body's velocity, s (0: the body moves at once, as eq. (1) assumes; beyond the "
+          'paper).', low=at_least(0.0), high=at_least(1000.0), users=START),
+    Param('plant.max_acceleration', Kind.DOUBLE, 0.0,
+          "Limit on the rate of change of the body's velocity, m/s^2, per world component "
+          'for points, on v (m/s^2) and w (rad/s^2) for unicycles (0: none; beyond the '
+          'paper).', low=at_least(0.0), high=at_least(SPEED_LIMIT), users=START),
+    Param('plant.pose_noise', Kind.DOUBLE, 0.0,
+          'Standard deviation of Gaussian noise on every sensed position (own pose and '
+          'neighbours), m, seeded by start.seed (0: exact; beyond the paper).',
+          low=at_least(0.0), high=at_least(LENGTH_LIMIT), users=START),
+    Param('plant.state_delay', Kind.DOUBLE, 0.0,
+          'A state reaches the robots this much later than it happened, s (0: at once; beyond '
+          'the paper); less than plant.input_timeout.', low=at_least(0.0),
+          high=at_least(1000.0), users=START),
     Param('plant.collision_distance', Kind.DOUBLE, DEFAULT_COLLISION_DISTANCE,
           'Two robots closer than this are logged as a collision, m.', low=at_least(0.0),
           users=PLANT),
@@ -310,6 +369,23 @@ DECLARATIONS = (
           users=frozenset({Exe.RECORD})),
     Param('record.markers', Kind.BOOL, False, 'Also record /formation/markers.',
           users=frozenset({Exe.RECORD})),
+    Param('relay.source_topic', Kind.STRING, '/robot_{i}/measured_pose',
+          "Topic of robot i's measured pose: '{i}' is the robot id, '{name}' its entry of "
+          "relay.source_names (e.g. '/vrpn_mocap/{name}/pose').", users=RELAY),
+    Param('relay.source_names', Kind.STRING_ARRAY, None,
+          "One name per robot (num_robots values), for '{name}' in relay.source_topic (e.g. "
+          'mocap rigid bodies [tb1, tb2, ...]).', users=RELAY),
+    Param('relay.source_type', Kind.STRING, SourceType.POSE.value,
+          "Message type of the measured poses: 'pose' (geometry_msgs/PoseStamped) or "
+          "'odometry' (nav_msgs/Odometry).", choices=_choices(SourceType), users=RELAY),
+    Param('relay.rate', Kind.DOUBLE, 50.0,
+          'Cycles per second of the relay, Hz (wall clock): each publishes every pose and '
+          'neighbour list with one stamp.', low=above(0.0), high=at_least(10000.0),
+          users=RELAY),
+    Param('relay.max_age', Kind.DOUBLE, 0.2,
+          'A robot whose latest measurement is older than this is stale, s: it gets no pose '
+          "(its watchdog stops it) but stays in the others' neighbour lists at its last "
+          'measured position.', low=above(0.0), high=at_least(1000.0), users=RELAY),
 )
 BY_NAME = {param.name: param for param in DECLARATIONS}
 ROS_OWN = ('use_sim_time', 'start_type_description_service', 'qos_overrides.')
@@ -358,6 +434,10 @@ def type_problem(param: Param, value: object) -> Optional[str]:
         return None if isinstance(value, str) else f'must be a string, got {value!r}'
     if param.kind is Kind.BOOL:
         return None if isinstance(value, bool) else f'must be true or false, got {value!r}'
+    if param.kind is Kind.STRING_ARRAY:
+        ok = (isinstance(value, (list, tuple)) and bool(value)
+              and all(isinstance(item, str) for item in value))
+        return None if ok else f'must be a non-empty list of strings, got {value!r}'
     if not isinstance(value, (list, tuple)) or not value:
         return f'must be a non-empty list of doubles, got {value!r}'
     for item in value:
@@ -413,7 +493,7 @@ def check_values(raw: Mapping[str, Any], exe: Exe) -> Dict[str, Any]:
         if problem:
             problems.append((param.name, problem))
         else:
-            values[param.name] = list(value) if param.kind is Kind.DOUBLE_ARRAY else value
+            values[param.name] = list(value) if param.kind in ARRAYS else value
     if problems:
         raise ParamError(problems)
     return values

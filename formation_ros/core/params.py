@@ -15,11 +15,15 @@ one :class:`ParamError`.
 
 from dataclasses import dataclass, field
 import math
+import re
+import string
 from typing import Any, Dict, List, Mapping, Optional, Tuple, Union
 
 from formation_ros.core.bodies import BodySettings, POINT_BODY, random_headings
-from formation_ros.core.declarations import (BodyKind, check_values, Exe, JumpKind, ParamError,
-                                             PoseType, PsiKind, ReferenceKind)
+from formation_ros.core.declarations import (BodyKind, check_values, CommandFrame, CommandType,
+                                             DEFAULT_WORLD_FRAME, Exe, JumpKind, ParamError,
+                                             PoseType, PsiKind, ReferenceKind, SourceType)
+from formation_ros.core.dynamics import IDEAL, Imperfections
 from formation_ros.core.frames import desired_positions, from_frame_velocity
 from formation_ros.core.law import LawParams, make_law, PSI_FUNCTIONS
 from formation_ros.core.params_file import load_params_file, PathText
@@ -33,6 +37,9 @@ Problems = List[Tuple[str, str]]
 TRACKING_SAMPLES = 721
 HAND_POINTS_APART = 1e-9
 """Hand points closer than this at the start (m) are one point: the law has no direction."""
+FRAME_ID = re.compile(r'[A-Za-z0-9_][A-Za-z0-9_./-]*')
+"""A frame id as tf2 takes it: no leading slash, no spaces."""
+SOURCE_FIELDS = ('i', 'name')
 
 
 @dataclass(frozen=True)
@@ -78,6 +85,47 @@ class RobotSettings:
 
 
 @dataclass(frozen=True)
+class CommandSettings:
+    """
+    What a robot publishes on ``cmd_vel`` and the plant reads (``command.*``).
+
+    message: TwistStamped or Twist (``command.type``); frame: world (u in ``world_frame``) or
+    body (the robot's ``robot_<i>/base_link``: u rotated into it by the pose's orientation, and
+    (v, w) for unicycles, which always command in their body frame).
+    """
+
+    message: CommandType = CommandType.TWIST_STAMPED
+    frame: CommandFrame = CommandFrame.WORLD
+
+    @property
+    def stamped(self) -> bool:
+        """Tell whether commands carry the stamp of the state they answer."""
+        return self.message is CommandType.TWIST_STAMPED
+
+
+@dataclass(frozen=True)
+class RelaySettings:
+    """
+    The relay's own parameters (``relay.*``): where the measured poses come from, how often.
+
+    source_topic: template with ``{i}`` (robot id) and ``{name}`` (its entry of
+    ``source_names``); source_type: PoseStamped or Odometry; rate: cycles per second, Hz;
+    max_age: a measurement older than this is stale, s.
+    """
+
+    source_topic: str
+    source_names: Tuple[str, ...]
+    source_type: SourceType
+    rate: float
+    max_age: float
+
+    def source(self, robot_id: int) -> str:
+        """Return robot ``robot_id``'s (1-based) measured-pose topic."""
+        name = self.source_names[robot_id - 1] if self.source_names else ''
+        return self.source_topic.format(i=robot_id, name=name)
+
+
+@dataclass(frozen=True)
 class ReferenceSettings:
     """The reference node's own parameters, and the plant's step (lockstep sends one ahead)."""
 
@@ -104,7 +152,10 @@ class FormationConfig:
     (dim,). plant / robot / reference_node / recorder: the executable's own settings (None for
     the others). values: the flat checked values with defaults (to write back as a file).
     body: the robots' bodies (``body.*``); start_headings: (N,) start headings in rad of
-    unicycles (for the executables that get a start; None for point bodies).
+    unicycles (for the executables that get a start; None for point bodies). world_frame: the
+    frame id of every formation message; command: what cmd_vel carries (``command.*``);
+    imperfections: how the bodies differ from q' = u (``plant.actuator_lag`` ...: ideal for
+    the executables that do not step bodies); relay: the relay's settings (None for the others).
     """
 
     num_robots: int
@@ -133,6 +184,10 @@ class FormationConfig:
     values: Dict[str, Any] = field(default_factory=dict, repr=False)
     body: BodySettings = POINT_BODY
     start_headings: Optional[NDArray[np.float64]] = None
+    world_frame: str = DEFAULT_WORLD_FRAME
+    command: CommandSettings = CommandSettings()
+    imperfections: Imperfections = IDEAL
+    relay: Optional[RelaySettings] = None
 
     def law(self) -> LawParams:
         """Return the control law constants (``core.law.LawParams``)."""
@@ -375,13 +430,90 @@ def _own_settings(values: Mapping[str, Any], exe: Exe, n: int,
             wait_for_subscribers=values['wait_for_subscribers'],
             pose_type=PoseType(values['pose_type']))}
     if exe is Exe.REFERENCE:
-        return {'reference_node': ReferenceSettings(
-            rate=values['reference.rate'], step_ns=int(round(NS_PER_S / values['plant.rate'])))}
+        step_ns = NS_PER_S / values['plant.rate']
+        if not math.isfinite(step_ns):
+            problems.append(('plant.rate', f"{values['plant.rate']:g} Hz is too slow for a step "
+                                           'in nanoseconds'))
+            step_ns = NS_PER_S
+        return {'reference_node': ReferenceSettings(rate=values['reference.rate'],
+                                                    step_ns=int(round(step_ns)))}
     if exe is Exe.RECORD:
         return {'recorder': RecorderSettings(path=values['record.path'],
                                              overwrite=values['record.overwrite'],
                                              markers=values['record.markers'])}
     return {}
+
+
+def _world_frame(values: Mapping[str, Any], problems: Problems) -> str:
+    frame = values['world_frame']
+    if not FRAME_ID.fullmatch(frame):
+        problems.append(('world_frame', f'must be a frame id without a leading slash or '
+                                        f"spaces (e.g. 'world', 'map'), got {frame!r}"))
+    return str(frame)
+
+
+def _command(values: Mapping[str, Any], body: BodySettings,
+             problems: Problems) -> CommandSettings:
+    """``command.*``: unicycles command (v, w) in their body frame, points either frame."""
+    kind = CommandType(values.get('command.type', CommandType.TWIST_STAMPED.value))
+    given = values.get('command.frame')
+    if body.is_unicycle:
+        if given is not None and CommandFrame(given) is not CommandFrame.BODY:
+            problems.append(('command.frame', 'unicycles command (v, w) in their body frame: '
+                                              "leave command.frame out or set it to 'body'"))
+        return CommandSettings(kind, CommandFrame.BODY)
+    return CommandSettings(kind, CommandFrame.WORLD if given is None else CommandFrame(given))
+
+
+def _imperfections(values: Mapping[str, Any], exe: Exe, problems: Problems) -> Imperfections:
+    """``plant.actuator_lag`` ...: the non-ideal bodies of the executables that step them."""
+    if exe not in (Exe.SIM, Exe.PLANT, Exe.RECORD):
+        return IDEAL
+    imperfections = Imperfections(
+        actuator_lag=values['plant.actuator_lag'],
+        max_acceleration=values['plant.max_acceleration'],
+        pose_noise=values['plant.pose_noise'], state_delay=values['plant.state_delay'],
+        seed=values['start.seed'])
+    timeout = values.get('plant.input_timeout')
+    if exe is Exe.PLANT and timeout is not None and imperfections.state_delay >= timeout:
+        problems.append(('plant.state_delay', f'{imperfections.state_delay:g} s would make '
+                                              'every command stale: it must be less than '
+                                              f'plant.input_timeout = {timeout:g} s'))
+    return imperfections
+
+
+def _relay(values: Mapping[str, Any], n: int, problems: Problems) -> RelaySettings:
+    """``relay.*``: the topic template may name {i} and {name} (with one name per robot)."""
+    template = values['relay.source_topic']
+    names = tuple(values.get('relay.source_names') or ())
+    try:
+        fields = [name for _, name, spec, conv in string.Formatter().parse(template)
+                  if name is not None]
+    except ValueError as exc:
+        problems.append(('relay.source_topic', f'is not a topic template ({exc}): {template!r}'))
+        fields = []
+    unknown = sorted(set(fields) - set(SOURCE_FIELDS))
+    if unknown:
+        problems.append(('relay.source_topic', 'may use only {i} and {name}, got '
+                                               f"{', '.join('{' + f + '}' for f in unknown)} in "
+                                               f'{template!r}'))
+    if names and len(names) != n:
+        problems.append(('relay.source_names', f'must hold num_robots = {n} names, '
+                                               f'got {len(names)}'))
+    elif 'name' in fields and not names:
+        problems.append(('relay.source_names', f'is required: relay.source_topic {template!r} '
+                                               'uses {name}'))
+    elif names and len(set(names)) != len(names):
+        problems.append(('relay.source_names', 'names must differ (two robots would read one '
+                                               'topic)'))
+    elif names and not all(names):
+        problems.append(('relay.source_names', 'names must not be empty'))
+    elif not unknown and fields.count('i') + fields.count('name') == 0 and n > 1:
+        problems.append(('relay.source_topic', f'{template!r} names no robot: use {{i}} or '
+                                               '{name}, or every robot would read one topic'))
+    return RelaySettings(source_topic=template, source_names=names,
+                         source_type=SourceType(values['relay.source_type']),
+                         rate=values['relay.rate'], max_age=values['relay.max_age'])
 
 
 def validate(raw: Mapping[str, Any], executable: Union[Exe, str] = Exe.SIM) -> FormationConfig:
@@ -412,6 +544,10 @@ def validate(raw: Mapping[str, Any], executable: Union[Exe, str] = Exe.SIM) -> F
     velocity = _vector(values, 'reference.velocity', dim, problems)
     own = _own_settings(values, exe, n, problems)
     body = _body(values, dim, problems)
+    world_frame = _world_frame(values, problems)
+    command = _command(values, body, problems)
+    imperfections = _imperfections(values, exe, problems)
+    relay = _relay(values, n, problems) if exe is Exe.RELAY else None
     headings = _headings(values, body, n, problems) if start is not None else None
     if start is not None and not problems:
         _body_geometry(body, start, headings, problems)
@@ -430,7 +566,8 @@ def validate(raw: Mapping[str, Any], executable: Union[Exe, str] = Exe.SIM) -> F
         reference_velocity=velocity, reference_radius=values['reference.radius'],
         reference_speed=values['reference.speed'], reference_pitch=values['reference.pitch'],
         duration=values['duration'], lockstep=values.get('plant.lockstep', False),
-        values=values, body=body, start_headings=headings, **own)
+        values=values, body=body, start_headings=headings, world_frame=world_frame,
+        command=command, imperfections=imperfections, relay=relay, **own)
 
 
 def load_config(path: PathText,
@@ -447,12 +584,12 @@ def validate_for_every_executable(raw: Mapping[str, Any]) -> Dict[Exe, Formation
     Raises the first :class:`ParamError`.
     """
     checked = {}
-    for exe in (Exe.SIM, Exe.PLANT, Exe.REFERENCE, Exe.ROBOT):
+    for exe in (Exe.SIM, Exe.PLANT, Exe.REFERENCE, Exe.ROBOT, Exe.RELAY):
         given = {**raw, 'robot_id': raw.get('robot_id', 1)} if exe is Exe.ROBOT else raw
         checked[exe] = validate(given, exe)
     return checked
 
 
-__all__ = ['FormationConfig', 'load_config', 'ParamError', 'PlantSettings',
-           'RecorderSettings', 'ReferenceSettings', 'RobotSettings', 'validate',
+__all__ = ['CommandSettings', 'FormationConfig', 'load_config', 'ParamError', 'PlantSettings',
+           'RecorderSettings', 'ReferenceSettings', 'RelaySettings', 'RobotSettings', 'validate',
            'validate_for_every_executable']

@@ -38,17 +38,15 @@ for points, (N, 2) holding (v, w) in m/s and rad/s for unicycles.
 from collections import OrderedDict
 from dataclasses import dataclass, field
 import enum
-from typing import Dict, List, Optional, Set, Tuple, TYPE_CHECKING
+from typing import Dict, List, Optional, Set, Tuple
 
 from formation_ros.core.bodies import Bodies, PointBodies
 from formation_ros.core.frames import from_frame_velocity, to_frame_velocity
 from formation_ros.core.law import LawParams
 from formation_ros.core.reference import Reference
+from formation_ros.core.sensing import neighbour_lists, sensed_pairs, sensor_radii
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-
-if TYPE_CHECKING:
-    from scipy.spatial import cKDTree
 
 NS_PER_S = 1_000_000_000
 BOUND_TOLERANCE_FIXED = 1e-9
@@ -307,23 +305,6 @@ def start_positions(spec: StartSpec) -> Optional[NDArray[np.float64]]:
                         spec.seed)
 
 
-def sensed_pairs(tree: 'cKDTree', q: NDArray[np.float64],
-                 radii: NDArray[np.float64]) -> Tuple[NDArray[np.intp], NDArray[np.intp]]:
-    """
-    Who senses whom: arrays (observer, seen) of every ordered pair with ||q_o - q_s|| < R_o.
-
-    tree: k-d tree of ``q`` (N, dim); radii: (N,) R_i in m. Sorted by observer.
-    """
-    pairs = tree.query_pairs(r=float(np.max(radii)), output_type='ndarray').reshape(-1, 2)
-    diff = q[pairs[:, 0]] - q[pairs[:, 1]]
-    d2 = np.einsum('kd,kd->k', diff, diff)
-    first = pairs[d2 < radii[pairs[:, 0]] ** 2]
-    second = pairs[d2 < radii[pairs[:, 1]] ** 2][:, ::-1]
-    both = np.concatenate([first, second])
-    order = np.lexsort((both[:, 1], both[:, 0]))
-    return both[order, 0], both[order, 1]
-
-
 class PlantModel:
     """
     Every robot's body and range sensor, stepped with zero-order hold.
@@ -364,7 +345,7 @@ class PlantModel:
         self.input_timeout_ns = int(input_timeout_ns)
         self.collision_distance = float(collision_distance)
         self.contact_distance = max(self.collision_distance, self.body.contact_distance)
-        self.sensor_radii = self.radii + self.body.sensing_margin
+        self.sensor_radii = sensor_radii(self.radii, self.body.sensing_margin)
         self.pair_radius = float(pair_radius)
         self.pairs: Optional[NDArray[np.intp]] = None
         """(P, 2) pairs i < j of control points within ``pair_radius`` now (None without it)."""
@@ -523,18 +504,17 @@ class PlantModel:
 
     def sensed_pairs(self) -> Tuple[NDArray[np.intp], NDArray[np.intp]]:
         """
-        Every robot's range sensor now: (observer, seen) pairs, see :func:`sensed_pairs`.
+        Every robot's range sensor now: (observer, seen) pairs (``core.sensing``).
 
         A sensor sees bodies, strictly within R_i for points and R_i + 2 l for unicycles
         (``sensor_radii``), so that it sees every hand point within R_i of its own.
         """
-        return sensed_pairs(self.body_tree, self.q, self.sensor_radii)
+        return sensed_pairs(self.q, self.sensor_radii, self.body_tree)
 
     def neighbours(self) -> List[NDArray[np.intp]]:
         """Robot i's range sensor: indices of the other bodies it sees, each sorted."""
         observer, seen = self.sensed_pairs()
-        splits = np.searchsorted(observer, np.arange(1, self.num_robots))
-        return np.split(seen, splits)
+        return neighbour_lists(observer, seen, self.num_robots)
 
     def closest_pair_distance(self) -> float:
         """Smallest distance between two control points now, m (inf for a single robot)."""

@@ -300,7 +300,7 @@ class StateEncoder:
         Return (poses, arrays): robot i's serialized PoseStamped and PoseArray at ``stamp_ns``.
 
         q: (N, dim) positions, m; (observer, seen): every sensed pair, sorted by observer
-        (``core.plant.sensed_pairs``): robot ``observer[k]`` sees robot ``seen[k]``;
+        (``core.sensing.sensed_pairs``): robot ``observer[k]`` sees robot ``seen[k]``;
         headings: (N,) rad about +z, written as the orientations (None: identity).
         """
         self.rows[:, :self.dim] = q

@@ -15,8 +15,8 @@ import re
 import sys
 from typing import Any, Dict, Optional
 
-from formation_ros.core.declarations import (Bound, did_you_mean, Exe, is_known, Kind, Param,
-                                             ParamError, used_by)
+from formation_ros.core.declarations import (ARRAYS, Bound, did_you_mean, Exe, is_known, Kind,
+                                             Param, ParamError, used_by)
 from formation_ros.core.params import FormationConfig, validate
 from formation_ros.ros.topics import robot_namespace
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
@@ -30,6 +30,7 @@ TYPES = {
     Kind.STRING: Parameter.Type.STRING,
     Kind.BOOL: Parameter.Type.BOOL,
     Kind.DOUBLE_ARRAY: Parameter.Type.DOUBLE_ARRAY,
+    Kind.STRING_ARRAY: Parameter.Type.STRING_ARRAY,
 }
 FLOAT_MAX = sys.float_info.max
 INT_MAX = 2 ** 63 - 1
@@ -74,7 +75,7 @@ def _given(node: Node, exe: Exe) -> Dict[str, Any]:
         node.undeclare_parameter(param.name)
         if probe.value is not None:
             value = probe.value
-            given[param.name] = list(value) if param.kind is Kind.DOUBLE_ARRAY else value
+            given[param.name] = list(value) if param.kind in ARRAYS else value
     if problems:
         raise ParamError(problems)
     return given

@@ -3,7 +3,7 @@
 
 """Headings on the wire: state messages of unicycles against rclpy's deserialisation."""
 
-from formation_ros.core.plant import sensed_pairs
+from formation_ros.core.sensing import sensed_pairs
 from formation_ros.core.unicycle import headings_from_quaternions, quaternions_from_headings
 from formation_ros.ros.cdr import read_pose_array, StateEncoder
 from geometry_msgs.msg import Pose, PoseArray, PoseStamped
@@ -16,7 +16,7 @@ def test_state_messages_carry_each_robots_heading():
     rng = np.random.default_rng(5)
     q = rng.uniform(-1.0, 1.0, (7, 2))
     headings = rng.uniform(-np.pi, np.pi, 7)
-    observer, seen = sensed_pairs(cKDTree(q), q, np.full(7, 1.2))
+    observer, seen = sensed_pairs(q, np.full(7, 1.2), cKDTree(q))
     encoder = StateEncoder(7, 2, 'world')
     poses, arrays = encoder.encode(q, observer, seen, 123_000_000_789, headings)
     for i in range(7):

@@ -3,7 +3,7 @@
 
 """The plant's state messages written as bytes equal the messages built one by one."""
 
-from formation_ros.core.plant import sensed_pairs
+from formation_ros.core.sensing import sensed_pairs
 from formation_ros.ros import fields, messages
 from formation_ros.ros.cdr import StateEncoder
 from geometry_msgs.msg import PoseArray, PoseStamped
@@ -21,7 +21,7 @@ def test_encoded_states_equal_messages_built_alone_at_every_step(dim):
     for step in range(3):
         q = rng.uniform(-2.0, 2.0, (n, dim))
         radii = np.full(n, 1.5 + step)
-        observer, seen = sensed_pairs(cKDTree(q), q, radii)
+        observer, seen = sensed_pairs(q, radii, cKDTree(q))
         stamp = 1_000_000_007 * (step + 1)
         poses, arrays = encoder.encode(q, observer, seen, stamp)
         assert len(poses) == len(arrays) == n
@@ -36,7 +36,7 @@ def test_encoded_states_equal_messages_built_alone_at_every_step(dim):
 
 def test_encode_leaves_its_inputs_alone_and_lists_nobody_unseen():
     q = np.array([[0.0, 0.0], [0.5, 0.0], [3.0, 3.0]])
-    observer, seen = sensed_pairs(cKDTree(q), q, np.ones(3))
+    observer, seen = sensed_pairs(q, np.ones(3), cKDTree(q))
     before = (q.copy(), observer.copy(), seen.copy())
     poses, arrays = StateEncoder(3, 2, messages.WORLD_FRAME).encode(q, observer, seen, 5)
     assert np.array_equal(q, before[0]) and np.array_equal(observer, before[1])
