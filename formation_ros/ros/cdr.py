@@ -204,6 +204,13 @@ def read_twist_stamped(data: bytes) -> TwistData:
     return TwistData(stamp_ns, frame_id, values[:3], values[3:])
 
 
+def read_twist(data: bytes) -> TwistData:
+    """Read a serialized geometry_msgs/Twist (stamp 0, frame ''); CdrError if it is not one."""
+    reader = _Reader(data, 'Twist')
+    values = reader.doubles(6)
+    return TwistData(0, '', values[:3], values[3:])
+
+
 def read_odometry(data: bytes) -> OdometryData:
     """Read a serialized nav_msgs/Odometry (its covariances skipped); CdrError if not one."""
     reader = _Reader(data, 'Odometry')
@@ -254,6 +261,11 @@ def encode_twist_stamped(stamp_ns: int, frame_id: str, linear: ArrayLike,
                          angular: ArrayLike = (0.0, 0.0, 0.0)) -> bytes:
     """Return a serialized TwistStamped: ``linear`` ((dim,) m/s) and ``angular`` (rad/s)."""
     return _with_doubles(encode_header(stamp_ns, frame_id), _xyz(linear) + _xyz(angular))
+
+
+def encode_twist(linear: ArrayLike, angular: ArrayLike = (0.0, 0.0, 0.0)) -> bytes:
+    """Return a serialized Twist (no header): ``linear`` ((dim,) m/s) and ``angular`` (rad/s)."""
+    return _with_doubles(LITTLE, _xyz(linear) + _xyz(angular))
 
 
 def encode_odometry(stamp_ns: int, frame_id: str, child_frame_id: str, position: ArrayLike,
