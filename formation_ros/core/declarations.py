@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import difflib
 import enum
 import math
+import re
 from typing import Any, Dict, FrozenSet, Iterable, Mapping, Optional, Tuple, Type
 
 from formation_ros.core.law import GAIN_MAX, KAPPA_MAX, REPULSION_RANGE
@@ -156,6 +157,10 @@ PLANT = frozenset({Exe.PLANT, Exe.RECORD})
 ROBOT = frozenset({Exe.ROBOT, Exe.RECORD})
 COMMAND = frozenset({Exe.SIM, Exe.ROBOT, Exe.PLANT, Exe.RECORD})
 RELAY = frozenset({Exe.RELAY})
+SCHEDULE = frozenset({Exe.SIM, Exe.REFERENCE, Exe.RECORD})
+SHAPE_VERTICES = 'formations.<name>.vertices'
+"""The declaration of every named shape's vertices: ``formations.line.vertices`` and so on."""
+SHAPE_NAME = re.compile(r'[A-Za-z][A-Za-z0-9_]*')
 DEFAULT_WORLD_FRAME = 'world'
 
 
@@ -227,6 +232,22 @@ DECLARATIONS = (
     Param('formation.vertices', Kind.DOUBLE_ARRAY, REQUIRED,
           "Flat list of num_robots x dim values: robot i's place in the formation frame, m.",
           low=at_least(-LENGTH_LIMIT), high=at_least(LENGTH_LIMIT)),
+    Param('formation.name', Kind.STRING, '',
+          "Name of the shape in force: one of formations.names, or '' for formation.vertices. "
+          'Settable on the running reference node.'),
+    Param('formations.names', Kind.STRING_ARRAY, None,
+          'Names of the shapes the team can switch between; shape N has its vertices in '
+          'formations.N.vertices.'),
+    Param(SHAPE_VERTICES, Kind.DOUBLE_ARRAY, None,
+          'Vertices of the shape named <name> (one of formations.names), as formation.vertices.',
+          low=at_least(-LENGTH_LIMIT), high=at_least(LENGTH_LIMIT)),
+    Param('formation.schedule.times', Kind.DOUBLE_ARRAY, None,
+          'Times at which the shape changes, s, increasing (with formation.schedule.names): a '
+          'scripted switch that formation_sim and a lockstep run reproduce alike.',
+          low=at_least(0.0), high=at_least(1e7), users=SCHEDULE),
+    Param('formation.schedule.names', Kind.STRING_ARRAY, None,
+          'The shape (a name of formations.names) in force from each of formation.schedule.times '
+          'on.', users=SCHEDULE),
     Param('body.kind', Kind.STRING, BodyKind.POINT.value,
           "The robots' bodies: 'point' (q' = u, eq. 1) or 'unicycle' (differential drive, "
           'commanded with (v, w) through a hand point; dim 2 only).', choices=_choices(BodyKind)),
@@ -406,9 +427,23 @@ def used_by(exe: Exe) -> Tuple[Param, ...]:
     return tuple(param for param in DECLARATIONS if exe in param.users)
 
 
+def shape_vertices_name(shape: str) -> str:
+    """Return the parameter of a named shape's vertices: 'line' gives formations.line.vertices."""
+    return f'formations.{shape}.vertices'
+
+
+def shape_of_parameter(name: str) -> Optional[str]:
+    """Return the shape a ``formations.<name>.vertices`` parameter names, else None."""
+    parts = name.split('.')
+    if len(parts) == 3 and parts[0] == 'formations' and parts[2] == 'vertices' \
+            and SHAPE_NAME.fullmatch(parts[1]):
+        return parts[1]
+    return None
+
+
 def is_known(name: str) -> bool:
     """Tell whether ``name`` is a formation parameter or one that rclpy itself declares."""
-    return name in BY_NAME or name.startswith(ROS_OWN)
+    return name in BY_NAME or name.startswith(ROS_OWN) or shape_of_parameter(name) is not None
 
 
 def did_you_mean(name: str) -> str:
@@ -481,7 +516,18 @@ def check_values(raw: Mapping[str, Any], exe: Exe) -> Dict[str, Any]:
     problems = [(name, f'unknown parameter{did_you_mean(name)}') for name in raw
                 if not is_known(name)]
     values: Dict[str, Any] = {}
+    shapes = BY_NAME[SHAPE_VERTICES]
+    for name in raw:
+        if shape_of_parameter(name) is not None and exe in shapes.users:
+            value = raw[name]
+            problem = type_problem(shapes, value) or range_problem(shapes, value)
+            if problem:
+                problems.append((name, problem))
+            else:
+                values[name] = list(value)
     for param in used_by(exe):
+        if param is shapes:
+            continue
         value = raw.get(param.name)
         if value is None:
             if param.default is REQUIRED:

@@ -20,9 +20,11 @@ import string
 from typing import Any, Dict, List, Mapping, Optional, Tuple, Union
 
 from formation_ros.core.bodies import BodySettings, POINT_BODY, random_headings
-from formation_ros.core.declarations import (BodyKind, check_values, CommandFrame, CommandType,
-                                             DEFAULT_WORLD_FRAME, Exe, JumpKind, ParamError,
-                                             PoseType, PsiKind, ReferenceKind, SourceType)
+from formation_ros.core.declarations import (BodyKind, BY_NAME, check_values, CommandFrame,
+                                             CommandType, DEFAULT_WORLD_FRAME, Exe, JumpKind,
+                                             ParamError, PoseType, PsiKind, range_problem,
+                                             ReferenceKind, SHAPE_NAME, shape_vertices_name,
+                                             SourceType, type_problem)
 from formation_ros.core.dynamics import IDEAL, Imperfections
 from formation_ros.core.frames import desired_positions, from_frame_velocity
 from formation_ros.core.law import LawParams, make_law, PSI_FUNCTIONS
@@ -154,7 +156,10 @@ class FormationConfig:
     body: the robots' bodies (``body.*``); start_headings: (N,) start headings in rad of
     unicycles and of points with body-frame commands (for the executables that get a start;
     None otherwise). world_frame: the
-    frame id of every formation message; command: what cmd_vel carries (``command.*``);
+    frame id of every formation message; shapes: the named shapes {name: (N, dim) vertices}
+    (``formations.*``), shape_name: the one in force at the start ('' for
+    ``formation.vertices``; ``vertices`` are then that shape's), schedule: (time in s, shape
+    name) switches (``formation.schedule.*``); command: what cmd_vel carries (``command.*``);
     imperfections: how the bodies differ from q' = u (``plant.actuator_lag`` ...: ideal for
     the executables that do not step bodies); relay: the relay's settings (None for the others).
     """
@@ -186,6 +191,9 @@ class FormationConfig:
     body: BodySettings = POINT_BODY
     start_headings: Optional[NDArray[np.float64]] = None
     world_frame: str = DEFAULT_WORLD_FRAME
+    shapes: Dict[str, NDArray[np.float64]] = field(default_factory=dict, repr=False)
+    shape_name: str = ''
+    schedule: Tuple[Tuple[float, str], ...] = ()
     command: CommandSettings = CommandSettings()
     imperfections: Imperfections = IDEAL
     relay: Optional[RelaySettings] = None
@@ -257,6 +265,49 @@ def _vector(values: Dict[str, Any], name: str, dim: int,
     return np.array(vec, dtype=float)
 
 
+def shape_problem(vertices: NDArray[np.float64], repulsion_radius: float) -> Optional[str]:
+    """
+    Return why a shape cannot be the formation, or None: two vertices closer than b.
+
+    vertices: (N, dim) finite, m. Eq. (11) needs b_ij <= eps_2, the smallest distance between
+    two vertices, so that the collision term vanishes at the formation.
+    """
+    if len(vertices) < 2:
+        return None
+    gap, i, j = _closest_pair(vertices)
+    if gap == 0.0:
+        return f'robots {i} and {j} have the same vertex'
+    if repulsion_radius > gap:
+        return (f'b = {repulsion_radius:g} m must not exceed the distance between the closest '
+                f'vertices ({i} and {j}: {gap:g} m): eq. (11) needs b_ij <= eps_2')
+    return None
+
+
+def check_shape(flat: Any, n: int, dim: int, repulsion_radius: float) -> NDArray[np.float64]:
+    """
+    Check a shape given at runtime as the file's would be; return its vertices (N, dim).
+
+    flat: num_robots x dim finite doubles, robot after robot. Raises :class:`ParamError` (one
+    problem, named ``formation.vertices``) otherwise.
+    """
+    problems: Problems = []
+    param = BY_NAME['formation.vertices']
+    problem = type_problem(param, flat) or range_problem(param, flat)
+    vertices = None
+    if problem:
+        problems.append(('formation.vertices', problem))
+    else:
+        vertices = _points({'v': list(flat)}, 'v', n, dim, problems)
+    if vertices is not None:
+        problem = shape_problem(vertices, repulsion_radius)
+        if problem:
+            problems.append(('formation.vertices', problem))
+    if problems or vertices is None:
+        raise ParamError([('formation.vertices', text.replace("'v'", 'formation.vertices'))
+                          for _, text in problems])
+    return vertices
+
+
 def _geometry(values: Mapping[str, Any], radii: NDArray[np.float64],
               vertices: Optional[NDArray[np.float64]],
               start: Optional[NDArray[np.float64]], problems: Problems) -> None:
@@ -267,13 +318,10 @@ def _geometry(values: Mapping[str, Any], radii: NDArray[np.float64],
                                              f'(smallest R_i = {smallest:g} m): eq. (11) needs '
                                              'b_ij <= min(R_i, R_j)'))
     if vertices is not None:
-        gap, i, j = _closest_pair(vertices)
-        if gap == 0.0:
-            problems.append(('formation.vertices', f'robots {i} and {j} have the same vertex'))
-        elif b > gap:
-            problems.append(('repulsion_radius', f'b = {b:g} m must not exceed the distance '
-                                                 f'between the closest vertices ({i} and {j}: '
-                                                 f'{gap:g} m): eq. (11) needs b_ij <= eps_2'))
+        problem = shape_problem(vertices, b)
+        if problem:
+            name = 'repulsion_radius' if problem.startswith('b =') else 'formation.vertices'
+            problems.append((name, problem))
     if start is not None:
         gap, i, j = _closest_pair(start)
         if gap == 0.0:
@@ -344,6 +392,14 @@ def _body(values: Mapping[str, Any], dim: int, problems: Problems) -> BodySettin
                                              f'{_up(v_bound / max_angular):g} m would fit'))
     return BodySettings(kind=kind, hand_distance=l_value, radius=values.get('body.radius', 0.0),
                         max_linear=max_linear, max_angular=max_angular)
+
+
+def tracking_problem(body: BodySettings, vertices: NDArray[np.float64], reference: Reference,
+                     duration: float) -> Optional[str]:
+    """Return why unicycles cannot follow ``reference`` with ``vertices`` (speed), or None."""
+    problems: Problems = []
+    _tracking_problems(body, vertices, reference, duration, problems)
+    return problems[0][1] if problems else None
 
 
 def _tracking_problems(body: BodySettings, vertices: NDArray[np.float64],
@@ -453,6 +509,57 @@ def _own_settings(values: Mapping[str, Any], exe: Exe, n: int,
     return {}
 
 
+def _named_shapes(values: Mapping[str, Any], n: int, dim: int,
+                  problems: Problems) -> Dict[str, NDArray[np.float64]]:
+    """``formations.names`` and each ``formations.<name>.vertices``, checked as the file's."""
+    names = list(values.get('formations.names') or ())
+    shapes: Dict[str, NDArray[np.float64]] = {}
+    for name in names:
+        key = shape_vertices_name(name)
+        if not SHAPE_NAME.fullmatch(name):
+            problems.append(('formations.names', f'{name!r} is not a shape name (a letter, then '
+                                                 'letters, digits or _)'))
+        elif name in shapes:
+            problems.append(('formations.names', f'{name!r} is named twice'))
+        elif values.get(key) is None:
+            problems.append((key, f'is required: formations.names lists {name!r}'))
+        else:
+            points = _points(values, key, n, dim, problems)
+            problem = None if points is None else shape_problem(points, values['repulsion_radius'])
+            if problem:
+                problems.append((key, problem))
+            elif points is not None:
+                shapes[name] = points
+    for key in values:
+        shape = key.split('.')[1] if key.startswith('formations.') and key.count('.') == 2 \
+            else None
+        if shape is not None and key.endswith('.vertices') and shape not in names:
+            problems.append((key, f'{shape!r} is not in formations.names'))
+    given = values.get('formation.name', '')
+    if given and given not in names:
+        problems.append(('formation.name', f'{given!r} is not a shape of formations.names '
+                                           f"({', '.join(names) or 'none'})"))
+    return shapes
+
+
+def _schedule(values: Mapping[str, Any], shapes: Mapping[str, NDArray[np.float64]],
+              problems: Problems) -> Tuple[Tuple[float, str], ...]:
+    """``formation.schedule.*``: (time in s, shape name) pairs, times increasing."""
+    times = list(values.get('formation.schedule.times') or ())
+    names = list(values.get('formation.schedule.names') or ())
+    if len(times) != len(names):
+        problems.append(('formation.schedule.names', f'must hold one name per time: {len(times)} '
+                                                     f'times, {len(names)} names'))
+        return ()
+    if any(later <= earlier for earlier, later in zip(times, times[1:])):
+        problems.append(('formation.schedule.times', f'must increase, got {times}'))
+    unknown = [name for name in names if name not in shapes]
+    if unknown:
+        problems.append(('formation.schedule.names', f"{', '.join(map(repr, unknown))} not in "
+                                                     'formations.names'))
+    return tuple(zip(times, names))
+
+
 def _world_frame(values: Mapping[str, Any], problems: Problems) -> str:
     frame = values['world_frame']
     if not FRAME_ID.fullmatch(frame):
@@ -548,6 +655,10 @@ def validate(raw: Mapping[str, Any], executable: Union[Exe, str] = Exe.SIM) -> F
         else:
             radii = np.array(values['sensing_radii'], dtype=float)
     vertices = _points(values, 'formation.vertices', n, dim, problems)
+    shapes = _named_shapes(values, n, dim, problems)
+    if values.get('formation.name') and vertices is not None:
+        vertices = shapes.get(values['formation.name'], vertices)
+    schedule = _schedule(values, shapes, problems)
     start = _start(values, n, dim, problems) if exe in (Exe.SIM, Exe.PLANT, Exe.RECORD) \
         else None
     _geometry(values, radii, vertices, start, problems)
@@ -579,6 +690,7 @@ def validate(raw: Mapping[str, Any], executable: Union[Exe, str] = Exe.SIM) -> F
         reference_speed=values['reference.speed'], reference_pitch=values['reference.pitch'],
         duration=values['duration'], lockstep=values.get('plant.lockstep', False),
         values=values, body=body, start_headings=headings, world_frame=world_frame,
+        shapes=shapes, shape_name=values.get('formation.name', ''), schedule=schedule,
         command=command, imperfections=imperfections, relay=relay, **own)
 
 

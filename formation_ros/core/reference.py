@@ -61,8 +61,13 @@ class Reference:
 
     def __init__(self, kind: str, dim: int, origin: Optional[ArrayLike] = None,
                  velocity: Optional[ArrayLike] = None, radius: float = 1.0, speed: float = 0.0,
-                 pitch: float = 0.0) -> None:
-        """Build a reference (values already validated by ``core.params``)."""
+                 pitch: float = 0.0, phase: float = 0.0) -> None:
+        """
+        Build a reference (values already validated by ``core.params``).
+
+        phase: angle a of the circle, figure eight and helix at t = 0, rad (0: their start
+        above); a = rate t + phase.
+        """
         if kind not in REFERENCE_KINDS:
             raise ValueError(f'unknown reference kind {kind!r}; expected one of {REFERENCE_KINDS}')
         if dim not in (2, 3):
@@ -76,6 +81,7 @@ class Reference:
         self.radius = float(radius)
         self.speed = float(speed)
         self.pitch = float(pitch)
+        self.phase = float(phase)
         self.rate = self._angular_rate()
 
     def _angular_rate(self) -> float:
@@ -87,6 +93,27 @@ class Reference:
             rise = self.pitch / (2.0 * math.pi)
             return self.speed / math.hypot(self.radius, rise)
         return 0.0
+
+    def with_speed(self, speed: float, t: float) -> 'Reference':
+        """
+        Return this reference run at path speed ``speed`` from time ``t`` on, without a jump.
+
+        For the circle, figure eight and helix: the same path with the phase chosen so that
+        ``q_od`` at ``t`` is where it is now (a = rate t + phase is kept at t); the speed, and so
+        qdot_od and J's rate, change at once. Raises ValueError for the other kinds.
+        """
+        if self.kind not in ('circle', 'figure_eight', 'helix'):
+            raise ValueError(f'a {self.kind} reference has no path speed')
+        angle = self.rate * t + self.phase
+        faster = Reference(self.kind, self.dim, self.origin, self.velocity, self.radius, speed,
+                           self.pitch)
+        return Reference(self.kind, self.dim, self.origin, self.velocity, self.radius, speed,
+                         self.pitch, angle - faster.rate * t)
+
+    def with_values(self, origin: ArrayLike, speed: float, phase: float) -> 'Reference':
+        """Return this reference with another origin (dim,) m, path speed m/s and phase rad."""
+        return Reference(self.kind, self.dim, origin, self.velocity, self.radius, speed,
+                         self.pitch, phase)
 
     @property
     def is_stationary(self) -> bool:
@@ -102,7 +129,8 @@ class Reference:
         """
         if self.kind in ('fixed', 'line'):
             return float(np.linalg.norm(self.velocity)), 0.0
-        times = np.arange(RATE_SAMPLES) * (2.0 * math.pi / self.rate / RATE_SAMPLES)
+        times = np.arange(RATE_SAMPLES) * (2.0 * math.pi / self.rate / RATE_SAMPLES) \
+            - self.phase / self.rate
         speed = turn = 0.0
         for t in times:
             frame = self.sample(float(t))
@@ -119,7 +147,7 @@ class Reference:
         if self.kind == 'line':
             return self.origin + self.velocity * t, self.velocity.copy(), zero, zero.copy()
         r, w = self.radius, self.rate
-        a = w * t
+        a = w * t + self.phase
         ca, sa = math.cos(a), math.sin(a)
         if self.kind == 'figure_eight':
             c2, s2 = math.cos(2.0 * a), math.sin(2.0 * a)

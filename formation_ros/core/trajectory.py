@@ -67,15 +67,19 @@ class Trajectory:
         """
         Build a trajectory from states and commands and the reference frame of each sample.
 
-        t: (T,) s; q, u: (T, N, dim); frames: T FrameSamples; vertices: (N, dim). u_hat comes
-        from inverting eq. (25), desired positions from eq. (20).
+        t: (T,) s; q, u: (T, N, dim); frames: T FrameSamples; vertices: (N, dim), or (T, N,
+        dim) for a shape that changes (the shape in force at each sample). u_hat comes from
+        inverting eq. (25), desired positions from eq. (20).
         """
         q = np.asarray(q, dtype=float)
         u = np.asarray(u, dtype=float)
+        shapes = np.asarray(vertices, dtype=float)
+        per_sample = shapes if shapes.ndim == 3 else [shapes] * len(frames)
         return cls(t=np.asarray(t, dtype=float), q=q, u=u,
                    u_hat=np.array([to_frame_velocity(u_k, q_k, f)
                                    for u_k, q_k, f in zip(u, q, frames)]),
-                   q_desired=np.array([desired_positions(vertices, f) for f in frames]),
+                   q_desired=np.array([desired_positions(v, f)
+                                       for v, f in zip(per_sample, frames)]),
                    q_od=np.array([f.q_od for f in frames]))
 
     @classmethod

@@ -45,11 +45,13 @@ from formation_ros.core.declarations import CommandFrame, Exe
 from formation_ros.core.frames import desired_positions
 from formation_ros.core.plant import (Commands, CommandStatus, DurationHistogram, NS_PER_S,
                                       PLANT_STATS_FILE, PlantModel, StepReport)
+from formation_ros.core.timeline import Mode
 from formation_ros.core.trajectory import (CHUNKS_DIR, ChunkWriter, read_body_chunks,
                                            read_chunks, Trajectory)
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import (CdrError, encode_clock, read_twist, read_twist_stamped,
                                    StateEncoder)
+from formation_ros.ros.changes import Changes
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.liveliness import PeerLiveliness
 from formation_ros.ros.markers import formation_markers, Paths
@@ -84,7 +86,12 @@ class PlantNode(Node):
         assert settings is not None and config.start is not None
         self.config, self.settings = config, settings
         self.law = config.law()
-        self.reference = config.reference()
+        self.once = OnceLog(self.get_logger())
+        self.steady = Clock(clock_type=ClockType.STEADY_TIME)
+        self.refused_changes: Dict[str, int] = {}
+        self.changes = Changes(self, config, self.steady, self._reject_change)
+        self.reference = self.changes.reference
+        self.held_steps = 0
         self.n, self.dim = config.num_robots, config.dim
         self.unicycles = config.body.is_unicycle
         self.body_frame = config.command.frame is CommandFrame.BODY
@@ -104,8 +111,6 @@ class PlantNode(Node):
         self.status = np.full(self.n, CommandStatus.MISSING, dtype=np.int8)
         self.lockstep = config.lockstep
         self.publish_every = 1 if self.lockstep else settings.steps_per_publish
-        self.once = OnceLog(self.get_logger())
-        self.steady = Clock(clock_type=ClockType.STEADY_TIME)
         self.chunks = (ChunkWriter(os.path.join(settings.output_dir, CHUNKS_DIR))
                        if settings.output_dir else None)
         self.closest = self.model.closest_pair_distance()
@@ -192,6 +197,16 @@ class PlantNode(Node):
         if self.lockstep:
             self.step_wake.arm()
 
+    def _reject_change(self, what: str, why: str) -> None:
+        """Count and log once a shape or status refused (``ros.changes``)."""
+        self.refused_changes[what] = self.refused_changes.get(what, 0) + 1
+        self.once.start(f'{what}-refused', f'ignoring a {what} with {why} (logged once; '
+                                           'counted in diagnostics)', 'error')
+
+    def _vertices_at(self, t_ns: int) -> np.ndarray:
+        """Return the shape in force at ``t_ns`` (N, dim), m."""
+        return self.changes.shapes.at(t_ns).vertices
+
     def _time_answers(self) -> None:
         """Count how long each new command took: from its state's publish to its arrival."""
         stamps = self.commands.stamp_ns
@@ -237,6 +252,8 @@ class PlantNode(Node):
 
     def _step(self) -> None:
         self._time_answers()
+        if self.changes.states.at(self.model.t_ns).mode is Mode.STOPPED:
+            self.held_steps += 1
         report = self.model.advance(self.commands)
         self.largest_u_hat = max(self.largest_u_hat,
                                  float(np.max(report.admission.largest_u_hat)))
@@ -355,6 +372,10 @@ class PlantNode(Node):
         if np.any(self.wrong_frame):
             values['robots with cmd_vel in a frame other than their command frame'] = ', '.join(
                 f'{i + 1}: {count}' for i, count in enumerate(self.wrong_frame.tolist()) if count)
+        values['team'] = self.changes.states.at(self.model.t_ns).mode.value
+        values['held steps'] = self.held_steps
+        values.update({f'refused {what} messages': count
+                       for what, count in self.refused_changes.items()})
         if np.any(self.malformed):
             values['robots with malformed cmd_vel messages'] = ', '.join(
                 f'{i + 1}: {count}' for i, count in enumerate(self.malformed.tolist()) if count)
@@ -415,7 +436,8 @@ class PlantNode(Node):
         self.paths.append(self.model.q)
         if self.marker_pub.get_subscription_count() == 0:
             return
-        desired = desired_positions(self.config.vertices, self.reference.sample(self.model.t))
+        desired = desired_positions(self._vertices_at(self.model.t_ns),
+                                    self.reference.sample(self.model.t))
         self.marker_pub.publish(formation_markers(
             self.model.q, self.config.sensing_radii, self.law.repulsion_radius, desired,
             self.paths, self.model.t_ns, self.config.world_frame))
@@ -430,7 +452,8 @@ class PlantNode(Node):
         except ValueError:
             return None
         frames = [self.reference.sample(time_s) for time_s in t]
-        trajectory = Trajectory.from_frames(t, q, u, frames, self.config.vertices)
+        shapes = [self._vertices_at(int(round(time_s * NS_PER_S))) for time_s in t]
+        trajectory = Trajectory.from_frames(t, q, u, frames, shapes)
         body = read_body_chunks(self.chunks.folder) if self.unicycles else None
         return trajectory if body is None else replace(trajectory, **body)
 
@@ -442,7 +465,8 @@ class PlantNode(Node):
         wall = time.monotonic() - self.started_wall
         counts = self.model.counts
         totals = counts.totals()
-        desired = desired_positions(self.config.vertices, self.reference.sample(self.model.t))
+        desired = desired_positions(self._vertices_at(self.model.t_ns),
+                                    self.reference.sample(self.model.t))
         error = float(np.max(np.linalg.norm(self.model.points - desired, axis=1)))
         bodies = f', min body distance {self.closest_body:.4g} m' if self.unicycles else ''
         self.get_logger().info(
@@ -460,6 +484,8 @@ class PlantNode(Node):
             'simulated_time': self.model.t, 'wall_time': wall,
             'achieved_step_rate': totals['steps'] / wall if wall > 0 else None}
         stats.update(totals)
+        stats['held_steps'] = self.held_steps
+        stats['shape_changes'] = len(self.changes.shapes.changes())
         stats['oldest_command_counted'] = counts.oldest_counted_ns / NS_PER_S
         stats['command_age_steps'] = counts.age_steps.tolist()
         stats['answer_latency'] = {

@@ -44,12 +44,14 @@ from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.declarations import CommandFrame, Exe, PoseType
 from formation_ros.core.frames import advance, FrameSample, to_body_frame, valid_quaternions
 from formation_ros.core.law import Command, robot_command
+from formation_ros.core.timeline import Mode, TeamState
 from formation_ros.core.unicycle import (hand_points, headings_from_quaternions,
                                          unicycle_commands)
 from formation_ros.ros import fields, messages, qos, topics
 from formation_ros.ros.cdr import (CdrError, encode_twist, encode_twist_stamped, OdometryData,
                                    PoseArrayData, PoseData, read_odometry, read_pose_array,
                                    read_pose_stamped, TooManyPoses)
+from formation_ros.ros.changes import Changes
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
@@ -79,6 +81,7 @@ class Reason(enum.Enum):
     TOO_MANY = 'more neighbours than there are robots'
     MALFORMED = 'bytes that are not a whole message of its type'
     TOO_FAST = 'a speed or turn rate its reference kind cannot have'
+    CHANGE = 'a shape or team status that cannot hold'
 
 
 class RobotNode(Node):
@@ -93,6 +96,7 @@ class RobotNode(Node):
         self.dim = config.dim
         self.index = settings.robot_id - 1
         self.vertex = config.vertices[self.index]
+        self.base_reference = config.reference()
         self.sensing_radius = float(config.sensing_radii[self.index])
         self.law = config.law()
         self.lockstep = config.lockstep
@@ -133,6 +137,7 @@ class RobotNode(Node):
                                  qos.STATE_INPUT, raw=True)
         self.create_subscription(Odometry, topics.REFERENCE, self.on_reference, qos.REFERENCE,
                                  raw=True)
+        self.changes = Changes(self, config, self.steady, self._reject_change, self._new_state)
         self.cmd_pub = self.create_publisher(TwistStamped if self.stamped else Twist,
                                              topics.CMD_VEL, qos.COMMAND)
         self.diagnostics_pub = self.create_publisher(DiagnosticArray, topics.DIAGNOSTICS,
@@ -261,6 +266,20 @@ class RobotNode(Node):
             if self.lockstep:
                 self.answer.arm()
 
+    def _reject_change(self, what: str, why: str) -> None:
+        """Count and log once a shape or status refused (``ros.changes``)."""
+        key = (what, Reason.CHANGE)
+        self.rejected[key] = self.rejected.get(key, 0) + 1
+        self.once.start(f'{what}-refused',
+                        f'ignoring a {what} with {why} (logged once; diagnostics count them)',
+                        'error')
+
+    def _new_state(self, state: TeamState) -> None:
+        """Accept reference samples as fast as the reference in force may be."""
+        speed, turn = state.reference(self.base_reference).rate_limits()
+        self.speed_limit = max(self.speed_limit, speed)
+        self.turn_limit = max(self.turn_limit, turn)
+
     def _plausible(self, msg: OdometryData) -> bool:
         """Whether a reference sample's speed and turn rate fit the configured reference."""
         speed = math.hypot(*msg.linear)
@@ -285,9 +304,19 @@ class RobotNode(Node):
         return advance(newest, ahead)
 
     def _command(self, stamp_ns: int, exact: bool) -> Optional[np.ndarray]:
+        """Return the command for the state stamped ``stamp_ns`` (zero while stopped), or None."""
         frame = self._reference_for(stamp_ns, exact)
         if frame is None:
             return None
+        if self.changes.differs:
+            self.once.start('other-shape', "following the reference's shape: it differs from "
+                                           "this robot's formation.vertices (another "
+                                           'parameters file?)', 'warning')
+        if self.changes.states.at(stamp_ns).mode is Mode.STOPPED:
+            self.once.start('stopped', 'team stopped: holding still', 'info')
+            return np.zeros(2 if self.unicycle else self.dim)
+        self.once.end('stopped', 'team running again')
+        self.vertex = self.changes.shapes.at(stamp_ns).vertices[self.index]
         self.last = robot_command(self._own_position(), self.vertex, self._neighbour_points(),
                                   self.sensing_radius, self.law, frame)
         if self.unicycle:

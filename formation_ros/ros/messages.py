@@ -8,8 +8,12 @@ The nodes write their hot topics as bytes (``cdr``); these typed messages are wh
 tests publish, and what the byte writers are tested against.
 """
 
+import math
+
 from builtin_interfaces.msg import Time
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from formation_ros.core.frames import frame_to_pose
+from formation_ros.core.timeline import Mode, TeamState
 from formation_ros.ros.fields import NS_PER_S
 from geometry_msgs.msg import Pose, PoseArray, PoseStamped, TwistStamped
 from nav_msgs.msg import Odometry
@@ -35,9 +39,9 @@ def _xyz(vector, dim):
     return values
 
 
-def _stamped(msg, stamp_ns):
+def _stamped(msg, stamp_ns, frame_id=WORLD_FRAME):
     msg.header.stamp = ns_to_stamp(stamp_ns)
-    msg.header.frame_id = WORLD_FRAME
+    msg.header.frame_id = frame_id
     return msg
 
 
@@ -49,9 +53,9 @@ def pose_stamped(position, stamp_ns, dim):
     return msg
 
 
-def pose_array(points, stamp_ns, dim):
-    """Build a PoseArray of the rows of ``points`` ((K, dim), m), frame 'world'."""
-    msg = _stamped(PoseArray(), stamp_ns)
+def pose_array(points, stamp_ns, dim, frame_id=WORLD_FRAME):
+    """Build a PoseArray of the rows of ``points`` ((K, dim), m), frame ``frame_id``."""
+    msg = _stamped(PoseArray(), stamp_ns, frame_id)
     for point in points:
         pose = Pose()
         pose.position.x, pose.position.y, pose.position.z = _xyz(point, dim)
@@ -79,3 +83,46 @@ def reference_odometry(frame, stamp_ns, dim):
     twist.linear.x, twist.linear.y, twist.linear.z = (float(v) for v in linear)
     twist.angular.x, twist.angular.y, twist.angular.z = (float(v) for v in angular)
     return msg
+
+
+TEAM_STATUS = 'formation_ros/team'
+MODE_LEVELS = {'running': DiagnosticStatus.OK, 'stopped': DiagnosticStatus.WARN}
+
+
+def team_status(mode, since_ns, values):
+    """
+    Build the ``/formation/status`` message: the team's mode and reference from ``since_ns``.
+
+    mode: 'running' or 'stopped'; values: {key: text} (the shape's name, the reference's
+    origin, speed and phase in force). The header's stamp is the time from which it holds.
+    """
+    status = DiagnosticStatus(level=MODE_LEVELS[mode], name=TEAM_STATUS, message=mode,
+                              hardware_id='formation_ros')
+    status.values = [KeyValue(key=key, value=str(value)) for key, value in values.items()]
+    array = DiagnosticArray(status=[status])
+    array.header.stamp = ns_to_stamp(since_ns)
+    return array
+
+
+def team_state_of(msg, dim):
+    """
+    Read a ``/formation/status`` message (:func:`team_status`) into a ``core.timeline.TeamState``.
+
+    Raises ValueError when it is not one: no team status, an unknown mode, missing or
+    non-finite values, an origin that is not dim values.
+    """
+    statuses = [status for status in msg.status if status.name == TEAM_STATUS]
+    if not statuses:
+        raise ValueError(f'no {TEAM_STATUS} status')
+    status = statuses[0]
+    values = {kv.key: kv.value for kv in status.values}
+    try:
+        mode = Mode(status.message)
+        origin = tuple(float(v) for v in values['origin'].split(','))
+        speed, phase = float(values['speed']), float(values['phase'])
+    except (KeyError, ValueError) as exc:
+        raise ValueError(f'not a team status: {exc}') from None
+    if len(origin) != dim or not all(map(math.isfinite, origin + (speed, phase))):
+        raise ValueError(f'origin {origin}, speed {speed}, phase {phase} do not fit')
+    shape = values.get('shape', '')
+    return TeamState(mode, '' if shape == 'formation.vertices' else shape, origin, speed, phase)

@@ -4,19 +4,22 @@
 """
 Declare a node's parameters from the declarations and validate them with the core's checks.
 
-Each parameter the executable reads is declared once, read-only, typed, with its description
-and range. Optional parameters without a value (``start.positions`` when the start is random,
-``sensing_radii`` when every robot has ``sensing_radius``) are declared only when given, and
+Each parameter the executable reads is declared once, typed, with its description and range,
+read-only except those a node lets change while it runs (the reference's shape, origin and
+speed), which that node checks itself when they are set. Optional parameters without a value
+(``start.positions`` when the start is random, ``sensing_radii`` when every robot has
+``sensing_radius``) are declared only when given, and
 ``reference.origin`` / ``reference.velocity`` with their zero defaults, so ``ros2 param dump``
 and ``ros2 param get`` answer for every declared parameter.
 """
 
 import re
 import sys
-from typing import Any, Dict, Optional
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
-from formation_ros.core.declarations import (ARRAYS, Bound, did_you_mean, Exe, is_known, Kind,
-                                             Param, ParamError, used_by)
+from formation_ros.core.declarations import (ARRAYS, Bound, BY_NAME, did_you_mean, Exe,
+                                             is_known, Kind, Param, ParamError, SHAPE_NAME,
+                                             SHAPE_VERTICES, shape_vertices_name, used_by)
 from formation_ros.core.params import FormationConfig, validate
 from formation_ros.ros.topics import robot_namespace
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
@@ -41,14 +44,21 @@ def _end(bound: Optional[Bound], fallback: float) -> float:
     return fallback if bound is None else bound.value
 
 
-def descriptor_for(param: Param) -> ParameterDescriptor:
-    """Build the descriptor of a declaration: type, description with range, read-only."""
+def descriptor_for(param: Param, name: Optional[str] = None,
+                   read_only: bool = True) -> ParameterDescriptor:
+    """
+    Build the descriptor of a declaration: type, description with range, read-only or not.
+
+    name: the parameter's own name where the declaration stands for many
+    (``formations.<name>.vertices``).
+    """
     text = param.description
     allowed = param.range_text()
     if allowed:
         text += f' Allowed: {allowed}.'
-    descriptor = ParameterDescriptor(name=param.name, type=TYPES[param.kind].value,
-                                     description=text, read_only=True, dynamic_typing=False)
+    descriptor = ParameterDescriptor(name=name or param.name, type=TYPES[param.kind].value,
+                                     description=text, read_only=read_only,
+                                     dynamic_typing=False)
     if param.low is None and param.high is None:
         return descriptor
     if param.kind is Kind.DOUBLE:
@@ -62,20 +72,38 @@ def descriptor_for(param: Param) -> ParameterDescriptor:
     return descriptor
 
 
+def _probe(node: Node, param: Param, name: str, given: Dict[str, Any],
+           problems: List[Tuple[str, str]]) -> None:
+    """Read what is given for parameter ``name`` (of declaration ``param``) into ``given``."""
+    try:
+        probe = node.declare_parameter(name, TYPES[param.kind],
+                                       ParameterDescriptor(dynamic_typing=False))
+    except (InvalidParameterTypeException, InvalidParameterValueException) as exc:
+        problems.append((name, str(exc).split(': ' + name)[0]))
+        return
+    node.undeclare_parameter(name)
+    if probe.value is not None:
+        value = probe.value
+        given[name] = list(value) if param.kind in ARRAYS else value
+
+
 def _given(node: Node, exe: Exe) -> Dict[str, Any]:
-    """Return what the command line and parameters files give for ``exe``'s parameters."""
-    given, problems = {}, []
+    """
+    Return what the command line and parameters files give for ``exe``'s parameters.
+
+    The vertices of named shapes are read for the names ``formations.names`` gives, as nav2
+    reads its plugins' parameters.
+    """
+    given: Dict[str, Any] = {}
+    problems: List[Tuple[str, str]] = []
     for param in used_by(exe):
-        try:
-            probe = node.declare_parameter(param.name, TYPES[param.kind],
-                                           ParameterDescriptor(dynamic_typing=False))
-        except (InvalidParameterTypeException, InvalidParameterValueException) as exc:
-            problems.append((param.name, str(exc).split(': ' + param.name)[0]))
-            continue
-        node.undeclare_parameter(param.name)
-        if probe.value is not None:
-            value = probe.value
-            given[param.name] = list(value) if param.kind in ARRAYS else value
+        if param.name != SHAPE_VERTICES:
+            _probe(node, param, param.name, given, problems)
+    shapes = BY_NAME[SHAPE_VERTICES]
+    if exe in shapes.users:
+        for shape in given.get('formations.names') or ():
+            if SHAPE_NAME.fullmatch(shape):
+                _probe(node, shapes, shape_vertices_name(shape), given, problems)
     if problems:
         raise ParamError(problems)
     return given
@@ -112,10 +140,13 @@ def _robot_identity(namespace: str, given: Dict[str, Any]) -> None:
                                        'to it')])
 
 
-def declare_parameters(node: Node, exe: Exe) -> FormationConfig:
+def declare_parameters(node: Node, exe: Exe,
+                       runtime: Sequence[str] = ()) -> FormationConfig:
     """
     Declare and validate the parameters of ``exe`` on ``node``; return its configuration.
 
+    runtime: the parameters this node lets change while it runs (declared writable; the node
+    checks new values in its own set-parameters callback); every other one is read-only.
     Raises :class:`ParamError` naming every bad parameter (wrong type, out of range,
     inconsistent). A parameter given that no formation executable knows is logged as a
     warning with the closest known name (it may be meant for another tool).
@@ -129,8 +160,12 @@ def declare_parameters(node: Node, exe: Exe) -> FormationConfig:
     for name in DEFAULT_ZERO_VECTORS:
         effective.setdefault(name, [0.0] * config.dim)
     for param in used_by(exe):
-        value = effective.get(param.name)
-        if value is not None:
-            node.declare_parameter(param.name, value, descriptor_for(param),
-                                   ignore_override=True)
+        names = ([param.name] if param.name != SHAPE_VERTICES
+                 else [shape_vertices_name(shape) for shape in config.shapes])
+        for name in names:
+            value = effective.get(name)
+            if value is not None:
+                node.declare_parameter(name, value,
+                                       descriptor_for(param, name, name not in runtime),
+                                       ignore_override=True)
     return config

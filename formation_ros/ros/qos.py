@@ -22,6 +22,10 @@ Quality of service of every formation topic, in one place.
 * Diagnostics (``/diagnostics``): reliable, keep last 10, volatile, as diagnostic tools expect.
 * Markers (``/formation/markers``): reliable, keep last 1, transient local, so RViz started
   later still shows the latest picture.
+* Changes (``/formation/shape``, ``/formation/status``): reliable, keep last
+  :data:`CHANGES_KEPT`, transient local: a node that joins late gets every recent change with
+  the stamp it holds from (a scheduled switch is sent ahead), so it answers each state with
+  the shape and mode in force at that state's stamp.
 
 The recorder subscribes with the publishers' reliability and durability but a deep history
 (:func:`recording`): a sample that waits a moment for a busy recorder is stored, not
@@ -61,8 +65,11 @@ STATE_INPUT = _profile(1, ReliabilityPolicy.BEST_EFFORT, DurabilityPolicy.VOLATI
 CLOCK = _profile(1, ReliabilityPolicy.RELIABLE, DurabilityPolicy.VOLATILE)
 DIAGNOSTICS = _profile(10, ReliabilityPolicy.RELIABLE, DurabilityPolicy.VOLATILE)
 MARKERS = _profile(1, ReliabilityPolicy.RELIABLE, DurabilityPolicy.TRANSIENT_LOCAL)
+CHANGES_KEPT = 32
+CHANGES = _profile(CHANGES_KEPT, ReliabilityPolicy.RELIABLE, DurabilityPolicy.TRANSIENT_LOCAL)
 BY_KIND = {QosKind.COMMAND: COMMAND, QosKind.REFERENCE: REFERENCE, QosKind.STATE: STATE,
-           QosKind.CLOCK: CLOCK, QosKind.DIAGNOSTICS: DIAGNOSTICS, QosKind.MARKERS: MARKERS}
+           QosKind.CLOCK: CLOCK, QosKind.DIAGNOSTICS: DIAGNOSTICS, QosKind.MARKERS: MARKERS,
+           QosKind.CHANGES: CHANGES}
 
 
 RECORDING_DEPTH = 1000

@@ -21,6 +21,10 @@ CLOCK = '/clock'
 DIAGNOSTICS = '/diagnostics'
 MARKERS = '/formation/markers'
 PARAMS = '/formation/params'
+SHAPE = '/formation/shape'
+STATUS = '/formation/status'
+STOP = '/formation/stop'
+START = '/formation/start'
 
 
 class QosKind(enum.Enum):
@@ -32,6 +36,7 @@ class QosKind(enum.Enum):
     CLOCK = 'clock'
     DIAGNOSTICS = 'diagnostics'
     MARKERS = 'markers'
+    CHANGES = 'changes'
 
 
 @dataclass(frozen=True)
@@ -77,6 +82,8 @@ def recorded_topics(num_robots: int, markers: bool,
         Topic(REFERENCE, 'nav_msgs/msg/Odometry', QosKind.REFERENCE),
         Topic(CLOCK, 'rosgraph_msgs/msg/Clock', QosKind.CLOCK),
         Topic(DIAGNOSTICS, 'diagnostic_msgs/msg/DiagnosticArray', QosKind.DIAGNOSTICS),
+        Topic(SHAPE, 'geometry_msgs/msg/PoseArray', QosKind.CHANGES),
+        Topic(STATUS, 'diagnostic_msgs/msg/DiagnosticArray', QosKind.CHANGES),
     ]
     if markers:
         topics.append(Topic(MARKERS, 'visualization_msgs/msg/MarkerArray', QosKind.MARKERS))

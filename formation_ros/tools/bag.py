@@ -27,12 +27,13 @@ from typing import Any, Dict, List, Optional, Tuple
 
 from formation_ros.core.declarations import CommandFrame
 from formation_ros.core.frames import advance, FrameSample, from_body_frame
-from formation_ros.core.params import FormationConfig
+from formation_ros.core.params import check_shape, FormationConfig, ParamError
+from formation_ros.core.timeline import Shape, Timeline
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.core.unicycle import hand_points, hand_velocity, headings_from_quaternions
 from formation_ros.ros import topics as names
 from formation_ros.ros.bag_writer import BagError, BagWriter, PARAMS_FILE, TYPESTORE
-from formation_ros.ros.fields import frame_of, NS_PER_S, position_of, stamp_to_ns
+from formation_ros.ros.fields import frame_of, NS_PER_S, points_of, position_of, stamp_to_ns
 from mcap.data_stream import ReadDataStream
 from mcap.opcode import Opcode
 from mcap.records import Channel, Chunk, Header, Message, Schema
@@ -507,21 +508,45 @@ def trajectory_from_topics(recorded: Recorded,
         values = np.array([commands[int(k)] for k in known])
         u[:, i - 1] = np.where((index >= 0)[:, None], values[np.maximum(index, 0)], 0.0)
     frames, source = _frames_at(stamps, recorded.get(names.REFERENCE, []), config)
+    shapes = recorded_shapes(recorded, config)
+    vertices = [shapes.at(stamp).vertices for stamp in stamps]
     info: Dict[str, Any] = {'reference_source': source}
+    if shapes.changes():
+        info['shape_changes'] = len(shapes.changes())
     if other_frame:
         info['poses_in_another_frame'] = other_frame
     if not unicycles:
         trajectory = Trajectory.from_frames(np.array(stamps) / NS_PER_S, q, u, frames,
-                                            config.vertices)
+                                            vertices)
         return trajectory, info
     heading = np.array([[headings[stamp][i] for i in range(n)] for stamp in stamps])
     l_value = config.body.hand_distance
     trajectory = Trajectory.from_frames(np.array(stamps) / NS_PER_S,
                                         hand_points(q, heading, l_value),
                                         hand_velocity(u, heading, l_value), frames,
-                                        config.vertices)
+                                        vertices)
     return (replace(trajectory, heading=heading, q_body=q, body_command=u),
             info)
+
+
+def recorded_shapes(recorded: Recorded, config: FormationConfig) -> Timeline[Shape]:
+    """
+    Return the shape in force at each stamp: the file's, then each recorded ``/formation/shape``.
+
+    A recorded shape in another frame, or that the law could not hold, is left out (the robots
+    refused it too).
+    """
+    shapes = Timeline(Shape(config.shape_name, config.vertices))
+    for _, message in recorded.get(names.SHAPE, []):
+        if message.header.frame_id != config.world_frame:
+            continue
+        flat = [float(v) for row in points_of(message, config.dim) for v in row]
+        try:
+            vertices = check_shape(flat, config.num_robots, config.dim, config.repulsion_radius)
+        except ParamError:
+            continue
+        shapes.add(stamp_to_ns(message.header.stamp), Shape('', vertices))
+    return shapes
 
 
 def _commands_by_state(recorded: Recorded, robot: int,

@@ -23,7 +23,7 @@ import shutil
 import sys
 import tempfile
 import time
-from typing import Optional, Sequence, TextIO, Tuple
+from typing import Callable, Optional, Sequence, TextIO, Tuple
 
 from formation_ros.core.bodies import make_bodies
 from formation_ros.core.declarations import (CommandFrame, DEFAULT_COLLISION_DISTANCE, Exe,
@@ -36,6 +36,7 @@ from formation_ros.core.params import (FormationConfig, load_config,
 from formation_ros.core.params_file import load_params_file
 from formation_ros.core.plant import Commands, NS_PER_S, PlantModel
 from formation_ros.core.safety import guaranteed_min_distance
+from formation_ros.core.timeline import scheduled_shapes, Shape, Timeline
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.core.unicycle import hand_points, unicycle_commands, unicycle_rates
 import numpy as np
@@ -87,12 +88,54 @@ def sample_times(duration: float, sample_dt: float) -> np.ndarray:
     return times
 
 
-def _assemble(times, states, config, law, reference):
+def shapes_of(config: FormationConfig) -> Timeline[Shape]:
+    """Return the shape in force at each time: the file's, then its scheduled switches."""
+    return scheduled_shapes(Shape(config.shape_name, config.vertices), config.schedule,
+                            config.shapes)
+
+
+def vertices_at(shapes: Timeline[Shape], t: float) -> np.ndarray:
+    """Return the vertices (N, dim) in force at t in s."""
+    return shapes.at(int(round(t * NS_PER_S))).vertices
+
+
+def integrate_segments(rhs: Callable[[float, np.ndarray, np.ndarray], np.ndarray],
+                       start: np.ndarray, times: np.ndarray,
+                       shapes: Timeline[Shape]) -> Tuple[np.ndarray, np.ndarray]:
+    """
+    RK45 from one shape switch to the next, each segment with its shape's vertices.
+
+    rhs(t, y, vertices); times: the sample times (T,). A switch makes the right-hand side jump,
+    so each segment is integrated on its own from where the last ended. Returns (t (T,),
+    y (T, len(start))).
+    """
+    from scipy.integrate import solve_ivp  # RK45 only: a --dt run does not load it
+    ends = [stamp / NS_PER_S for stamp, _ in shapes.changes() if 0.0 < stamp / NS_PER_S
+            < times[-1]] + [float(times[-1])]
+    t_out, y_out, begin, y0 = [], [], 0.0, start
+    for end in ends:
+        vertices = vertices_at(shapes, begin)
+        inside = times[(times >= begin) & ((times < end) | (end == times[-1]))]
+        solution = solve_ivp(lambda t, y: rhs(t, y, vertices), (begin, end), y0,
+                             method='RK45', t_eval=np.append(inside, end)
+                             if not len(inside) or inside[-1] < end else inside,
+                             rtol=RTOL, atol=ATOL)
+        if not solution.success:
+            raise RuntimeError(f'RK45 failed: {solution.message}')
+        keep = np.isin(solution.t, inside)
+        t_out.append(solution.t[keep])
+        y_out.append(solution.y.T[keep])
+        begin, y0 = end, solution.y[:, -1]
+    return np.concatenate(t_out), np.concatenate(y_out)
+
+
+def _assemble(times, states, config, law, reference, shapes):
     commands, desired, centres = [], [], []
     for t, q in zip(times, states):
         frame = reference.sample(t)
-        commands.append(team_command(q, config.vertices, config.sensing_radii, law, frame))
-        desired.append(desired_positions(config.vertices, frame))
+        vertices = vertices_at(shapes, t)
+        commands.append(team_command(q, vertices, config.sensing_radii, law, frame))
+        desired.append(desired_positions(vertices, frame))
         centres.append(frame.q_od)
     return Trajectory(t=np.asarray(times, dtype=float), q=np.asarray(states),
                       u=np.array([c.u for c in commands]),
@@ -118,23 +161,19 @@ def simulate(config: FormationConfig, duration: Optional[float] = None,
         return simulate_unicycles(config, duration, sample_dt, progress)
     law = config.law()
     reference = config.reference()
+    shapes = shapes_of(config)
     n, dim = config.num_robots, config.dim
     assert config.start is not None
 
-    def rhs(t: float, y: np.ndarray) -> np.ndarray:
+    def rhs(t: float, y: np.ndarray, vertices: np.ndarray) -> np.ndarray:
         progress.update(t)
         frame = reference.sample(t)
-        return team_command(y.reshape(n, dim), config.vertices, config.sensing_radii, law,
+        return team_command(y.reshape(n, dim), vertices, config.sensing_radii, law,
                             frame).u.ravel()
 
-    times = sample_times(duration, sample_dt)
-    from scipy.integrate import solve_ivp  # RK45 only: a --dt run does not load it
-    solution = solve_ivp(rhs, (0.0, duration), config.start.ravel(), method='RK45',
-                         t_eval=times, rtol=RTOL, atol=ATOL)
-    if not solution.success:
-        raise RuntimeError(f'RK45 failed: {solution.message}')
-    states = solution.y.T.reshape(-1, n, dim)
-    return _assemble(solution.t, states, config, law, reference)
+    times, y = integrate_segments(rhs, config.start.ravel(), sample_times(duration, sample_dt),
+                                  shapes)
+    return _assemble(times, y.reshape(-1, n, dim), config, law, reference, shapes)
 
 
 def simulate_unicycles(config: FormationConfig, duration: float, sample_dt: float,
@@ -147,29 +186,25 @@ def simulate_unicycles(config: FormationConfig, duration: float, sample_dt: floa
     """
     law = config.law()
     reference = config.reference()
+    shapes = shapes_of(config)
     n = config.num_robots
     l_value = config.body.hand_distance
     assert config.start is not None and config.start_headings is not None
 
-    def rhs(t: float, y: np.ndarray) -> np.ndarray:
+    def rhs(t: float, y: np.ndarray, vertices: np.ndarray) -> np.ndarray:
         progress.update(t)
         q, heading = y[:2 * n].reshape(n, 2), y[2 * n:]
-        u = team_command(hand_points(q, heading, l_value), config.vertices, config.sensing_radii,
+        u = team_command(hand_points(q, heading, l_value), vertices, config.sensing_radii,
                          law, reference.sample(t)).u
         q_rate, heading_rate = unicycle_rates(heading, unicycle_commands(u, heading, l_value))
         return np.concatenate([q_rate.ravel(), heading_rate])
 
-    times = sample_times(duration, sample_dt)
     start = np.concatenate([config.start.ravel(), config.start_headings])
-    from scipy.integrate import solve_ivp  # RK45 only: a --dt run does not load it
-    solution = solve_ivp(rhs, (0.0, duration), start, method='RK45', t_eval=times, rtol=RTOL,
-                         atol=ATOL)
-    if not solution.success:
-        raise RuntimeError(f'RK45 failed: {solution.message}')
-    q_body = solution.y[:2 * n].T.reshape(-1, n, 2)
-    heading = solution.y[2 * n:].T
-    trajectory = _assemble(solution.t, hand_points(q_body, heading, l_value), config, law,
-                           reference)
+    times, y = integrate_segments(rhs, start, sample_times(duration, sample_dt), shapes)
+    q_body = y[:, :2 * n].reshape(-1, n, 2)
+    heading = y[:, 2 * n:]
+    trajectory = _assemble(times, hand_points(q_body, heading, l_value), config, law,
+                           reference, shapes)
     return replace(trajectory, heading=heading, q_body=q_body,
                    body_command=unicycle_commands(trajectory.u, heading, l_value))
 
@@ -192,12 +227,14 @@ def simulate_fixed_step(config: FormationConfig, duration: float, dt: float,
                        bodies=bodies, headings=config.start_headings,
                        pair_radius=law.repulsion_radius)
     commands = Commands.empty(config.num_robots, bodies.command_width(config.dim))
+    shapes = shapes_of(config)
     steps = int(round(duration / dt))
     stride = max(1, int(round(sample_dt / dt)))
     times, states, applied, frames, headings, q_body, held = [], [], [], [], [], [], []
     for k in range(steps + 1):
         frame = reference.sample(model.t)
-        u = team_command(model.points, config.vertices, config.sensing_radii, law, frame,
+        u = team_command(model.points, shapes.at(model.t_ns).vertices, config.sensing_radii,
+                         law, frame,
                          model.tree, model.pairs).u
         commands.store_all(bodies.body_command(u, model.heading), model.t_ns)
         if k == steps:
@@ -221,7 +258,8 @@ def simulate_fixed_step(config: FormationConfig, duration: float, dt: float,
             headings.append(report.heading)
             q_body.append(report.q)
             held.append(report.admission.u)
-    trajectory = Trajectory.from_frames(times, states, applied, frames, config.vertices)
+    trajectory = Trajectory.from_frames(times, states, applied, frames,
+                                        [vertices_at(shapes, t) for t in times])
     if not bodies.has_heading:
         return trajectory
     return replace(trajectory, heading=np.array(headings), q_body=np.array(q_body),

@@ -1,0 +1,50 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""What holds when (core/timeline.py): the change in force at a stamp, whatever the order."""
+
+import itertools
+
+from formation_ros.core.timeline import MAX_CHANGES, Mode, Shape, Timeline
+import numpy as np
+
+
+def test_the_latest_change_at_or_before_a_stamp_holds():
+    timeline = Timeline(Mode.RUNNING)
+    timeline.add(100, Mode.STOPPED)
+    timeline.add(300, Mode.RUNNING)
+    expected = {-5: Mode.RUNNING, 0: Mode.RUNNING, 99: Mode.RUNNING, 100: Mode.STOPPED,
+                299: Mode.STOPPED, 300: Mode.RUNNING, 10 ** 12: Mode.RUNNING}
+    assert {stamp: timeline.at(stamp) for stamp in expected} == expected
+    assert timeline.changes() == [(100, Mode.STOPPED), (300, Mode.RUNNING)]
+
+
+def test_arrival_order_does_not_matter():
+    changes = [(50, 'a'), (10, 'b'), (30, 'c'), (70, 'd')]
+    answers = set()
+    for order in itertools.permutations(changes):
+        timeline = Timeline('start')
+        for stamp, value in order:
+            timeline.add(stamp, value)
+        answers.add(tuple(timeline.at(t) for t in range(0, 80, 5)))
+    assert len(answers) == 1
+    brute = tuple(max([(s, v) for s, v in changes if s <= t], default=(0, 'start'))[1]
+                  for t in range(0, 80, 5))
+    assert answers == {brute}
+
+
+def test_a_change_with_the_same_stamp_replaces_it_and_old_ones_are_dropped():
+    timeline = Timeline(0)
+    timeline.add(5, 1)
+    timeline.add(5, 2)
+    assert timeline.changes() == [(5, 2)] and timeline.latest == 2
+    for k in range(MAX_CHANGES + 10):
+        timeline.add(10 + k, k)
+    assert len(timeline.changes()) == MAX_CHANGES - 1
+    assert timeline.at(0) == 0 and timeline.latest == MAX_CHANGES + 9
+
+
+def test_shapes_compare_by_vertices():
+    square = Shape('square', np.array([[1.0, 1.0], [-1.0, 1.0]]))
+    assert square.same_as(Shape('', square.vertices.copy()))
+    assert not square.same_as(Shape('square', square.vertices + 1e-12))

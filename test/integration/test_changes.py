@@ -1,0 +1,150 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+Formations that change while they run, over real DDS and the parameter and Trigger services.
+
+Shapes are set as ``ros2 param set /reference ...`` sets them (rcl_interfaces SetParameters),
+the team is stopped and started as ``ros2 service call /formation/stop std_srvs/srv/Trigger``
+does, and a scheduled switch in lockstep is compared with ``formation_sim``.
+"""
+
+import json
+
+from formation_ros.core.params import load_config
+from formation_ros.core.trajectory import Trajectory
+from formation_ros.ros import qos
+from formation_ros.tools.sim import simulate
+from geometry_msgs.msg import PoseStamped, TwistStamped
+from helpers import launch, SimClock, stop_when, write_params
+import numpy as np
+from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
+from rcl_interfaces.srv import SetParameters
+from std_srvs.srv import Trigger
+
+LINE = [-3.0, 0.0, -1.0, 0.0, 1.0, 0.0, 3.0, 0.0]
+WEDGE = [0.0, 1.5, -1.5, 0.0, 1.5, 0.0, 0.0, -1.5]
+SHAPES = {'formations.names': ['line', 'wedge'], 'formations.line.vertices': LINE,
+          'formations.wedge.vertices': WEDGE}
+
+
+def call(probe, client, request, timeout=30.0):
+    """Call a service from the probe and return its response (asserting it came)."""
+    assert probe.spin_until(lambda: client.service_is_ready(), timeout), client.srv_name
+    future = client.call_async(request)
+    assert probe.spin_until(future.done, timeout), f'{client.srv_name}: no answer'
+    return future.result()
+
+
+def set_parameter(probe, client, name, value):
+    """Set one parameter of the reference as ``ros2 param set`` does; return the result."""
+    if isinstance(value, str):
+        typed = ParameterValue(type=ParameterType.PARAMETER_STRING, string_value=value)
+    else:
+        typed = ParameterValue(type=ParameterType.PARAMETER_DOUBLE_ARRAY,
+                               double_array_value=value)
+    request = SetParameters.Request(parameters=[Parameter(name=name, value=typed)])
+    return call(probe, client, request).results[0]
+
+
+class Poses:
+    """The latest pose of every robot, heard by the probe."""
+
+    def __init__(self, probe, count):
+        self.latest = {}
+        for i in range(1, count + 1):
+            probe.create_subscription(
+                PoseStamped, f'/robot_{i}/pose',
+                lambda m, i=i: self.latest.__setitem__(i, (m.pose.position.x,
+                                                           m.pose.position.y)),
+                qos.STATE_INPUT)
+
+    def error(self, vertices):
+        """Largest distance of a robot from its vertex (fixed reference at the origin), m."""
+        if len(self.latest) < 4:
+            return float('inf')
+        q = np.array([self.latest[i] for i in range(1, 5)])
+        return float(np.max(np.linalg.norm(q - np.reshape(vertices, (4, 2)), axis=1)))
+
+
+def test_shapes_switch_and_the_team_stops_and_goes(processes, install, probe, tmp_path):
+    params = write_params(tmp_path, 'square_4.yaml', SHAPES)
+    config = load_config(params, 'plant')
+    bound = config.law().u_bound
+    poses, clock = Poses(probe, 4), SimClock(probe)
+    commands = []
+    for i in range(1, 5):
+        probe.create_subscription(
+            TwistStamped, f'/robot_{i}/cmd_vel', lambda m, i=i: commands.append(
+                (i, clock.seconds, m.twist.linear.x, m.twist.linear.y)), qos.COMMAND)
+    parameters = probe.create_client(SetParameters, '/reference/set_parameters')
+    stop = probe.create_client(Trigger, '/formation/stop')
+    start = probe.create_client(Trigger, '/formation/start')
+    out, bag = tmp_path / 'out', tmp_path / 'bag'
+    launch(processes, install, params, out=out, record=bag)
+    square = config.vertices.ravel().tolist()
+    assert probe.spin_until(lambda: poses.error(square) < 0.01, 90), processes.log('launcher')
+
+    close = [0.0, 0.0, 0.5, 0.0, -1.0, 1.0, 1.0, -1.0]
+    refused = set_parameter(probe, parameters, 'formation.vertices', close)
+    assert not refused.successful and 'b = 1 m must not exceed' in refused.reason
+    short = set_parameter(probe, parameters, 'formation.vertices', LINE[:6])
+    assert not short.successful and '4 x 2 = 8 values' in short.reason
+    unknown = set_parameter(probe, parameters, 'formation.name', 'circle')
+    assert not unknown.successful and 'line, wedge' in unknown.reason
+
+    assert set_parameter(probe, parameters, 'formation.name', 'line').successful
+    assert probe.spin_until(lambda: poses.error(LINE) < 0.01, 60), processes.log('reference')
+    assert set_parameter(probe, parameters, 'formation.vertices', WEDGE).successful
+    assert probe.spin_until(lambda: poses.error(WEDGE) < 0.01, 60), processes.log('reference')
+
+    assert set_parameter(probe, parameters, 'formation.name', 'line').successful
+    moving_from = clock.seconds
+    assert probe.spin_until(lambda: clock.seconds > moving_from + 0.3, 30)
+    response = call(probe, stop, Trigger.Request())
+    assert response.success and 'team stopped' in response.message
+    stopped_at = clock.seconds
+    assert probe.spin_until(lambda: clock.seconds > stopped_at + 0.2, 30)
+    held = dict(poses.latest)
+    assert probe.spin_until(lambda: clock.seconds > stopped_at + 2.0, 30)
+    late = [(x, y) for _, t, x, y in commands if t > stopped_at + 0.1]
+    assert late and all(x == 0.0 and y == 0.0 for x, y in late), late[:5]
+    drift = max(np.hypot(poses.latest[i][0] - held[i][0], poses.latest[i][1] - held[i][1])
+                for i in held)
+    assert drift < 1e-9, drift
+    assert poses.error(LINE) > 0.1
+    assert call(probe, start, Trigger.Request()).success
+    info = stop_when(probe, processes, lambda: poses.error(LINE) < 0.01)
+    assert info.returncode == 0, processes.log('launcher')
+
+    assert all(max(abs(x), abs(y)) <= bound + 1e-9 for _, _, x, y in commands)
+    stats = json.loads((out / 'plant_stats.json').read_text())
+    assert stats['collisions'] == 0 and stats['bound_violations'] == 0
+    assert stats['held_steps'] > 100 and stats['shape_changes'] >= 3
+    trajectory = Trajectory.load(str(out / 'trajectory.npz'))
+    assert np.allclose(trajectory.q_desired[-1].ravel(), LINE)
+    assert np.allclose(trajectory.q_desired[0], config.vertices)
+    from_bag = json.loads((out / 'metrics.json').read_text())
+    assert from_bag['source'] == 'rosbag2' and from_bag['shape_changes'] >= 3
+    assert from_bag['final_max_error'] < 0.02 and from_bag['collisions'] == 0
+
+
+def test_a_scheduled_switch_in_lockstep_is_formation_sims(processes, install, probe, tmp_path):
+    params = write_params(tmp_path, 'square_4.yaml', {
+        **SHAPES, 'formation.schedule.times': [0.8], 'formation.schedule.names': ['wedge'],
+        'plant.lockstep': True, 'plant.realtime_factor': 200.0})
+    clock = SimClock(probe)
+    out = tmp_path / 'lockstep'
+    launch(processes, install, params, out=out)
+    info = stop_when(probe, processes, lambda: clock.seconds >= 1.6)
+    assert info.returncode == 0, processes.log('launcher')
+    plant = Trajectory.load(str(out / 'trajectory.npz'))
+    assert plant.t[-1] > 1.5
+    sim = simulate(load_config(params), duration=plant.t[-1], dt=0.01, sample_dt=0.01)
+    assert len(sim.t) == len(plant.t)
+    assert np.max(np.abs(sim.q - plant.q)) < 1e-9
+    assert np.max(np.abs(sim.u - plant.u)) < 1e-9
+    switched = plant.t >= 0.8 - 1e-9
+    assert np.allclose(plant.q_desired[switched][:, :, :].reshape(-1, 8), WEDGE)
+    assert np.allclose(plant.q_desired[~switched].reshape(-1, 8),
+                       load_config(params).vertices.ravel())
