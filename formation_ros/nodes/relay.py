@@ -296,6 +296,16 @@ class RelayNode(Node):
             values[f'robot {robot}: refused measurements ({reason.value})'] = count
         for topic, names in self.foreign_types.items():
             values[f'{topic}: publishers of another type'] = ', '.join(names)
+        counts = [sub.get_publisher_count() for sub in self.source_subs]
+        values['robots whose source has no publisher'] = ', '.join(
+            str(i + 1) for i, count in enumerate(counts) if count == 0) or 'none'
+        shared = [i + 1 for i, count in enumerate(counts) if count > 1]
+        if shared:
+            values['robots whose source has several publishers'] = ', '.join(map(str, shared))
+        for robot in shared:
+            self.once.start(f'shared-{robot}', f'robot {robot}: {self.sources[robot - 1]} has '
+                                               'more than one publisher (two mocap nodes?); '
+                                               'the latest measurement of any of them is used')
         if self.foreign_types:
             level, message = 'error', (f'{len(self.foreign_types)} source topics with '
                                        f'publishers of another type than {self.source_type_name}')

@@ -10,8 +10,8 @@ the point of a lab test is that the robots meet bodies the package did not write
 * Bodies: holonomic points (velocity (vx, vy) in the world) or differential-drive unicycles
   (forward speed v, turn rate w), each with a first-order lag (time constant ``lag``, s) from
   its base's command to its velocity and an acceleration limit (``max_acceleration``, m/s^2 per
-  component; rad/s^2 on w), integrated with explicit Euler steps of at most :data:`SUBSTEP` s
-  over the wall-clock time between two ticks of a probe timer.
+  component; ``max_angular_acceleration``, rad/s^2, on w), integrated with explicit Euler steps
+  of at most :data:`SUBSTEP` s over the wall-clock time between two ticks of a probe timer.
 * Bases: a holonomic base takes geometry_msgs/Twist in its BODY frame and turns it into the
   world with its own heading (fixed, one per body); a diff_drive-like base takes TwistStamped
   in ``robot_<i>/base_link`` (linear.x = v, angular.z = w) and drops a command whose stamp is
@@ -72,6 +72,7 @@ class Lab:
     noise: float = 0.0
     lag: float = 0.0
     max_acceleration: float = 0.0
+    max_angular_acceleration: Optional[float] = None
     cmd_vel_timeout: float = 0.5
     seed: int = 0
     hidden: Set[int] = field(default_factory=set)
@@ -99,6 +100,12 @@ class Lab:
         self.rng = np.random.default_rng(self.seed)
         self.last = steady_s()
         self.next_measure = self.last
+        angular = (self.max_acceleration if self.max_angular_acceleration is None
+                   else self.max_angular_acceleration)
+        self.limits = np.array([self.max_acceleration,
+                                angular if self.base is Base.DIFF_DRIVE
+                                else self.max_acceleration])
+        """Largest change of each velocity component per second: m/s^2 (rad/s^2 for w)."""
 
     def attach(self, probe) -> None:
         """Subscribe the bases to their commands, create the mocap publishers, start ticking."""
@@ -151,7 +158,7 @@ class Lab:
         else:
             change = target - self.velocity
         if self.max_acceleration > 0.0:
-            change = np.clip(change, -self.max_acceleration * dt, self.max_acceleration * dt)
+            change = np.clip(change, -self.limits * dt, self.limits * dt)
         self.velocity += change
 
     def tick(self) -> None:
