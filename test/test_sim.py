@@ -228,3 +228,15 @@ def test_cli_accepts_a_step_equal_to_the_duration(tmp_path):
                      '--sample-dt', '0.5', '--no-plots')
     assert result.returncode == 0, result.stderr
     assert Trajectory.load(str(out / 'trajectory.npz')).t.tolist() == [0.0, 0.5]
+
+
+def test_body_frame_commands_move_the_bodies_as_world_ones_do():
+    from formation_ros.tools.sim import Progress, simulate_fixed_step
+    raw = load_params_file(os.path.join(ROOT, 'config', 'square_4.yaml'))
+    world = validate(raw)
+    body = validate({**raw, 'command.frame': 'body', 'start.headings': [0.5, 2.0, -1.0, 3.0]})
+    runs = [simulate_fixed_step(config, 3.0, 0.01, 0.01, Progress(3.0, quiet=True))
+            for config in (world, body)]
+    assert np.allclose(runs[0].q, runs[1].q, atol=1e-12, rtol=0.0)
+    assert np.allclose(runs[0].u, runs[1].u, atol=1e-12, rtol=0.0)
+    assert np.ptp(runs[1].q[:, :, 0]) > 0.1

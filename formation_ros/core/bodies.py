@@ -16,8 +16,9 @@ depends on the kind:
   (U3, U4);
 * the **step** with the command held over dt: ``q += dt u`` for a point, the exact arc of
   :func:`formation_ros.core.unicycle.zoh_step` for a unicycle;
-* the **actuator caps** a command is clipped to (``plant.max_speed`` per world component for
-  points; ``body.max_linear`` on |v| and ``body.max_angular`` on |w| for unicycles);
+* the **actuator caps** a command is clipped to (``plant.max_speed`` per command component
+  for points, in the world frame or, with ``command.frame: body``, the body's;
+  ``body.max_linear`` on |v| and ``body.max_angular`` on |w| for unicycles);
 * the **contact distance** of two bodies (``2 body.radius``) and the **sensing margin**: a
   range sensor sees bodies, so a unicycle's sensor must reach ``R_i + 2 l`` to see every hand
   point within R_i of its own.
@@ -27,7 +28,9 @@ from dataclasses import dataclass
 from typing import Optional, Tuple, Union
 
 from formation_ros.core.declarations import BodyKind
-from formation_ros.core.unicycle import hand_points, hand_velocity, unicycle_commands, zoh_step
+from formation_ros.core.frames import from_body_frame, to_body_frame
+from formation_ros.core.unicycle import (hand_points, hand_velocity, quaternions_from_headings,
+                                         unicycle_commands, zoh_step)
 import numpy as np
 from numpy.typing import NDArray
 
@@ -63,15 +66,23 @@ POINT_BODY = BodySettings()
 
 
 class PointBodies:
-    """Single integrators q' = u (eq. 1); the control point is the body position."""
+    """
+    Single integrators q' = u (eq. 1); the control point is the body position.
+
+    With ``body_frame`` (``command.frame: body``: holonomic bases that take body-frame
+    velocities) a command is the velocity in the body's frame, which is turned by the body's
+    heading about +z (constant: nothing turns a point): u = R(th) command. Otherwise the
+    command is u itself, in the world frame.
+    """
 
     has_heading = False
     sensing_margin = 0.0
 
-    def __init__(self, max_speed: float = 0.0, radius: float = 0.0):
-        """Cap every world command component at ``max_speed`` m/s (0: no cap); radius in m."""
+    def __init__(self, max_speed: float = 0.0, radius: float = 0.0, body_frame: bool = False):
+        """Cap every command component at ``max_speed`` m/s (0: no cap); radius in m."""
         self.max_speed = float(max_speed)
         self.contact_distance = 2.0 * float(radius)
+        self.body_frame = bool(body_frame)
 
     def command_width(self, dim: int) -> int:
         """Return the number of values in one robot's command: dim."""
@@ -82,16 +93,20 @@ class PointBodies:
         return q
 
     def world_velocity(self, command: Float, heading: Float) -> Float:
-        """Return the velocity of the control point: the command itself, not copied."""
-        return command
+        """Return the velocity of the control point: the command (not copied), or R(th) it."""
+        if not self.body_frame:
+            return command
+        return from_body_frame(command, quaternions_from_headings(heading))
 
     def body_command(self, u: Float, heading: Float) -> Float:
-        """Return the command that gives the control point velocity u: u itself."""
-        return u
+        """Return the command that gives the control point velocity u: u, or R(th)^T u."""
+        if not self.body_frame:
+            return u
+        return to_body_frame(u, quaternions_from_headings(heading))
 
     def step(self, q: Float, heading: Float, command: Float, dt: float) -> Tuple[Float, Float]:
-        """Zero-order hold over dt: (q + dt u, heading)."""
-        return q + dt * command, heading
+        """Zero-order hold over dt: (q + dt u, heading), u the command's world velocity."""
+        return q + dt * self.world_velocity(command, heading), heading
 
     def cap(self, command: Float, rows: NDArray[np.bool_]) -> NDArray[np.bool_]:
         """Clip (in place) the ``rows`` whose components exceed max_speed; return which."""
@@ -153,12 +168,18 @@ class UnicycleBodies:
 Bodies = Union[PointBodies, UnicycleBodies]
 
 
-def make_bodies(settings: BodySettings, max_speed: float = 0.0) -> Bodies:
-    """Build the body object of ``settings`` (``max_speed``: plant.max_speed, points only)."""
+def make_bodies(settings: BodySettings, max_speed: float = 0.0,
+                body_frame: bool = False) -> Bodies:
+    """
+    Build the body object of ``settings``.
+
+    max_speed: plant.max_speed; body_frame: points take body-frame commands (``command.frame:
+    body``); both for points only.
+    """
     if settings.is_unicycle:
         return UnicycleBodies(settings.hand_distance, settings.radius, settings.max_linear,
                               settings.max_angular)
-    return PointBodies(max_speed, settings.radius)
+    return PointBodies(max_speed, settings.radius, body_frame)
 
 
 def random_headings(n: int, seed: int) -> Float:

@@ -154,7 +154,7 @@ ALL = frozenset(Exe)
 START = frozenset({Exe.SIM, Exe.PLANT, Exe.RECORD})
 PLANT = frozenset({Exe.PLANT, Exe.RECORD})
 ROBOT = frozenset({Exe.ROBOT, Exe.RECORD})
-COMMAND = frozenset({Exe.ROBOT, Exe.PLANT, Exe.RECORD})
+COMMAND = frozenset({Exe.SIM, Exe.ROBOT, Exe.PLANT, Exe.RECORD})
 RELAY = frozenset({Exe.RELAY})
 DEFAULT_WORLD_FRAME = 'world'
 

@@ -237,6 +237,63 @@ def matrix_from_quaternion(quat: ArrayLike) -> NDArray[np.float64]:
         [2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)]])
 
 
+QUATERNION_TOLERANCE = 1e-3
+"""An orientation is valid when its quaternion is finite and its norm within this of 1."""
+
+
+def valid_quaternions(quaternion: ArrayLike) -> NDArray[np.bool_]:
+    """Tell which quaternions (x, y, z, w) (..., 4) are orientations: finite, norm ~ 1: (...)."""
+    quat = np.asarray(quaternion, dtype=float)
+    with np.errstate(invalid='ignore', over='ignore'):
+        norm = np.sqrt(np.sum(quat * quat, axis=-1))
+        valid: NDArray[np.bool_] = np.all(np.isfinite(quat), axis=-1) & (
+            np.abs(norm - 1.0) <= QUATERNION_TOLERANCE)
+    return valid
+
+
+def _rotations(quaternion: ArrayLike) -> NDArray[np.float64]:
+    """Return the rotation matrices (N, 3, 3) of valid quaternions (N, 4), normalised first."""
+    quat = np.asarray(quaternion, dtype=float).reshape(-1, 4)
+    x, y, z, w = (quat / np.linalg.norm(quat, axis=1, keepdims=True)).T
+    return np.stack([
+        np.stack([1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w)], -1),
+        np.stack([2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w)], -1),
+        np.stack([2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)], -1),
+    ], axis=1)
+
+
+def _planar_rotations(quaternion: ArrayLike) -> NDArray[np.float64]:
+    """Return the yaw rotations (N, 2, 2) of quaternions (N, 4): the plane's part of them."""
+    x, y, z, w = np.asarray(quaternion, dtype=float).reshape(-1, 4).T
+    yaw = np.arctan2(2.0 * (w * z + x * y), x * x + y * y + z * z + w * w - 2.0 * (y * y + z * z))
+    c, s = np.cos(yaw), np.sin(yaw)
+    return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], axis=1)
+
+
+def to_body_frame(u: ArrayLike, quaternion: ArrayLike) -> NDArray[np.float64]:
+    """
+    Express world vectors in the bodies' frames: ``R^T u`` for each row.
+
+    u: (N, dim) world-frame vectors (m/s); quaternion: (N, 4) orientations (x, y, z, w) of the
+    bodies in the world (valid: :func:`valid_quaternions`). In 2D the rotation is the yaw
+    about +z (the plane's part of the orientation); in 3D the whole rotation. Returns (N, dim).
+    """
+    vectors = np.asarray(u, dtype=float)
+    rotation = _rotations(quaternion) if vectors.shape[-1] == 3 else _planar_rotations(
+        quaternion)
+    return np.asarray(np.einsum('nji,nj->ni', rotation, vectors.reshape(len(rotation), -1)),
+                      dtype=float)
+
+
+def from_body_frame(v: ArrayLike, quaternion: ArrayLike) -> NDArray[np.float64]:
+    """Inverse of :func:`to_body_frame`: body-frame vectors (N, dim) into the world, ``R v``."""
+    vectors = np.asarray(v, dtype=float)
+    rotation = _rotations(quaternion) if vectors.shape[-1] == 3 else _planar_rotations(
+        quaternion)
+    return np.asarray(np.einsum('nij,nj->ni', rotation, vectors.reshape(len(rotation), -1)),
+                      dtype=float)
+
+
 def rotation_of_vector(rotvec: ArrayLike) -> NDArray[np.float64]:
     """
     Return the rotation matrix (3, 3) of a rotation vector (axis times angle in rad; Rodrigues).

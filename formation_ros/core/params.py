@@ -152,7 +152,8 @@ class FormationConfig:
     (dim,). plant / robot / reference_node / recorder: the executable's own settings (None for
     the others). values: the flat checked values with defaults (to write back as a file).
     body: the robots' bodies (``body.*``); start_headings: (N,) start headings in rad of
-    unicycles (for the executables that get a start; None for point bodies). world_frame: the
+    unicycles and of points with body-frame commands (for the executables that get a start;
+    None otherwise). world_frame: the
     frame id of every formation message; command: what cmd_vel carries (``command.*``);
     imperfections: how the bodies differ from q' = u (``plant.actuator_lag`` ...: ideal for
     the executables that do not step bodies); relay: the relay's settings (None for the others).
@@ -307,10 +308,12 @@ def _body(values: Mapping[str, Any], dim: int, problems: Problems) -> BodySettin
     kind = BodyKind(values['body.kind'])
     l_value = values.get('body.hand_distance')
     if kind is BodyKind.POINT:
-        for name in ('body.hand_distance', 'body.max_linear', 'body.max_angular',
-                     'start.headings'):
+        for name in ('body.hand_distance', 'body.max_linear', 'body.max_angular'):
             if values.get(name) is not None:
                 problems.append((name, 'applies only to body.kind unicycle'))
+        if values.get('start.headings') is not None and not _body_frame_points(values):
+            problems.append(('start.headings', 'applies to unicycles and to points with '
+                                               'command.frame body'))
         return BodySettings(radius=values.get('body.radius', 0.0))
     if dim != 2:
         problems.append(('body.kind', f'unicycle needs dim 2 (a differential-drive robot moves '
@@ -370,10 +373,16 @@ def _tracking_problems(body: BodySettings, vertices: NDArray[np.float64],
                                             '(or vertices nearer its path) would fit'))
 
 
+def _body_frame_points(values: Mapping[str, Any]) -> bool:
+    """Tell whether point bodies take body-frame commands (and so have headings)."""
+    return (values['body.kind'] == BodyKind.POINT.value
+            and values.get('command.frame') == CommandFrame.BODY.value)
+
+
 def _headings(values: Mapping[str, Any], body: BodySettings, n: int,
               problems: Problems) -> Optional[NDArray[np.float64]]:
-    """Start headings of unicycles: given, random with a random start, else 0."""
-    if not body.is_unicycle:
+    """Start headings of unicycles and body-frame points: given, random (random start), or 0."""
+    if not body.is_unicycle and not _body_frame_points(values):
         return None
     given = values.get('start.headings')
     if given is not None:
@@ -462,6 +471,9 @@ def _command(values: Mapping[str, Any], body: BodySettings,
             problems.append(('command.frame', 'unicycles command (v, w) in their body frame: '
                                               "leave command.frame out or set it to 'body'"))
         return CommandSettings(kind, CommandFrame.BODY)
+    if kind is CommandType.TWIST and values.get('plant.lockstep', False):
+        problems.append(('command.type', 'plant.lockstep needs twist_stamped: a Twist carries no '
+                                         'stamp to tell which state it answers'))
     return CommandSettings(kind, CommandFrame.WORLD if given is None else CommandFrame(given))
 
 

@@ -9,9 +9,12 @@ The physics is :class:`formation_ros.core.plant.PlantModel`, the same model ``fo
 command admission (a missing, non-finite or stale command counts as zero), the bound audit and
 the collision check. This node only moves messages in and out:
 
-* it stores each robot's latest ``robot_<i>/cmd_vel`` (TwistStamped) in its callback;
+* it stores each robot's latest ``robot_<i>/cmd_vel`` in its callback: a TwistStamped in the
+  robot's command frame (``world_frame``; ``robot_<i>/base_link`` for unicycles and
+  ``command.frame: body``), or with ``command.type: twist`` a Twist, taken to answer the latest
+  state published; it is the stand-in for every base the robots can drive;
 * its timer steps the model and publishes ``robot_<i>/pose`` (PoseStamped) and
-  ``robot_<i>/neighbors`` (PoseArray: what robot i's range sensor sees) at
+  ``robot_<i>/neighbors`` (PoseArray: what robot i's range sensor sees), in ``world_frame``, at
   ``plant.publish_rate``, each time after ``/clock`` (the simulated time, from 0): the clock
   advances with the states, so nodes on simulated time wake once per state, not per step;
 * it logs what the model reports (once per condition), publishes ``/diagnostics`` and
@@ -38,14 +41,15 @@ from typing import Any, Dict, List, Optional
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.bodies import make_bodies
-from formation_ros.core.declarations import Exe
+from formation_ros.core.declarations import CommandFrame, Exe
 from formation_ros.core.frames import desired_positions
 from formation_ros.core.plant import (Commands, CommandStatus, DurationHistogram, NS_PER_S,
                                       PLANT_STATS_FILE, PlantModel, StepReport)
 from formation_ros.core.trajectory import (CHUNKS_DIR, ChunkWriter, read_body_chunks,
                                            read_chunks, Trajectory)
 from formation_ros.ros import messages, qos, topics
-from formation_ros.ros.cdr import CdrError, encode_clock, read_twist_stamped, StateEncoder
+from formation_ros.ros.cdr import (CdrError, encode_clock, read_twist, read_twist_stamped,
+                                   StateEncoder)
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.liveliness import PeerLiveliness
 from formation_ros.ros.markers import formation_markers, Paths
@@ -53,7 +57,7 @@ from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
 from formation_ros.ros.runner import run
 from formation_ros.ros.wake import Wake
-from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
+from geometry_msgs.msg import PoseArray, PoseStamped, Twist, TwistStamped
 import numpy as np
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
@@ -82,15 +86,19 @@ class PlantNode(Node):
         self.law = config.law()
         self.reference = config.reference()
         self.n, self.dim = config.num_robots, config.dim
-        self.bodies = make_bodies(config.body, settings.max_speed)
         self.unicycles = config.body.is_unicycle
+        self.body_frame = config.command.frame is CommandFrame.BODY
+        self.bodies = make_bodies(config.body, settings.max_speed,
+                                  body_frame=self.body_frame and not self.unicycles)
         self.model = PlantModel(config.start, config.sensing_radii, settings.step_ns, self.law,
                                 self.reference, settings.input_timeout_ns,
                                 settings.collision_distance, settings.max_speed,
                                 bodies=self.bodies, headings=config.start_headings)
         self.commands = Commands.empty(self.n, self.bodies.command_width(self.dim))
-        self.command_frames = [messages.body_frame(i) if self.unicycles else None
+        self.stamped = config.command.stamped
+        self.command_frames = [messages.body_frame(i) if self.body_frame else config.world_frame
                                for i in range(1, self.n + 1)]
+        self.state_stamp_ns = 0
         self.wrong_frame = np.zeros(self.n, dtype=np.int64)
         self.closest_body = self.model.closest_body_distance()
         self.status = np.full(self.n, CommandStatus.MISSING, dtype=np.int8)
@@ -114,7 +122,7 @@ class PlantNode(Node):
         self.latency = DurationHistogram()
         self.rate_window = (time.monotonic(), 0)
 
-        self.state_encoder = StateEncoder(self.n, self.dim, messages.WORLD_FRAME)
+        self.state_encoder = StateEncoder(self.n, self.dim, config.world_frame)
         self.malformed = np.zeros(self.n, dtype=np.int64)
         self.pose_pubs, self.neighbour_pubs = [], []
         self.command_liveliness: List[PeerLiveliness] = []
@@ -125,7 +133,7 @@ class PlantNode(Node):
                 PoseArray, topics.robot_topic(i, topics.NEIGHBOURS), qos.STATE))
             self.command_liveliness.append(PeerLiveliness())
             self.command_subs.append(self.create_subscription(
-                TwistStamped, topics.robot_topic(i, topics.CMD_VEL),
+                TwistStamped if self.stamped else Twist, topics.robot_topic(i, topics.CMD_VEL),
                 lambda data, index=i - 1: self.on_command(index, data), qos.COMMAND, raw=True,
                 event_callbacks=self.command_liveliness[-1].callbacks()))
         self.clock_pub = self.create_publisher(ClockMsg, topics.CLOCK, qos.CLOCK)
@@ -150,27 +158,36 @@ class PlantNode(Node):
                else f'realtime factor {settings.realtime_factor:g}'))
 
     def on_command(self, index: int, data: bytes) -> None:
-        """Store robot ``index``'s latest command and when it arrived (lockstep: wake the step)."""
+        """
+        Store robot ``index``'s latest command and when it arrived (lockstep: wake the step).
+
+        A TwistStamped must be in the robot's command frame (``world_frame``, or its
+        ``robot_<i>/base_link`` for unicycles and ``command.frame: body``) and answers the state
+        of its stamp; a Twist (``command.type: twist``) has neither, and answers the latest
+        state published when it arrives.
+        """
         try:
-            command = read_twist_stamped(data)
+            command = read_twist_stamped(data) if self.stamped else read_twist(data)
         except CdrError as exc:
             self.malformed[index] += 1
+            kind = 'TwistStamped' if self.stamped else 'Twist'
             self.once.start(f'malformed-{index}', f'robot {index + 1}: ignoring cmd_vel bytes '
-                                                  f'that are not a TwistStamped ({exc}; logged '
+                                                  f'that are not a {kind} ({exc}; logged '
                                                   'once, counted in diagnostics)', 'error')
             return
         frame = self.command_frames[index]
-        if frame is not None:
-            if command.frame_id != frame:
-                self.wrong_frame[index] += 1
-                self.once.start(f'frame-{index}', f'robot {index + 1}: ignoring cmd_vel in frame '
-                                                  f'{command.frame_id!r}: a unicycle takes (v, '
-                                                  f'w) in its body frame {frame!r} (logged '
-                                                  'once, counted in diagnostics)', 'error')
-                return
-            self.commands.store(index, (command.linear[0], command.angular[2]), command.stamp_ns)
+        if self.stamped and command.frame_id != frame:
+            self.wrong_frame[index] += 1
+            self.once.start(f'frame-{index}', f'robot {index + 1}: ignoring cmd_vel in frame '
+                                              f'{command.frame_id!r}: its commands are in '
+                                              f'{frame!r} (logged once, counted in '
+                                              'diagnostics)', 'error')
+            return
+        stamp_ns = command.stamp_ns if self.stamped else self.state_stamp_ns
+        if self.unicycles:
+            self.commands.store(index, (command.linear[0], command.angular[2]), stamp_ns)
         else:
-            self.commands.store(index, command.linear[:self.dim], command.stamp_ns)
+            self.commands.store(index, command.linear[:self.dim], stamp_ns)
         self.arrived_ns[index] = time.monotonic_ns()
         if self.lockstep:
             self.step_wake.arm()
@@ -232,7 +249,7 @@ class PlantNode(Node):
                                    heading=report.heading, q_body=report.q,
                                    body_command=report.admission.u)
             elif self.chunks is not None:
-                self.chunks.append(report.t_ns / NS_PER_S, report.q, report.admission.u)
+                self.chunks.append(report.t_ns / NS_PER_S, report.q, report.admission.velocity)
         self._log(report)
 
     def _log(self, report: StepReport) -> None:
@@ -281,13 +298,14 @@ class PlantNode(Node):
     def _publish(self) -> None:
         """Publish /clock, then every robot's pose and what its range sensor sees."""
         self._publish_clock()
+        self.state_stamp_ns = self.model.t_ns
         self.published_ns.setdefault(self.model.t_ns, time.monotonic_ns())
         while len(self.published_ns) > PUBLISHES_TIMED:
             self.published_ns.popitem(last=False)
         observer, seen = self.model.sensed_pairs()
         poses, arrays = self.state_encoder.encode(
             self.model.q, observer, seen, self.model.t_ns,
-            self.model.heading if self.unicycles else None)
+            self.model.heading if self.unicycles or self.body_frame else None)
         for publisher, message in zip(self.pose_pubs, poses):
             publisher.publish(message)
         for publisher, message in zip(self.neighbour_pubs, arrays):
@@ -335,7 +353,7 @@ class PlantNode(Node):
                   'oldest command counted [s]': counts.oldest_counted_ns / NS_PER_S}
         values.update({name.replace('_', ' '): count for name, count in counts.totals().items()})
         if np.any(self.wrong_frame):
-            values['robots with cmd_vel in a frame other than their base_link'] = ', '.join(
+            values['robots with cmd_vel in a frame other than their command frame'] = ', '.join(
                 f'{i + 1}: {count}' for i, count in enumerate(self.wrong_frame.tolist()) if count)
         if np.any(self.malformed):
             values['robots with malformed cmd_vel messages'] = ', '.join(
@@ -400,7 +418,7 @@ class PlantNode(Node):
         desired = desired_positions(self.config.vertices, self.reference.sample(self.model.t))
         self.marker_pub.publish(formation_markers(
             self.model.q, self.config.sensing_radii, self.law.repulsion_radius, desired,
-            self.paths, self.model.t_ns))
+            self.paths, self.model.t_ns, self.config.world_frame))
 
     def trajectory(self) -> Optional[Trajectory]:
         """Return the run written so far (``plant.output_dir``): a sample per published state."""

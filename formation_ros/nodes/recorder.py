@@ -32,7 +32,7 @@ from formation_ros.ros.bag_writer import BagError, BagWriter, FLUSHES_PER_FILE, 
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
 from formation_ros.ros.runner import run
-from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
+from geometry_msgs.msg import PoseArray, PoseStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
@@ -48,6 +48,7 @@ MESSAGE_CLASSES = {
     'geometry_msgs/msg/PoseStamped': PoseStamped,
     'geometry_msgs/msg/PoseArray': PoseArray,
     'geometry_msgs/msg/TwistStamped': TwistStamped,
+    'geometry_msgs/msg/Twist': Twist,
     'nav_msgs/msg/Odometry': Odometry,
     'rosgraph_msgs/msg/Clock': ClockMsg,
     'diagnostic_msgs/msg/DiagnosticArray': DiagnosticArray,
@@ -79,7 +80,8 @@ class RecorderNode(Node):
         self.pending: List[Tuple[str, int, bytes]] = []
         self.once = OnceLog(self.get_logger())
         self.subscriptions_by_topic: Dict[str, Any] = {}
-        recorded = topics.recorded_topics(config.num_robots, settings.markers)
+        recorded = topics.recorded_topics(config.num_robots, settings.markers,
+                                          config.command.stamped)
         command_names = {topics.robot_topic(i, topics.CMD_VEL)
                          for i in range(1, config.num_robots + 1)}
         self.commands_to_subscribe = {topic.name: topic for topic in recorded

@@ -7,7 +7,8 @@ Reference node (executable ``reference``): broadcasts the desired formation fram
 Publishes ``/formation/reference`` (nav_msgs/Odometry) at ``reference.rate``: pose.position =
 q_od(t), orientation = the frame J as a quaternion (the rotation J^T from formation axes to world
 axes), twist.linear = qdot_od and twist.angular = the frame's angular velocity w, both in the
-world frame, with ``Jdot = -J [w]x``, so a robot has J and Jdot without differentiating.
+world frame (``world_frame``, the header's frame_id), with ``Jdot = -J [w]x``, so a robot has J
+and Jdot without differentiating.
 header.stamp is the time t of the sample. With ``use_sim_time`` t is the plant's simulated time;
 without it, t counts from the node's start. The timer runs on the wall clock at
 ``reference.rate``, so samples keep coming (with the same stamp) while the plant holds its clock,
@@ -47,6 +48,7 @@ class ReferenceNode(Node):
         settings = config.reference_node
         assert settings is not None
         self.dim = config.dim
+        self.world_frame = config.world_frame
         self.reference = config.reference()
         self.lockstep = config.lockstep
         self.step_ns = settings.step_ns
@@ -93,7 +95,7 @@ class ReferenceNode(Node):
     def _publish(self, stamp: int) -> None:
         self.last_stamp = stamp
         frame = self.reference.sample((stamp - self.epoch_ns) / fields.NS_PER_S)
-        self.pub.publish(encode_odometry(stamp, messages.WORLD_FRAME, messages.FORMATION_FRAME,
+        self.pub.publish(encode_odometry(stamp, self.world_frame, messages.FORMATION_FRAME,
                                          *frame_to_pose(frame, self.dim)))
         self.published += 1
 

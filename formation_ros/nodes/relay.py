@@ -34,9 +34,9 @@ used (nor forwarded).
 What is forwarded: the positions (x, y, z; in 2D the plane's x, y, z dropped) and orientations.
 A unicycle's orientation is its heading (yaw of the measured quaternion) as a rotation about +z,
 as the plant writes it; a point's is the measured quaternion, normalised (a holonomic base that
-takes body-frame commands rotates by it). An orientation that is not a unit quaternion (norm
-off 1 by more than ``cdr.QUATERNION_TOLERANCE``) is refused for every body kind, since the
-robots may rotate by it.
+takes body-frame commands, ``command.frame: body``, is turned by it). An orientation that is not
+a unit quaternion (``core.frames.valid_quaternions``, as the robots check it) is refused for
+every body kind: the relay does not know whether the robots turn their commands by it.
 
 Stale robots: a robot whose latest measurement is older than ``relay.max_age`` gets no pose and
 no neighbour list (its own watchdog, ``input_timeout``, then stops it), but stays in the other
@@ -46,7 +46,7 @@ measured nothing is published. ``/diagnostics`` names the stale robots (WARN) an
 measurements refused per robot and reason.
 
 Untrusted input: a measurement in a frame other than ``world_frame``, with non-finite values,
-with an orientation that is not a rotation, or whose bytes are not a whole message of the
+with an orientation that is not a unit quaternion, or whose bytes are not a whole message of the
 source type is refused (counted, logged once naming the topic, not stored). A source topic that
 also has publishers of another type (which DDS does not connect to this subscription) is logged
 once from the diagnostics timer.
@@ -59,6 +59,7 @@ from typing import Dict, List, Optional, Tuple
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.bodies import make_bodies
 from formation_ros.core.declarations import Exe, ParamError, SourceType
+from formation_ros.core.frames import valid_quaternions
 from formation_ros.core.sensing import sensed_pairs, sensor_radii
 from formation_ros.core.unicycle import headings_from_quaternions
 from formation_ros.ros import qos, topics
@@ -194,7 +195,7 @@ class RelayNode(Node):
         elif not pose.finite:
             self._refuse(index, Reason.NON_FINITE, f'position {pose.position}, orientation '
                                                    f'{pose.orientation}')
-        elif not pose.rotation:
+        elif not valid_quaternions(pose.orientation):
             self._refuse(index, Reason.ROTATION, f'orientation {pose.orientation}')
         else:
             self.positions[index] = pose.position

@@ -26,6 +26,12 @@ neighbours' hand points within R_i, and publishes (v, w) in its body frame
 (``robot_<i>/base_link``: linear.x = v, angular.z = w), as diff_drive_controller takes it. With
 ``pose_type: odometry`` the pose comes from a nav_msgs/Odometry (a real base's localisation)
 instead of a PoseStamped.
+
+Every state and reference message must be in ``world_frame`` (default ``world``). Commands for
+real bases: ``command.type: twist`` publishes a geometry_msgs/Twist (no stamp) instead of a
+TwistStamped, and ``command.frame: body`` publishes a point robot's u in its
+``robot_<i>/base_link`` (u turned by the inverse of its pose's orientation; a pose without a
+unit-quaternion orientation is then refused), as holonomic (mecanum, omni-wheel) bases take it.
 """
 
 from collections import deque
@@ -35,21 +41,21 @@ import time
 from typing import Callable, Dict, List, Optional, Tuple, TypeVar
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros.core.declarations import Exe, PoseType
-from formation_ros.core.frames import advance, FrameSample
+from formation_ros.core.declarations import CommandFrame, Exe, PoseType
+from formation_ros.core.frames import advance, FrameSample, to_body_frame, valid_quaternions
 from formation_ros.core.law import Command, robot_command
 from formation_ros.core.unicycle import (hand_points, headings_from_quaternions,
                                          unicycle_commands)
 from formation_ros.ros import fields, messages, qos, topics
-from formation_ros.ros.cdr import (CdrError, encode_twist_stamped, OdometryData, PoseArrayData,
-                                   PoseData, read_odometry, read_pose_array, read_pose_stamped,
-                                   TooManyPoses)
+from formation_ros.ros.cdr import (CdrError, encode_twist, encode_twist_stamped, OdometryData,
+                                   PoseArrayData, PoseData, read_odometry, read_pose_array,
+                                   read_pose_stamped, TooManyPoses)
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
 from formation_ros.ros.runner import run
 from formation_ros.ros.wake import Wake
-from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
+from geometry_msgs.msg import PoseArray, PoseStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 import numpy as np
 from numpy.typing import NDArray
@@ -66,7 +72,9 @@ class Reason(enum.Enum):
     """Why a robot ignores a message it heard."""
 
     NON_FINITE = 'non-finite values'
-    FRAME = f"a frame other than '{messages.WORLD_FRAME}'"
+    FRAME = 'a frame other than world_frame'
+    ORIENTATION = 'an orientation that is not a unit quaternion'
+
     CLOCK = 'stamps from another clock'
     TOO_MANY = 'more neighbours than there are robots'
     MALFORMED = 'bytes that are not a whole message of its type'
@@ -93,8 +101,12 @@ class RobotNode(Node):
         self.speed_limit, self.turn_limit = config.reference().rate_limits()
         self.unicycle = config.body.is_unicycle
         self.hand_distance = config.body.hand_distance
-        self.command_frame = (messages.body_frame(settings.robot_id) if self.unicycle
-                              else messages.WORLD_FRAME)
+        self.world_frame = config.world_frame
+        self.stamped = config.command.stamped
+        self.body_frame = config.command.frame is CommandFrame.BODY
+        self.needs_orientation = self.body_frame
+        self.command_frame = (messages.body_frame(settings.robot_id) if self.body_frame
+                              else self.world_frame)
         self.last_body_command: Optional[NDArray[np.float64]] = None
         self.sim_time = bool(self.get_parameter('use_sim_time').value)
         self.once = OnceLog(self.get_logger())
@@ -121,7 +133,8 @@ class RobotNode(Node):
                                  qos.STATE_INPUT, raw=True)
         self.create_subscription(Odometry, topics.REFERENCE, self.on_reference, qos.REFERENCE,
                                  raw=True)
-        self.cmd_pub = self.create_publisher(TwistStamped, topics.CMD_VEL, qos.COMMAND)
+        self.cmd_pub = self.create_publisher(TwistStamped if self.stamped else Twist,
+                                             topics.CMD_VEL, qos.COMMAND)
         self.diagnostics_pub = self.create_publisher(DiagnosticArray, topics.DIAGNOSTICS,
                                                      qos.DIAGNOSTICS)
         self.diagnostics_timer = self.create_timer(PERIOD, self.on_diagnostics,
@@ -134,8 +147,11 @@ class RobotNode(Node):
             f'robot {self.index + 1}/{config.num_robots}: vertex {np.round(self.vertex, 4)}, '
             f'R_i = {self.sensing_radius:g} m, b = {config.repulsion_radius:g} m, '
             f'bound c*M1 = {self.law.u_bound:.4g} m/s, '
-            + (f'unicycle, hand point {self.hand_distance:g} m ahead, commands in '
-               f'{self.command_frame}, ' if self.unicycle else '')
+            + (f'unicycle, hand point {self.hand_distance:g} m ahead, ' if self.unicycle
+               else '')
+            + f"commands as {'TwistStamped' if self.stamped else 'Twist'} in "
+              f'{self.command_frame}, '
+
             + ('lockstep' if self.lockstep else f'{settings.control_rate:g} Hz'))
 
     @staticmethod
@@ -159,12 +175,18 @@ class RobotNode(Node):
             return 0.0
         return (stamp_ns - now) / fields.NS_PER_S
 
-    def _check(self, name: str, frame_id: str, stamp_ns: int, finite: bool) -> bool:
-        """Accept a state message only in the world frame, finite, stamped on this clock."""
-        if frame_id != messages.WORLD_FRAME:
-            return self._reject(name, Reason.FRAME, f' (got {frame_id!r})')
+    def _check(self, name: str, frame_id: str, stamp_ns: int, finite: bool,
+               oriented: bool = True) -> bool:
+        """Accept a state message only in the world frame, finite, oriented, on this clock."""
+        if frame_id != self.world_frame:
+            return self._reject(name, Reason.FRAME, f' (got {frame_id!r}, expected '
+                                                    f'{self.world_frame!r})')
         if not finite:
             return self._reject(name, Reason.NON_FINITE)
+        if not oriented:
+            return self._reject(name, Reason.ORIENTATION, ' (its heading is needed: '
+                                                          + ('a unicycle' if self.unicycle
+                                                             else 'command.frame body') + ')')
         gap = self._clock_gap_s(stamp_ns)
         if abs(gap) * fields.NS_PER_S > self.timeout_ns:
             clock = 'simulated' if self.sim_time else 'wall-clock'
@@ -198,7 +220,8 @@ class RobotNode(Node):
                                       odometry.orientation))
 
     def _store_pose(self, pose: PoseData) -> None:
-        if self._check('pose', pose.frame_id, pose.stamp_ns, pose.finite):
+        oriented = not self.needs_orientation or bool(valid_quaternions(pose.orientation))
+        if self._check('pose', pose.frame_id, pose.stamp_ns, pose.finite, oriented):
             self.pose = pose
             self.pose_count += 1
             self.received_ns['pose'] = self._now_ns()
@@ -214,7 +237,8 @@ class RobotNode(Node):
             return
         finite = bool(np.all(np.isfinite(heard.positions))
                       and (not self.unicycle or np.all(np.isfinite(heard.orientations))))
-        if self._check('neighbour', heard.frame_id, heard.stamp_ns, finite):
+        oriented = not self.unicycle or bool(np.all(valid_quaternions(heard.orientations)))
+        if self._check('neighbour', heard.frame_id, heard.stamp_ns, finite, oriented):
             self.neighbours = heard
             self.received_ns['neighbour'] = self._now_ns()
             self.answer.arm()
@@ -224,8 +248,9 @@ class RobotNode(Node):
         msg = self._read('reference', read_odometry, data)
         if msg is None:
             return
-        if msg.frame_id != messages.WORLD_FRAME:
-            self._reject('reference', Reason.FRAME, f' (got {msg.frame_id!r})')
+        if msg.frame_id != self.world_frame:
+            self._reject('reference', Reason.FRAME, f' (got {msg.frame_id!r}, expected '
+                                                    f'{self.world_frame!r})')
         elif not msg.finite:
             self._reject('reference', Reason.NON_FINITE)
         elif not self._plausible(msg):
@@ -265,10 +290,15 @@ class RobotNode(Node):
             return None
         self.last = robot_command(self._own_position(), self.vertex, self._neighbour_points(),
                                   self.sensing_radius, self.law, frame)
-        if not self.unicycle:
+        if self.unicycle:
+            self.last_body_command = unicycle_commands(self.last.u, self._own_heading(),
+                                                       self.hand_distance)
+        elif self.body_frame:
+            assert self.pose is not None
+            self.last_body_command = to_body_frame(self.last.u[None, :],
+                                                   np.array([self.pose.orientation]))[0]
+        else:
             return self.last.u
-        self.last_body_command = unicycle_commands(self.last.u, self._own_heading(),
-                                                   self.hand_distance)
         return self.last_body_command
 
     def _own_heading(self) -> float:
@@ -296,15 +326,19 @@ class RobotNode(Node):
         """
         Publish a command answering the state stamped ``stamp_ns`` (None: zero).
 
-        u: (dim,) m/s in the world frame, or for a unicycle (v, w) in its body frame.
+        u: (dim,) m/s in the world frame or (``command.frame: body``) the body frame, or for a
+        unicycle (v, w) in its body frame; as a TwistStamped in ``command_frame`` stamped
+        ``stamp_ns``, or a Twist (``command.type: twist``).
         """
         if self.unicycle:
             v, w = (0.0, 0.0) if u is None else (float(u[0]), float(u[1]))
-            message = encode_twist_stamped(stamp_ns, self.command_frame, (v, 0.0, 0.0),
-                                           (0.0, 0.0, w))
+            linear, angular = (v, 0.0, 0.0), (0.0, 0.0, w)
         else:
-            message = encode_twist_stamped(stamp_ns, messages.WORLD_FRAME,
-                                           np.zeros(self.dim) if u is None else u)
+            linear, angular = (np.zeros(self.dim) if u is None else u), (0.0, 0.0, 0.0)
+        if self.stamped:
+            message = encode_twist_stamped(stamp_ns, self.command_frame, linear, angular)
+        else:
+            message = encode_twist(linear, angular)
         self.cmd_pub.publish(message)
 
     def on_state(self) -> None:
@@ -392,9 +426,12 @@ class RobotNode(Node):
             values['max |u| component [m/s]'] = float(np.max(np.abs(self.last.u)))
             values['max |u_hat| component [m/s]'] = float(np.max(np.abs(self.last.u_hat)))
         values['bound c*M1 [m/s]'] = self.law.u_bound
-        if self.last_body_command is not None:
+        if self.last_body_command is not None and self.unicycle:
             values['|v| [m/s]'] = abs(float(self.last_body_command[0]))
             values['|w| [rad/s]'] = abs(float(self.last_body_command[1]))
+        elif self.last_body_command is not None:
+            values['max |u| component in the body frame [m/s]'] = float(
+                np.max(np.abs(self.last_body_command)))
         values.update({f'rejected {name} messages ({reason.value})': count
                        for (name, reason), count in self.rejected.items()})
         if self.waiting:

@@ -40,8 +40,6 @@ ENDIANS = {b'\x00\x01': '<', b'\x00\x00': '>'}
 IDENTITY = (0.0, 0.0, 0.0, 1.0)
 FINAL_PADDING = 3
 """Bytes a writer may leave after a message's last field (its payload padded to 4)."""
-QUATERNION_TOLERANCE = 1e-2
-"""How far the norm of an orientation may be from 1 for it to count as a rotation."""
 
 
 class CdrError(ValueError):
@@ -79,11 +77,6 @@ class PoseData:
     def finite(self) -> bool:
         """Whether every number is finite."""
         return all(map(math.isfinite, self.position + self.orientation))
-
-    @property
-    def rotation(self) -> bool:
-        """Whether the orientation is a unit quaternion, within :data:`QUATERNION_TOLERANCE`."""
-        return abs(math.sqrt(sum(v * v for v in self.orientation)) - 1.0) <= QUATERNION_TOLERANCE
 
 
 @dataclass(frozen=True)
@@ -227,6 +220,13 @@ def read_twist_stamped(data: bytes) -> TwistData:
     return TwistData(stamp_ns, frame_id, values[:3], values[3:])
 
 
+def read_twist(data: bytes) -> TwistData:
+    """Read a serialized geometry_msgs/Twist (stamp 0, frame ''); CdrError if it is not one."""
+    reader = _Reader(data, 'Twist')
+    values = reader.doubles(6)
+    return TwistData(0, '', values[:3], values[3:])
+
+
 def read_odometry(data: bytes, exact: bool = False) -> OdometryData:
     """
     Read a serialized nav_msgs/Odometry (its covariances skipped); CdrError if not one.
@@ -283,6 +283,11 @@ def encode_twist_stamped(stamp_ns: int, frame_id: str, linear: ArrayLike,
                          angular: ArrayLike = (0.0, 0.0, 0.0)) -> bytes:
     """Return a serialized TwistStamped: ``linear`` ((dim,) m/s) and ``angular`` (rad/s)."""
     return _with_doubles(encode_header(stamp_ns, frame_id), _xyz(linear) + _xyz(angular))
+
+
+def encode_twist(linear: ArrayLike, angular: ArrayLike = (0.0, 0.0, 0.0)) -> bytes:
+    """Return a serialized Twist (no header): ``linear`` ((dim,) m/s) and ``angular`` (rad/s)."""
+    return _with_doubles(LITTLE, _xyz(linear) + _xyz(angular))
 
 
 def encode_odometry(stamp_ns: int, frame_id: str, child_frame_id: str, position: ArrayLike,

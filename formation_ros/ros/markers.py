@@ -6,7 +6,7 @@ RViz markers of the formation (``/formation/markers``, visualization_msgs/Marker
 
 Namespaces: ``robots`` (spheres), ``sensing`` (discs in 2D, balls in 3D, radius R_i: a sphere
 list per distinct radius), ``repulsion`` (radius b, one sphere list), ``desired`` (the desired
-formation polygon), ``paths`` (recent paths, one line list). Every marker is in frame 'world';
+formation polygon), ``paths`` (recent paths, one line list). Every marker is in the world frame;
 the arrays come from the plant. The number of markers does not grow with the team: a marker is
 a Python message of some forty fields, and building one per robot cost the plant most of its
 time at 50 robots.
@@ -29,9 +29,9 @@ def _point(row):
     return Point(x=values[0], y=values[1], z=values[2])
 
 
-def _marker(ns, marker_id, kind, stamp_ns, rgba):
+def _marker(ns, marker_id, kind, stamp_ns, rgba, frame_id=WORLD_FRAME):
     marker = Marker()
-    marker.header.frame_id = WORLD_FRAME
+    marker.header.frame_id = frame_id
     marker.header.stamp = ns_to_stamp(stamp_ns)
     marker.ns = ns
     marker.id = marker_id
@@ -42,7 +42,7 @@ def _marker(ns, marker_id, kind, stamp_ns, rgba):
     return marker
 
 
-def _zones(ns, first_id, centres, radii, dim, stamp_ns, rgba):
+def _zones(ns, first_id, centres, radii, dim, stamp_ns, rgba, frame_id):
     """
     One SPHERE_LIST per distinct radius (scale.z is the disc thickness in 2D).
 
@@ -52,7 +52,7 @@ def _zones(ns, first_id, centres, radii, dim, stamp_ns, rgba):
     """
     markers = []
     for k, radius in enumerate(np.unique(radii)):
-        marker = _marker(ns, first_id + k, Marker.SPHERE_LIST, stamp_ns, rgba)
+        marker = _marker(ns, first_id + k, Marker.SPHERE_LIST, stamp_ns, rgba, frame_id)
         marker.scale.x = marker.scale.y = 2.0 * float(radius)
         marker.scale.z = DISC_THICKNESS if dim == 2 else 2.0 * float(radius)
         marker.points = [_point(centre) for centre in centres[radii == radius]]
@@ -82,29 +82,32 @@ class Paths:
         return len(self.points[0]) if self.points else 0
 
 
-def formation_markers(q, sensing_radii, repulsion_radius, desired, paths, stamp_ns):
+def formation_markers(q, sensing_radii, repulsion_radius, desired, paths, stamp_ns,
+                      frame_id=WORLD_FRAME):
     """
     Build the MarkerArray of one moment.
 
     q: (N, dim) positions; sensing_radii: (N,); repulsion_radius: b; desired: (N, dim) desired
-    positions; paths: the robots' recent positions (:class:`Paths`); stamp_ns: time.
+    positions; paths: the robots' recent positions (:class:`Paths`); stamp_ns: time; frame_id:
+    the world frame (``world_frame``).
     """
     dim = q.shape[1]
     array = MarkerArray()
-    robots = _marker('robots', 0, Marker.SPHERE_LIST, stamp_ns, (0.1, 0.3, 0.9, 1.0))
+    robots = _marker('robots', 0, Marker.SPHERE_LIST, stamp_ns, (0.1, 0.3, 0.9, 1.0), frame_id)
     robots.scale.x = robots.scale.y = robots.scale.z = ROBOT_DIAMETER
     robots.points = [_point(row) for row in q]
     array.markers.append(robots)
     radii = np.asarray(sensing_radii, dtype=float)
-    array.markers.extend(_zones('sensing', 0, q, radii, dim, stamp_ns, (0.2, 0.7, 0.2, 0.08)))
+    array.markers.extend(_zones('sensing', 0, q, radii, dim, stamp_ns, (0.2, 0.7, 0.2, 0.08),
+                                frame_id))
     array.markers.extend(_zones('repulsion', 0, q, np.full(len(q), float(repulsion_radius)),
-                                dim, stamp_ns, (0.9, 0.2, 0.1, 0.2)))
-    polygon = _marker('desired', 0, Marker.LINE_STRIP, stamp_ns, (0.9, 0.1, 0.1, 0.9))
+                                dim, stamp_ns, (0.9, 0.2, 0.1, 0.2), frame_id))
+    polygon = _marker('desired', 0, Marker.LINE_STRIP, stamp_ns, (0.9, 0.1, 0.1, 0.9), frame_id)
     polygon.scale.x = 0.04
     polygon.points = [_point(row) for row in desired] + [_point(desired[0])]
     array.markers.append(polygon)
     if len(paths) > 1:
-        lines = _marker('paths', 0, Marker.LINE_LIST, stamp_ns, (0.3, 0.3, 0.3, 0.7))
+        lines = _marker('paths', 0, Marker.LINE_LIST, stamp_ns, (0.3, 0.3, 0.3, 0.7), frame_id)
         lines.scale.x = 0.02
         lines.points = [point for path in paths.points
                         for segment in zip(list(path)[:-1], list(path)[1:]) for point in segment]

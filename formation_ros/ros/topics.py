@@ -61,19 +61,26 @@ def robot_topic(robot_id: int, name: str) -> str:
     return f'{robot_namespace(robot_id)}/{name}'
 
 
-def robot_topics(robot_id: int) -> List[Topic]:
-    """Return the three topics of robot ``robot_id``: pose, neighbours, command."""
+def robot_topics(robot_id: int, stamped_commands: bool = True) -> List[Topic]:
+    """
+    Return the three topics of robot ``robot_id``: pose, neighbours, command.
+
+    The command is a TwistStamped, or a Twist without ``stamped_commands`` (``command.type``).
+    """
+    command_type = 'geometry_msgs/msg/TwistStamped' if stamped_commands else \
+        'geometry_msgs/msg/Twist'
     return [
         Topic(robot_topic(robot_id, POSE), 'geometry_msgs/msg/PoseStamped', QosKind.STATE),
         Topic(robot_topic(robot_id, NEIGHBOURS), 'geometry_msgs/msg/PoseArray', QosKind.STATE),
-        Topic(robot_topic(robot_id, CMD_VEL), 'geometry_msgs/msg/TwistStamped',
-              QosKind.COMMAND),
+        Topic(robot_topic(robot_id, CMD_VEL), command_type, QosKind.COMMAND),
     ]
 
 
-def recorded_topics(num_robots: int, markers: bool) -> List[Topic]:
+def recorded_topics(num_robots: int, markers: bool,
+                    stamped_commands: bool = True) -> List[Topic]:
     """Return every topic a recording of the formation holds (``/formation/params`` aside)."""
-    topics = [topic for i in range(1, num_robots + 1) for topic in robot_topics(i)]
+    topics = [topic for i in range(1, num_robots + 1)
+              for topic in robot_topics(i, stamped_commands)]
     topics += [
         Topic(REFERENCE, 'nav_msgs/msg/Odometry', QosKind.REFERENCE),
         Topic(CLOCK, 'rosgraph_msgs/msg/Clock', QosKind.CLOCK),

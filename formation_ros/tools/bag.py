@@ -25,13 +25,14 @@ import struct
 import tempfile
 from typing import Any, Dict, List, Optional, Tuple
 
-from formation_ros.core.frames import advance, FrameSample
+from formation_ros.core.declarations import CommandFrame
+from formation_ros.core.frames import advance, FrameSample, from_body_frame
 from formation_ros.core.params import FormationConfig
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.core.unicycle import hand_points, hand_velocity, headings_from_quaternions
 from formation_ros.ros import topics as names
 from formation_ros.ros.bag_writer import BagError, BagWriter, PARAMS_FILE, TYPESTORE
-from formation_ros.ros.fields import frame_of, NS_PER_S, position_of, stamp_to_ns, velocity_of
+from formation_ros.ros.fields import frame_of, NS_PER_S, position_of, stamp_to_ns
 from mcap.data_stream import ReadDataStream
 from mcap.opcode import Opcode
 from mcap.records import Channel, Chunk, Header, Message, Schema
@@ -462,31 +463,43 @@ def trajectory_from_topics(recorded: Recorded,
     the reference in the parameters) and the formation vertices. Returns (Trajectory, info).
     Unicycles: the headings are the poses' orientations, the commands (v, w) are linear.x and
     angular.z, and q, u are those of the hand points (``Trajectory`` with its body arrays).
+    Poses in a frame other than ``world_frame`` are left out (counted in the info); body-frame
+    commands of points are turned into the world by the orientation of the pose they answer.
     """
     n, dim = config.num_robots, config.dim
     unicycles = config.body.is_unicycle
+    body_frame = not unicycles and config.command.frame is CommandFrame.BODY
     poses: Dict[int, Dict[int, Any]] = {}
     headings: Dict[int, Dict[int, float]] = {}
+    orientations: Dict[Tuple[int, int], Tuple[float, ...]] = {}
+    other_frame = 0
     for i in range(1, n + 1):
         for _, message in recorded.get(names.robot_topic(i, names.POSE), []):
+            if message.header.frame_id != config.world_frame:
+                other_frame += 1
+                continue
             stamp = stamp_to_ns(message.header.stamp)
             poses.setdefault(stamp, {})[i - 1] = position_of(message, dim)
+            o = message.pose.orientation
             if unicycles:
-                o = message.pose.orientation
                 headings.setdefault(stamp, {})[i - 1] = float(
                     headings_from_quaternions([o.x, o.y, o.z, o.w]))
+            elif body_frame:
+                orientations[(i, stamp)] = (o.x, o.y, o.z, o.w)
     stamps = sorted(stamp for stamp, seen in poses.items() if len(seen) == n)
     if len(stamps) < 2:
-        raise BagError('fewer than two moments with the poses of all robots recorded')
+        frames = (f' ({other_frame} poses in a frame other than world_frame '
+                  f'{config.world_frame!r} left out)' if other_frame else '')
+        raise BagError(f'fewer than two moments with the poses of all robots recorded{frames}')
     q = np.array([[poses[stamp][i] for i in range(n)] for stamp in stamps])
     width = 2 if unicycles else dim
     u = np.zeros((len(stamps), n, width))
     for i in range(1, n + 1):
-        commands = {}
-        for _, message in recorded.get(names.robot_topic(i, names.CMD_VEL), []):
-            commands[stamp_to_ns(message.header.stamp)] = (
-                (message.twist.linear.x, message.twist.angular.z) if unicycles
-                else velocity_of(message, dim))
+        commands = _commands_by_state(recorded, i, config)
+        if body_frame:
+            commands = {stamp: from_body_frame(np.array([value]),
+                                               np.array([orientations[(i, stamp)]]))[0]
+                        for stamp, value in commands.items() if (i, stamp) in orientations}
         if not commands:
             continue
         known = np.array(sorted(commands))
@@ -494,10 +507,13 @@ def trajectory_from_topics(recorded: Recorded,
         values = np.array([commands[int(k)] for k in known])
         u[:, i - 1] = np.where((index >= 0)[:, None], values[np.maximum(index, 0)], 0.0)
     frames, source = _frames_at(stamps, recorded.get(names.REFERENCE, []), config)
+    info: Dict[str, Any] = {'reference_source': source}
+    if other_frame:
+        info['poses_in_another_frame'] = other_frame
     if not unicycles:
         trajectory = Trajectory.from_frames(np.array(stamps) / NS_PER_S, q, u, frames,
                                             config.vertices)
-        return trajectory, {'reference_source': source}
+        return trajectory, info
     heading = np.array([[headings[stamp][i] for i in range(n)] for stamp in stamps])
     l_value = config.body.hand_distance
     trajectory = Trajectory.from_frames(np.array(stamps) / NS_PER_S,
@@ -505,7 +521,35 @@ def trajectory_from_topics(recorded: Recorded,
                                         hand_velocity(u, heading, l_value), frames,
                                         config.vertices)
     return (replace(trajectory, heading=heading, q_body=q, body_command=u),
-            {'reference_source': source})
+            info)
+
+
+def _commands_by_state(recorded: Recorded, robot: int,
+                       config: FormationConfig) -> Dict[int, Any]:
+    """
+    Return robot ``robot``'s recorded commands by the stamp of the state each answers.
+
+    A TwistStamped carries that stamp; a Twist (``command.type: twist``) does not, and is taken
+    to answer the robot's latest pose recorded before it (by the recorder's receive times).
+    Values: (dim,) linear velocities, or (v, w) for unicycles.
+    """
+    linear_only = not config.body.is_unicycle
+    pose_log = [(received, stamp_to_ns(message.header.stamp)) for received, message in
+                recorded.get(names.robot_topic(robot, names.POSE), [])]
+    pose_log.sort()
+    received_at = np.array([received for received, _ in pose_log], dtype=np.int64)
+    commands: Dict[int, Any] = {}
+    for received, message in recorded.get(names.robot_topic(robot, names.CMD_VEL), []):
+        if config.command.stamped:
+            stamp, twist = stamp_to_ns(message.header.stamp), message.twist
+        else:
+            index = int(np.searchsorted(received_at, received, side='right')) - 1
+            if index < 0:
+                continue
+            stamp, twist = pose_log[index][1], message
+        commands[stamp] = (np.array([twist.linear.x, twist.linear.y, twist.linear.z][:config.dim])
+                           if linear_only else (twist.linear.x, twist.angular.z))
+    return commands
 
 
 def plant_status(recorded: Recorded) -> Dict[str, int]:

@@ -26,7 +26,8 @@ import time
 from typing import Optional, Sequence, TextIO, Tuple
 
 from formation_ros.core.bodies import make_bodies
-from formation_ros.core.declarations import DEFAULT_COLLISION_DISTANCE, Exe, ParamError
+from formation_ros.core.declarations import (CommandFrame, DEFAULT_COLLISION_DISTANCE, Exe,
+                                             ParamError)
 from formation_ros.core.frames import desired_positions
 from formation_ros.core.law import team_command
 from formation_ros.core.metrics import body_metrics, compute_metrics
@@ -184,7 +185,8 @@ def simulate_fixed_step(config: FormationConfig, duration: float, dt: float,
     law = config.law()
     reference = config.reference()
     step_ns = int(round(dt * NS_PER_S))
-    bodies = make_bodies(config.body)
+    bodies = make_bodies(config.body, body_frame=config.command.frame is CommandFrame.BODY
+                         and not config.body.is_unicycle)
     model = PlantModel(config.start, config.sensing_radii, step_ns, law, reference,
                        input_timeout_ns=step_ns, collision_distance=DEFAULT_COLLISION_DISTANCE,
                        bodies=bodies, headings=config.start_headings,

@@ -1,51 +1,130 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""The shipped lab parameters files: valid for every executable, the relay's sources, limits."""
+"""The lab's parameters: world_frame, command.*, relay.*, the non-ideal plant (core/params.py)."""
 
 import os
 
-from formation_ros.core.declarations import CommandFrame, CommandType, Exe, SourceType
-from formation_ros.core.params import validate_for_every_executable
+from formation_ros.core.declarations import (CommandFrame, CommandType, Exe, ParamError,
+                                             SourceType)
+from formation_ros.core.params import validate, validate_for_every_executable
 from formation_ros.core.params_file import load_params_file
-from formation_ros.core.unicycle import command_bounds
+import numpy as np
 import pytest
 
-CONFIG = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(
-    os.path.abspath(__file__)))), 'config')
+CONFIG_DIR = os.path.join(os.path.dirname(__file__), '..', '..', 'config')
 
 
-def checked(name):
-    return validate_for_every_executable(load_params_file(os.path.join(CONFIG, name)))
+def section5(**changes):
+    values = load_params_file(os.path.join(CONFIG_DIR, 'paper_section5.yaml'))
+    values.update(changes)
+    return values
 
 
-def test_turtlebot3_lab_reads_vrpn_mocap_and_keeps_within_a_burgers_limits():
-    configs = checked('lab_turtlebot3.yaml')
-    relay = configs[Exe.RELAY].relay
-    assert [relay.source(i) for i in range(1, 5)] == [f'/vrpn_mocap/tb{i}/pose'
-                                                      for i in range(1, 5)]
-    assert relay.source_type is SourceType.POSE
-    robot = configs[Exe.ROBOT]
-    assert robot.body.is_unicycle and robot.world_frame == 'world'
-    assert robot.command.frame is CommandFrame.BODY
-    v_bound, w_bound = command_bounds(robot.law().u_bound, robot.body.hand_distance)
-    body = configs[Exe.SIM].body
-    assert (body.max_linear, body.max_angular) == (0.22, 2.84)
-    assert v_bound <= body.max_linear and w_bound <= body.max_angular
+def unicycles(**changes):
+    values = load_params_file(os.path.join(CONFIG_DIR, 'unicycle_2d.yaml'))
+    values.update(changes)
+    return values
 
 
-def test_holonomic_lab_reads_natnet_and_commands_plain_twists_in_the_body_frame():
-    configs = checked('lab_holonomic.yaml')
-    relay = configs[Exe.RELAY].relay
-    assert [relay.source(i) for i in range(1, 5)] == [f'/base{i}/pose' for i in range(1, 5)]
-    robot = configs[Exe.ROBOT]
-    assert not robot.body.is_unicycle
-    assert robot.command.message is CommandType.TWIST
-    assert robot.command.frame is CommandFrame.BODY
+def problem(raw, exe):
+    with pytest.raises(ParamError) as info:
+        validate(raw, exe)
+    return str(info.value)
 
 
-@pytest.mark.parametrize('name', ['lab_turtlebot3.yaml', 'lab_holonomic.yaml'])
-def test_every_executable_reads_one_world_frame(name):
-    frames = {exe: config.world_frame for exe, config in checked(name).items()}
-    assert set(frames) == {Exe.SIM, Exe.PLANT, Exe.REFERENCE, Exe.ROBOT, Exe.RELAY}
-    assert set(frames.values()) == {'world'}
+def test_defaults_are_todays_system():
+    for exe in (Exe.PLANT, Exe.ROBOT, Exe.SIM, Exe.RECORD):
+        config = validate({**section5(), 'robot_id': 1, 'record.path': '/tmp/bag'}, exe)
+        assert config.world_frame == 'world'
+        assert config.command.message is CommandType.TWIST_STAMPED and config.command.stamped
+        assert config.command.frame is CommandFrame.WORLD
+        assert config.imperfections.is_ideal
+    assert validate(unicycles(), Exe.PLANT).command.frame is CommandFrame.BODY
+
+
+@pytest.mark.parametrize('frame', ['map', 'vicon_world', 'mocap', 'odom/child'])
+def test_world_frame_is_any_frame_id(frame):
+    assert validate(section5(world_frame=frame), Exe.PLANT).world_frame == frame
+
+
+@pytest.mark.parametrize('frame', ['', '/world', 'my frame', 'a\tb'])
+def test_world_frame_that_no_tf_takes_is_refused(frame):
+    assert "parameter 'world_frame'" in problem(section5(world_frame=frame), Exe.PLANT)
+
+
+def test_unicycles_command_in_their_body_frame_only():
+    text = problem(unicycles(**{'command.frame': 'world'}), Exe.PLANT)
+    assert "parameter 'command.frame'" in text and 'body frame' in text
+    config = validate(unicycles(**{'command.frame': 'body', 'command.type': 'twist'}), Exe.PLANT)
+    assert config.command.frame is CommandFrame.BODY and not config.command.stamped
+
+
+def test_a_twist_cannot_answer_a_state_in_lockstep():
+    text = problem(section5(**{'command.type': 'twist', 'plant.lockstep': True}), Exe.PLANT)
+    assert "parameter 'command.type'" in text and 'no stamp' in text
+    assert not validate(section5(**{'command.type': 'twist'}), Exe.PLANT).command.stamped
+
+
+def test_body_frame_points_have_headings():
+    headings = [0.1 * k for k in range(10)]
+    config = validate(section5(**{'command.frame': 'body', 'start.headings': headings}),
+                      Exe.PLANT)
+    assert np.array_equal(config.start_headings, headings)
+    assert validate(section5(**{'command.frame': 'body'}), Exe.PLANT).start_headings is not None
+    assert validate(section5(), Exe.PLANT).start_headings is None
+    text = problem(section5(**{'start.headings': headings}), Exe.PLANT)
+    assert 'command.frame body' in text
+
+
+def test_state_delay_must_leave_commands_fresh():
+    text = problem(section5(**{'plant.state_delay': 0.5, 'plant.input_timeout': 0.5}),
+                   Exe.PLANT)
+    assert "parameter 'plant.state_delay'" in text and 'stale' in text
+    config = validate(section5(**{'plant.state_delay': 0.1, 'plant.actuator_lag': 0.05,
+                                  'plant.max_acceleration': 2.0, 'plant.pose_noise': 0.01}),
+                      Exe.PLANT)
+    imperfections = config.imperfections
+    assert (imperfections.state_delay, imperfections.actuator_lag,
+            imperfections.max_acceleration, imperfections.pose_noise) == (0.1, 0.05, 2.0, 0.01)
+    assert not imperfections.is_ideal and imperfections.seed == config.values['start.seed']
+
+
+def test_robots_and_reference_step_no_bodies():
+    raw = section5(**{'plant.actuator_lag': 0.05, 'robot_id': 2})
+    assert validate(raw, Exe.ROBOT).imperfections.is_ideal
+
+
+def test_relay_sources_by_id_and_by_name():
+    relay = validate(section5(), Exe.RELAY).relay
+    assert relay.source(3) == '/robot_3/measured_pose' and relay.source_type is SourceType.POSE
+    names = [f'tb{k}' for k in range(1, 11)]
+    relay = validate(section5(**{'relay.source_topic': '/vrpn_mocap/{name}/pose',
+                                 'relay.source_names': names,
+                                 'relay.source_type': 'odometry'}), Exe.RELAY).relay
+    assert relay.source(7) == '/vrpn_mocap/tb7/pose'
+    assert relay.source_type is SourceType.ODOMETRY
+
+
+@pytest.mark.parametrize('changes, words', [
+    ({'relay.source_topic': '/vrpn_mocap/{name}/pose'}, ['relay.source_names', 'is required']),
+    ({'relay.source_names': ['a', 'b']}, ['relay.source_names', '10 names, got 2']),
+    ({'relay.source_names': ['a'] * 10, 'relay.source_topic': '/{name}/pose'},
+     ['must differ']),
+    ({'relay.source_topic': '/robot_{id}/pose'}, ['relay.source_topic', '{id}']),
+    ({'relay.source_topic': '/robot_{i/pose'}, ['relay.source_topic', 'not a topic template']),
+    ({'relay.source_topic': '/mocap/pose'}, ['names no robot']),
+    ({'relay.source_names': [1.0] * 10}, ['list of strings']),
+])
+def test_relay_templates_that_cannot_work_are_refused(changes, words):
+    text = problem(section5(**changes), Exe.RELAY)
+    assert all(word in text for word in words), text
+
+
+def test_a_lab_file_is_valid_for_every_executable():
+    raw = section5(**{'world_frame': 'map', 'command.type': 'twist', 'command.frame': 'body',
+                      'relay.source_topic': '/{name}/pose',
+                      'relay.source_names': [f'body_{k}' for k in range(10)]})
+    checked = validate_for_every_executable(raw)
+    assert set(checked) == {Exe.SIM, Exe.PLANT, Exe.REFERENCE, Exe.ROBOT, Exe.RELAY}
+    assert all(config.world_frame == 'map' for config in checked.values())

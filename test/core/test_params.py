@@ -251,8 +251,9 @@ def test_bad_unicycle_parameter_named_with_what_is_allowed(name, changes, messag
 def test_unicycle_parameters_are_refused_for_point_bodies(name):
     raw = base()
     raw[name] = [0.0] * 10 if name == 'start.headings' else 0.1
-    with pytest.raises(ParamError, match=f"'{re.escape(name)}': applies only to body.kind "
-                                         'unicycle'):
+    message = ('applies to unicycles and to points with command.frame body'
+               if name == 'start.headings' else 'applies only to body.kind unicycle')
+    with pytest.raises(ParamError, match=f"'{re.escape(name)}': {message}"):
         validate(raw)
 
 

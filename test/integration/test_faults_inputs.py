@@ -116,7 +116,7 @@ def test_robot_ignores_forged_poses_and_floods(processes, install, probe):
             publisher.publish(message)
         log = processes.log('robot_1')
         if not logged_at and all(reason in log for reason in (
-                "a frame other than 'world'", 'more neighbours than there are robots',
+                'a frame other than world_frame', 'more neighbours than there are robots',
                 'a speed or turn rate', 'not a whole message of its type')):
             logged_at.append(len(heard))
         return bool(logged_at) and len(heard) > logged_at[0] + 20
@@ -128,7 +128,7 @@ def test_robot_ignores_forged_poses_and_floods(processes, install, probe):
                              config.sensing_radii[0], config.law()).u
     assert all(np.max(np.abs(u - expected)) < 1e-12 for u in answers), answers[:5]
     log = processes.log('robot_1')
-    for reason in ("a frame other than 'world'", 'more neighbours than there are robots',
+    for reason in ('a frame other than world_frame', 'more neighbours than there are robots',
                    'a speed or turn rate', 'not a whole message of its type'):
         assert log.count(reason) == 1, (reason, log)
     assert processes.running('robot_1')

@@ -8,11 +8,12 @@ import math
 from formation_ros.core.frames import frame_from_pose, frame_to_pose
 from formation_ros.ros import messages
 from formation_ros.ros.cdr import (CdrError, encode_clock, encode_odometry, encode_pose_stamped,
-                                   encode_twist_stamped, read_odometry, read_pose_array,
-                                   read_pose_stamped, read_twist_stamped)
+                                   encode_twist, encode_twist_stamped, read_odometry,
+                                   read_pose_array, read_pose_stamped, read_twist,
+                                   read_twist_stamped)
 from formation_ros.ros.fields import points_of, stamp_to_ns
-from geometry_msgs.msg import (Point, Pose, PoseArray, PoseStamped, Quaternion, TwistStamped,
-                               Vector3)
+from geometry_msgs.msg import (Point, Pose, PoseArray, PoseStamped, Quaternion, Twist,
+                               TwistStamped, Vector3)
 from nav_msgs.msg import Odometry
 import numpy as np
 import pytest
@@ -166,3 +167,17 @@ def test_written_messages_are_what_rclpy_writes_and_reads(stamp):
         expected = serialize_message(message)
         assert isinstance(data, bytes) and len(data) == len(expected)
         assert deserialize_message(data, type(message)) == message
+
+
+def test_twist_without_header_is_what_rclpy_writes_and_reads():
+    rng = np.random.default_rng(11)
+    linear, angular = rng.normal(size=3), rng.normal(size=3)
+    message = Twist(linear=Vector3(**_vector(linear)), angular=Vector3(**_vector(angular)))
+    data = encode_twist(linear, angular)
+    assert data == serialize_message(message)
+    read = read_twist(serialize_message(message))
+    assert read.linear == tuple(linear) and read.angular == tuple(angular)
+    assert (read.stamp_ns, read.frame_id) == (0, '')
+    for end in range(len(data)):
+        with pytest.raises(CdrError):
+            read_twist(data[:end])

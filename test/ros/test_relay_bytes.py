@@ -1,13 +1,12 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""What the relay reads and writes as bytes: exact readers, rotations, forwarded orientations."""
+"""What the relay reads and writes as bytes: exact readers, forwarded orientations."""
 
 from formation_ros.core.sensing import sensed_pairs
 from formation_ros.ros import messages
-from formation_ros.ros.cdr import (CdrError, encode_odometry, encode_pose_stamped, PoseData,
-                                   QUATERNION_TOLERANCE, read_odometry, read_pose_stamped,
-                                   StateEncoder)
+from formation_ros.ros.cdr import (CdrError, encode_odometry, encode_pose_stamped,
+                                   read_odometry, read_pose_stamped, StateEncoder)
 from geometry_msgs.msg import PoseArray, PoseStamped
 import numpy as np
 import pytest
@@ -33,19 +32,6 @@ def test_exact_readers_take_whole_messages_and_a_final_padding(padding):
     assert read_odometry(ODOMETRY + b'\x00' * padding, exact=True).position == (1.0, 2.0, 0.0)
     with pytest.raises(CdrError):
         read_pose_stamped(pose + b'\x00' * 4, exact=True)
-
-
-@pytest.mark.parametrize('orientation, rotation', [
-    ((0.0, 0.0, 0.0, 1.0), True),
-    ((0.0, 0.0, 0.6, 0.8), True),
-    ((0.5, 0.5, 0.5, 0.5), True),
-    ((0.0, 0.0, 0.0, 1.0 + 0.9 * QUATERNION_TOLERANCE), True),
-    ((0.0, 0.0, 0.0, 1.0 + 1.1 * QUATERNION_TOLERANCE), False),
-    ((0.0, 0.0, 0.0, 0.0), False),
-    ((0.0, 0.0, 1.0, 1.0), False),
-])
-def test_rotation_tells_unit_quaternions(orientation, rotation):
-    assert PoseData(0, 'map', (0.0, 0.0, 0.0), orientation).rotation is rotation
 
 
 def test_orientations_given_are_written_as_they_are():
