@@ -260,7 +260,7 @@ def test_relay_refuses_sim_time_and_a_source_that_is_its_own_output(install, pro
 def test_mocap_dropout_stops_one_robot_and_the_others_keep_it_in_their_lists(
         processes, install, probe, tmp_path):
     """
-    Relay + four robots + reference on wall-clock time; the probe plays mocap and bodies.
+    Relay + four robots + reference on wall-clock time in 'map'; the probe plays mocap, bodies.
 
     Robot 3 is not measured for 2 s: its watchdog stops it, the others' neighbour lists keep
     it at its last measured position, the relay's diagnostics name it (WARN); once measured
@@ -269,11 +269,11 @@ def test_mocap_dropout_stops_one_robot_and_the_others_keep_it_in_their_lists(
     max_age, timeout = 0.4, 0.5
     params = write_params(tmp_path, 'square_4.yaml', {
         'sensing_radius': 3.0, 'controller.gain': 0.5, 'relay.max_age': max_age,
-        'relay.rate': 30.0, 'input_timeout': timeout})
+        'relay.rate': 30.0, 'input_timeout': timeout, 'world_frame': 'map'})
     outputs = Outputs(probe, 4)
     lab = Lab(q=[[0.3, 0.2], [-0.2, 0.4], [-0.3, -0.3], [0.4, -0.2]], heading=np.zeros(4),
               base=Base.WORLD, command_topic='/robot_{i}/cmd_vel',
-              mocap_topic='/robot_{i}/measured_pose', frame='world', rate=50.0)
+              mocap_topic='/robot_{i}/measured_pose', frame='map', rate=50.0)
     lab.attach(probe)
     processes.start(node(install, 'relay', params))
     processes.start(node(install, 'reference', params))
