@@ -56,8 +56,7 @@ def converged(lab, targets, tolerance, points=None):
     return bool(np.max(np.linalg.norm(where - targets, axis=1)) < tolerance)
 
 
-def test_holonomic_bases_taking_body_frame_twists_converge(processes, install, probe,
-                                                            tmp_path):
+def test_holonomic_bases_taking_body_frame_twists_converge(processes, install, probe, tmp_path):
     params = lab_params(tmp_path, 'square_4.yaml', {
         'controller.gain': 0.6, 'body.radius': 0.1, 'command.type': 'twist',
         'command.frame': 'body'})
