@@ -9,15 +9,17 @@ reference of the sensing rule written here (strictly within R_i; R_i + 2 l for u
 """
 
 import math
+import os
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from formation_ros.ros import fields, qos
 from formation_ros.ros.cdr import encode_odometry, encode_pose_stamped
 from geometry_msgs.msg import PoseArray, PoseStamped
-from helpers import node, write_params
+from helpers import CONFIG, node, write_params
 from lab_standin import Base, Lab, steady_s
 from nav_msgs.msg import Odometry
 import numpy as np
+import pytest
 from rclpy.clock import Clock, ClockType
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 
@@ -329,3 +331,18 @@ def test_mocap_dropout_stops_one_robot_and_the_others_keep_it_in_their_lists(
     assert log.count('robot 3: no measurement on /robot_3/measured_pose') == 1, log
     assert log.count('robot 3: measured again') == 1, log
     assert 'robot 1: no measurement' not in log
+
+
+@pytest.mark.parametrize('name, first_source', [('lab_turtlebot3.yaml', '/vrpn_mocap/tb1/pose'),
+                                                ('lab_holonomic.yaml', '/base1/pose')])
+def test_the_shipped_lab_files_start_the_relay_as_its_docstring_says(processes, install, probe,
+                                                                     name, first_source):
+    """``relay --ros-args --params-file config/<lab>.yaml``: it waits for its mocap sources."""
+    outputs = Outputs(probe, 4)
+    processes.start(node(install, 'relay', os.path.join(CONFIG, name)))
+    assert probe.spin_until(lambda: outputs.values().get('robots whose source has no publisher')
+                            == '1, 2, 3, 4', START_UP), processes.log('relay')
+    log = processes.log('relay')
+    assert f'measured on {first_source}' in log and "in 'world'" in log, log
+    assert outputs.statuses[-1].level == DiagnosticStatus.WARN
+    assert processes.running('relay')
