@@ -74,6 +74,7 @@ from nav_msgs.msg import Odometry
 import numpy as np
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
+from scipy.spatial import cKDTree
 
 NS_PER_S = 1_000_000_000
 NEVER = -1
@@ -236,11 +237,11 @@ class RelayNode(Node):
         messages are encoded too, but never published.
         """
         q = self.positions[:, :self.dim]
-        observer, seen = sensed_pairs(q[known], self.reach[known])
-        norms = np.linalg.norm(self.orientations, axis=1)
+        observer, seen = sensed_pairs(q[known], self.reach[known], cKDTree(q[known]))
         if self.unicycles:
             return self.encoder.encode(q, known[observer], known[seen], stamp_ns,
                                        headings=headings_from_quaternions(self.orientations))
+        norms = np.linalg.norm(self.orientations, axis=1)
         return self.encoder.encode(q, known[observer], known[seen], stamp_ns,
                                    orientations=self.orientations / norms[:, None])
 
