@@ -31,12 +31,13 @@ measurement is measured from its arrival on this host's monotonic clock, never f
 stamp: a mocap computer's clock may be off by any amount. A measurement's own stamp is not
 used (nor forwarded).
 
-What is forwarded: the positions (x, y, z; in 2D the plane's x, y, z dropped) and orientations.
-A unicycle's orientation is its heading (yaw of the measured quaternion) as a rotation about +z,
-as the plant writes it; a point's is the measured quaternion, normalised (a holonomic base that
-takes body-frame commands, ``command.frame: body``, is turned by it). An orientation that is not
-a unit quaternion (``core.frames.valid_quaternions``, as the robots check it) is refused for
-every body kind: the relay does not know whether the robots turn their commands by it.
+What is forwarded: the positions (x, y and in 3D z; in 2D the height z is dropped) and the
+orientations. A unicycle's orientation is its heading (yaw of the measured quaternion) as a
+rotation about +z, as the plant writes it; a point's is the measured quaternion, normalised (a
+holonomic base that takes body-frame commands, ``command.frame: body``, is turned by it). An
+orientation that is not a unit quaternion (``core.frames.valid_quaternions``, as the robots
+check it) is refused for every body kind: the relay does not know whether the robots turn their
+commands by it.
 
 Stale robots: a robot whose latest measurement is older than ``relay.max_age`` gets no pose and
 no neighbour list (its own watchdog, ``input_timeout``, then stops it), but stays in the other
