@@ -35,6 +35,7 @@ setup(
             'reference = formation_ros.nodes.reference:main',
             'record = formation_ros.nodes.recorder:main',
             'fleet = formation_ros.nodes.fleet:main',
+            'relay = formation_ros.nodes.relay:main',
         ],
     },
 )

@@ -38,6 +38,8 @@ COVARIANCE_DOUBLES = 36
 NS_PER_S = 1_000_000_000
 ENDIANS = {b'\x00\x01': '<', b'\x00\x00': '>'}
 IDENTITY = (0.0, 0.0, 0.0, 1.0)
+FINAL_PADDING = 3
+"""Bytes a writer may leave after a message's last field (its payload padded to 4)."""
 
 
 class CdrError(ValueError):
@@ -164,6 +166,13 @@ class _Reader:
     def uint32(self) -> int:
         return self._take('I', 4, 4)[0]
 
+    def end(self) -> None:
+        """Refuse bytes left over after the last field (beyond a final padding)."""
+        left = len(self.view) - self.offset
+        if left > FINAL_PADDING:
+            raise CdrError(f'{left} bytes left over after a {self.what}: a message of '
+                           'another type?')
+
 
 def read_pose_array(data: bytes, max_poses: int) -> PoseArrayData:
     """
@@ -188,11 +197,18 @@ def read_pose_array(data: bytes, max_poses: int) -> PoseArrayData:
                          poses[:, 3:].astype(np.float64))
 
 
-def read_pose_stamped(data: bytes) -> PoseData:
-    """Read a serialized geometry_msgs/PoseStamped; :class:`CdrError` if it is not one."""
+def read_pose_stamped(data: bytes, exact: bool = False) -> PoseData:
+    """
+    Read a serialized geometry_msgs/PoseStamped; :class:`CdrError` if it is not one.
+
+    exact: also refuse bytes left over after it (a longer message, e.g. an Odometry, would
+    otherwise read as a PoseStamped of whatever its first fields hold).
+    """
     reader = _Reader(data, 'PoseStamped')
     stamp_ns, frame_id = reader.header()
     values = reader.doubles(POSE_DOUBLES)
+    if exact:
+        reader.end()
     return PoseData(stamp_ns, frame_id, values[:3], values[3:])
 
 
@@ -211,8 +227,12 @@ def read_twist(data: bytes) -> TwistData:
     return TwistData(0, '', values[:3], values[3:])
 
 
-def read_odometry(data: bytes) -> OdometryData:
-    """Read a serialized nav_msgs/Odometry (its covariances skipped); CdrError if not one."""
+def read_odometry(data: bytes, exact: bool = False) -> OdometryData:
+    """
+    Read a serialized nav_msgs/Odometry (its covariances skipped); CdrError if not one.
+
+    exact: also refuse bytes left over after it (see :func:`read_pose_stamped`).
+    """
     reader = _Reader(data, 'Odometry')
     stamp_ns, frame_id = reader.header()
     child = reader.string('child_frame_id')
@@ -220,6 +240,8 @@ def read_odometry(data: bytes) -> OdometryData:
     reader.skip_doubles(COVARIANCE_DOUBLES)
     twist = reader.doubles(6)
     reader.skip_doubles(COVARIANCE_DOUBLES)
+    if exact:
+        reader.end()
     return OdometryData(stamp_ns, frame_id, child, pose[:3], pose[3:], twist[:3], twist[3:])
 
 
@@ -292,10 +314,10 @@ class StateEncoder:
     """
     The plant's state messages of all robots at once: poses and range-sensor readings as bytes.
 
-    Every robot's pose is 7 float64 (x, y, z, quaternion: identity, or the heading of a
-    unicycle) in one (N, 7) array; a
-    PoseStamped is a fixed prefix and that row, a PoseArray a prefix with its count and the rows
-    of the robots it lists, taken with one numpy index for all arrays together.
+    Every robot's pose is 7 float64 (x, y, z, quaternion: identity, the heading of a unicycle,
+    or an orientation given) in one (N, 7) array; a PoseStamped is a fixed prefix and that row,
+    a PoseArray a prefix with its count and the rows of the robots it lists, taken with one
+    numpy index for all arrays together. Used by the plant node and the relay node alike.
     """
 
     def __init__(self, num_robots: int, dim: int, frame_id: str) -> None:
@@ -307,17 +329,22 @@ class StateEncoder:
 
     def encode(self, q: NDArray[np.float64], observer: NDArray[np.intp],
                seen: NDArray[np.intp], stamp_ns: int,
-               headings: Optional[NDArray[np.float64]] = None) -> Encoded:
+               headings: Optional[NDArray[np.float64]] = None,
+               orientations: Optional[NDArray[np.float64]] = None) -> Encoded:
         """
         Return (poses, arrays): robot i's serialized PoseStamped and PoseArray at ``stamp_ns``.
 
         q: (N, dim) positions, m; (observer, seen): every sensed pair, sorted by observer
         (``core.sensing.sensed_pairs``): robot ``observer[k]`` sees robot ``seen[k]``;
-        headings: (N,) rad about +z, written as the orientations (None: identity).
+        headings: (N,) rad about +z, written as the orientations; else orientations: (N, 4)
+        unit quaternions (x, y, z, w) written as they are (neither: the previous call's, at
+        first identity).
         """
         self.rows[:, :self.dim] = q
         if headings is not None:
             self.rows[:, 3:] = quaternions_from_headings(headings)
+        elif orientations is not None:
+            self.rows[:, 3:] = orientations
         header = encode_header(stamp_ns, self.frame_id)
         pose_prefix = header + _pad(len(header), 8)
         poses = [pose_prefix + row for row in map(bytes, self.rows)]

@@ -17,6 +17,10 @@ Quality of service of every formation topic, in one place.
   neighbours, a localisation system or range-sensor driver with the ROS default QoS too. A
   robot notices a silent plant by its watchdog instead (``input_timeout``, 0.5 s by default:
   it publishes zero and its ``/diagnostics`` says so).
+* Measurements (the relay's sources, ``relay.source_topic``: a motion-capture system's poses):
+  best effort, keep last 1, volatile, no liveliness asked (``MEASUREMENT``). A best-effort
+  subscriber matches best-effort publishers (vrpn_mocap, which uses the sensor-data QoS) and
+  reliable ones (natnet_ros2, ``ros2 topic pub``) alike, and only the newest pose matters.
 * Clock (``/clock``): reliable, keep last 1; it matches rclpy's best-effort time source and
   reliable subscribers such as a recorder.
 * Diagnostics (``/diagnostics``): reliable, keep last 10, volatile, as diagnostic tools expect.
@@ -62,6 +66,7 @@ COMMAND = _profile(10, ReliabilityPolicy.RELIABLE, DurabilityPolicy.VOLATILE, LI
 REFERENCE = _profile(10, ReliabilityPolicy.RELIABLE, DurabilityPolicy.TRANSIENT_LOCAL)
 STATE = _profile(1, ReliabilityPolicy.BEST_EFFORT, DurabilityPolicy.VOLATILE, LIVELINESS_LEASE)
 STATE_INPUT = _profile(1, ReliabilityPolicy.BEST_EFFORT, DurabilityPolicy.VOLATILE)
+MEASUREMENT = _profile(1, ReliabilityPolicy.BEST_EFFORT, DurabilityPolicy.VOLATILE)
 CLOCK = _profile(1, ReliabilityPolicy.RELIABLE, DurabilityPolicy.VOLATILE)
 DIAGNOSTICS = _profile(10, ReliabilityPolicy.RELIABLE, DurabilityPolicy.VOLATILE)
 MARKERS = _profile(1, ReliabilityPolicy.RELIABLE, DurabilityPolicy.TRANSIENT_LOCAL)

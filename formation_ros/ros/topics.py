@@ -11,7 +11,9 @@ serves every robot, uses :func:`robot_topic`. The formation-wide topics are abso
 
 from dataclasses import dataclass
 import enum
-from typing import List
+from typing import Dict, List
+
+from formation_ros.core.declarations import SourceType
 
 POSE = 'pose'
 NEIGHBOURS = 'neighbors'
@@ -25,6 +27,12 @@ SHAPE = '/formation/shape'
 STATUS = '/formation/status'
 STOP = '/formation/stop'
 START = '/formation/start'
+MEASUREMENT_TYPES: Dict[SourceType, str] = {
+    SourceType.POSE: 'geometry_msgs/msg/PoseStamped',
+    SourceType.ODOMETRY: 'nav_msgs/msg/Odometry',
+}
+"""ROS type of the relay's measured poses for each ``relay.source_type`` (topics: the template
+``relay.source_topic``, ``core.params.RelaySettings.source``)."""
 
 
 class QosKind(enum.Enum):

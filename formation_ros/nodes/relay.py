@@ -1,0 +1,326 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+r"""
+Relay node (executable ``relay``): the range sensor of the plant, without the bodies.
+
+In a lab the bodies are real and a motion-capture system (or any localisation) measures them.
+The relay reads those measured poses and publishes what the plant node would: every robot's
+``/robot_<i>/pose`` (PoseStamped) and ``/robot_<i>/neighbors`` (PoseArray: what its range
+sensor sees), same types, same QoS (``qos.STATE``), in ``world_frame``, with the one sensing
+rule of ``core.sensing`` (strictly within R_i; R_i + 2 l for unicycles, whose law acts on hand
+points l ahead of the bodies). The robot nodes run unchanged, on wall-clock time::
+
+    ros2 run formation_ros relay --ros-args --params-file config/lab_turtlebot3.yaml
+
+(from the repository; ``$(ros2 pkg prefix --share formation_ros)/config/...`` elsewhere). The
+relay runs on wall-clock time: leave ``use_sim_time`` out (a lab has no ``/clock``; it is
+refused).
+
+Inputs: robot i's measured pose on ``relay.source_topic`` with ``{i}`` its id and ``{name}`` its
+entry of ``relay.source_names`` (e.g. ``/vrpn_mocap/{name}/pose``), a PoseStamped or, with
+``relay.source_type: odometry``, a nav_msgs/Odometry; QoS ``qos.MEASUREMENT`` (best effort, no
+liveliness), so best-effort and reliable publishers are both heard. Callbacks read the bytes
+(``ros.cdr``), check them and store the latest measurement of each robot with the time it
+arrived; a timer at ``relay.rate`` (steady clock) runs each cycle.
+
+Stamps and ages: every pose and neighbour list of a cycle carries ONE stamp, the relay's
+wall-clock time at the cycle (``get_clock().now()``), so that a robot, which answers a state
+when its pose and neighbours carry the same stamp, answers every cycle. The age of a
+measurement is measured from its arrival on this host's monotonic clock, never from its header
+stamp: a mocap computer's clock may be off by any amount. A measurement's own stamp is not
+used (nor forwarded).
+
+What is forwarded: the positions (x, y and in 3D z; in 2D the height z is dropped) and the
+orientations. A unicycle's orientation is its heading (yaw of the measured quaternion) as a
+rotation about +z, as the plant writes it; a point's is the measured quaternion, normalised (a
+holonomic base that takes body-frame commands, ``command.frame: body``, is turned by it). An
+orientation that is not a unit quaternion (``core.frames.valid_quaternions``, as the robots
+check it) is refused for every body kind: the relay does not know whether the robots turn their
+commands by it.
+
+Stale robots: a robot whose latest measurement is older than ``relay.max_age`` gets no pose and
+no neighbour list (its own watchdog, ``input_timeout``, then stops it), but stays in the other
+robots' neighbour lists at its last measured position: a neighbour that vanishes from a list is
+how collisions happen. A robot never measured is listed nowhere. Until at least one robot is
+measured nothing is published. ``/diagnostics`` names the stale robots (WARN) and counts the
+measurements refused per robot and reason.
+
+Untrusted input: a measurement in a frame other than ``world_frame``, with non-finite values,
+with an orientation that is not a unit quaternion, or whose bytes are not a whole message of the
+source type is refused (counted, logged once naming the topic, not stored). A source topic that
+also has publishers of another type (which DDS does not connect to this subscription) is logged
+once from the diagnostics timer.
+"""
+
+import enum
+import time
+from typing import Dict, List, Optional, Tuple
+
+from diagnostic_msgs.msg import DiagnosticArray
+from formation_ros.core.bodies import make_bodies
+from formation_ros.core.declarations import Exe, ParamError, SourceType
+from formation_ros.core.frames import valid_quaternions
+from formation_ros.core.sensing import sensed_pairs, sensor_radii
+from formation_ros.core.unicycle import headings_from_quaternions
+from formation_ros.ros import qos, topics
+from formation_ros.ros.cdr import (CdrError, PoseData, read_odometry, read_pose_stamped,
+                                   StateEncoder)
+from formation_ros.ros.diagnostics import diagnostics, PERIOD
+from formation_ros.ros.once import OnceLog
+from formation_ros.ros.parameters import declare_parameters
+from formation_ros.ros.runner import run
+from geometry_msgs.msg import PoseArray, PoseStamped
+from nav_msgs.msg import Odometry
+import numpy as np
+from rclpy.clock import Clock, ClockType
+from rclpy.node import Node
+from scipy.spatial import cKDTree
+
+NS_PER_S = 1_000_000_000
+NEVER = -1
+MESSAGE_TYPES = {SourceType.POSE: PoseStamped, SourceType.ODOMETRY: Odometry}
+
+
+class Reason(enum.Enum):
+    """Why the relay refuses a measurement."""
+
+    MALFORMED = 'bytes that are not a whole message of relay.source_type'
+    FRAME = 'a frame other than world_frame'
+    NON_FINITE = 'non-finite values'
+    ROTATION = 'an orientation that is not a unit quaternion'
+
+
+class RelayNode(Node):
+    """Measured poses in, every robot's pose and sensor reading out, one stamp per cycle."""
+
+    def __init__(self) -> None:
+        """Declare and check parameters, then subscribe to every source and start the cycle."""
+        super().__init__('relay')
+        config = declare_parameters(self, Exe.RELAY)
+        settings = config.relay
+        assert settings is not None
+        if self.get_parameter('use_sim_time').value:
+            raise ParamError([('use_sim_time', 'must be false: the relay stamps its states '
+                                               'with wall-clock time (a lab has no /clock)')])
+        self.settings = settings
+        self.n, self.dim = config.num_robots, config.dim
+        self.world_frame = config.world_frame
+        self.unicycles = config.body.is_unicycle
+        margin = make_bodies(config.body).sensing_margin
+        self.reach = sensor_radii(config.sensing_radii, margin)
+        self.max_age_ns = int(settings.max_age * NS_PER_S)
+        self.sources = [settings.source(i) for i in range(1, self.n + 1)]
+        outputs = {topics.robot_topic(i, name) for i in range(1, self.n + 1)
+                   for name in (topics.POSE, topics.NEIGHBOURS, topics.CMD_VEL)}
+        looped = sorted(set(self.sources) & outputs)
+        if looped:
+            raise ParamError([('relay.source_topic', f'{settings.source_topic!r} gives '
+                                                     f'{looped[0]}, a topic of the robots '
+                                                     '(the relay would read what it writes, or '
+                                                     'the commands): use e.g. '
+                                                     "'/robot_{i}/measured_pose'")])
+        self.source_type_name = topics.MEASUREMENT_TYPES[settings.source_type]
+        self.once = OnceLog(self.get_logger())
+        self.steady = Clock(clock_type=ClockType.STEADY_TIME)
+
+        self.positions = np.zeros((self.n, 3))
+        self.orientations = np.tile([0.0, 0.0, 0.0, 1.0], (self.n, 1))
+        self.received_ns = np.full(self.n, NEVER, dtype=np.int64)
+        self.measurements = np.zeros(self.n, dtype=np.int64)
+        self.refused: Dict[Tuple[int, Reason], int] = {}
+        self.foreign_types: Dict[str, List[str]] = {}
+        self.cycles = 0
+        self.published_cycles = 0
+        self.rate_window = (time.monotonic(), 0)
+        self.stale = np.ones(self.n, dtype=bool)
+
+        self.encoder = StateEncoder(self.n, self.dim, self.world_frame)
+        message_type = MESSAGE_TYPES[settings.source_type]
+        callback = (self.on_odometry if settings.source_type is SourceType.ODOMETRY
+                    else self.on_pose)
+        self.source_subs = [
+            self.create_subscription(message_type, topic,
+                                     lambda data, index=i: callback(index, data),
+                                     qos.MEASUREMENT, raw=True)
+            for i, topic in enumerate(self.sources)]
+        self.pose_pubs, self.neighbour_pubs = [], []
+        for i in range(1, self.n + 1):
+            self.pose_pubs.append(self.create_publisher(
+                PoseStamped, topics.robot_topic(i, topics.POSE), qos.STATE))
+            self.neighbour_pubs.append(self.create_publisher(
+                PoseArray, topics.robot_topic(i, topics.NEIGHBOURS), qos.STATE))
+        self.diagnostics_pub = self.create_publisher(
+            DiagnosticArray, topics.DIAGNOSTICS, qos.DIAGNOSTICS)
+        self.timer = self.create_timer(1.0 / settings.rate, self.on_cycle, clock=self.steady)
+        self.diagnostics_timer = self.create_timer(PERIOD, self.on_diagnostics,
+                                                   clock=self.steady)
+        shown = ', '.join(self.sources[:3]) + (', ...' if self.n > 3 else '')
+        self.get_logger().info(
+            f'relay: {self.n} robots ({config.body.kind.value}s) measured on {shown} '
+            f'({self.source_type_name}), publishing pose and neighbors in '
+            f"'{self.world_frame}' at {settings.rate:g} Hz, stale after {settings.max_age:g} s")
+
+    def _refuse(self, index: int, reason: Reason, detail: str) -> None:
+        """Count a refused measurement of robot ``index``; log it once per robot and reason."""
+        key = (index + 1, reason)
+        self.refused[key] = self.refused.get(key, 0) + 1
+        self.once.start(f'refused-{index}-{reason.name}',
+                        f'robot {index + 1}: ignoring measurements on {self.sources[index]} '
+                        f'with {reason.value}: {detail} (logged once; counted in diagnostics)',
+                        'error')
+
+    def on_pose(self, index: int, data: bytes) -> None:
+        """Store robot ``index``'s measured pose, read from a serialized PoseStamped."""
+        try:
+            pose = read_pose_stamped(data, exact=True)
+        except CdrError as exc:
+            self._refuse(index, Reason.MALFORMED, f'{exc}, expected a {self.source_type_name}')
+            return
+        self._store(index, pose)
+
+    def on_odometry(self, index: int, data: bytes) -> None:
+        """Store robot ``index``'s measured pose, read from a serialized nav_msgs/Odometry."""
+        try:
+            odometry = read_odometry(data, exact=True)
+        except CdrError as exc:
+            self._refuse(index, Reason.MALFORMED, f'{exc}, expected a {self.source_type_name}')
+            return
+        self._store(index, PoseData(odometry.stamp_ns, odometry.frame_id, odometry.position,
+                                    odometry.orientation))
+
+    def _store(self, index: int, pose: PoseData) -> None:
+        """Keep a measurement that is in world_frame, finite and rotated by a unit quaternion."""
+        if pose.frame_id != self.world_frame:
+            self._refuse(index, Reason.FRAME, f"got frame '{pose.frame_id}', expected "
+                                              f"world_frame '{self.world_frame}'")
+        elif not pose.finite:
+            self._refuse(index, Reason.NON_FINITE, f'position {pose.position}, orientation '
+                                                   f'{pose.orientation}')
+        elif not valid_quaternions(pose.orientation):
+            self._refuse(index, Reason.ROTATION, f'orientation {pose.orientation}')
+        else:
+            self.positions[index] = pose.position
+            self.orientations[index] = pose.orientation
+            self.received_ns[index] = time.monotonic_ns()
+            self.measurements[index] += 1
+
+    def on_cycle(self) -> None:
+        """Publish the pose and sensor reading of every fresh robot, all with one stamp."""
+        self.cycles += 1
+        now = time.monotonic_ns()
+        measured = self.received_ns != NEVER
+        fresh = measured & (now - self.received_ns <= self.max_age_ns)
+        self._log_staleness(measured, fresh)
+        self.stale = ~fresh
+        if not np.any(measured):
+            self.once.start('waiting', f'no robot measured yet (robots 1..{self.n} on '
+                                       f'{self.sources[0]}, ...): publishing nothing until one '
+                                       'is', 'info')
+            return
+        if self.once.is_active('waiting'):
+            missing = (np.flatnonzero(~measured) + 1).tolist()
+            self.once.end('waiting', f'robots {(np.flatnonzero(measured) + 1).tolist()} '
+                                     f'measured: publishing; not measured yet: '
+                                     f"{missing or 'none'}")
+        stamp_ns = self.get_clock().now().nanoseconds
+        poses, arrays = self._encode(np.flatnonzero(measured), stamp_ns)
+        for i in np.flatnonzero(fresh).tolist():
+            self.pose_pubs[i].publish(poses[i])
+            self.neighbour_pubs[i].publish(arrays[i])
+        self.published_cycles += 1
+
+    def _encode(self, known: np.ndarray, stamp_ns: int) -> Tuple[List[bytes], List[bytes]]:
+        """
+        Return every robot's pose and neighbour list at ``stamp_ns`` (``StateEncoder``).
+
+        known: indices of the robots ever measured, the only ones a sensor can see; the others'
+        messages are encoded too, but never published.
+        """
+        q = self.positions[:, :self.dim]
+        observer, seen = sensed_pairs(q[known], self.reach[known], cKDTree(q[known]))
+        if self.unicycles:
+            return self.encoder.encode(q, known[observer], known[seen], stamp_ns,
+                                       headings=headings_from_quaternions(self.orientations))
+        norms = np.linalg.norm(self.orientations, axis=1)
+        return self.encoder.encode(q, known[observer], known[seen], stamp_ns,
+                                   orientations=self.orientations / norms[:, None])
+
+    def _log_staleness(self, measured: np.ndarray, fresh: np.ndarray) -> None:
+        """Say once when a measured robot goes stale and once when it is measured again."""
+        for i in np.flatnonzero(fresh != ~self.stale).tolist():
+            if fresh[i]:
+                self.once.end(f'stale-{i}', f'robot {i + 1}: measured again on '
+                                            f'{self.sources[i]}: publishing its pose')
+            elif measured[i]:
+                where = np.round(self.positions[i, :self.dim], 3).tolist()
+                self.once.start(f'stale-{i}', f'robot {i + 1}: no measurement on '
+                                              f'{self.sources[i]} for {self.settings.max_age:g}'
+                                              ' s: no pose for it (its watchdog stops it); '
+                                              'the others keep it in their neighbour lists at '
+                                              f'its last position {where}')
+
+    def _check_source_types(self) -> None:
+        """Log once each source topic that has publishers of another type than the relay's."""
+        for topic in self.sources:
+            foreign = sorted({info.topic_type for info in self.get_publishers_info_by_topic(topic)
+                              if info.topic_type != self.source_type_name})
+            if foreign:
+                self.foreign_types[topic] = foreign
+                for name in foreign:
+                    self.once.start(f'type-{topic}-{name}',
+                                    f'topic {topic} has type {name}, relay.source_type expects '
+                                    f'{self.source_type_name} (DDS does not connect them: no '
+                                    'measurement from that publisher)', 'error')
+            else:
+                self.foreign_types.pop(topic, None)
+
+    def on_diagnostics(self) -> None:
+        """Publish the relay's status: stale robots, refused measurements, cycle rate."""
+        self._check_source_types()
+        now = time.monotonic()
+        since, cycles = self.rate_window
+        rate = (self.cycles - cycles) / (now - since) if now > since else 0.0
+        self.rate_window = (now, self.cycles)
+        measured = self.received_ns != NEVER
+        stale = [i + 1 for i in np.flatnonzero(self.stale & measured).tolist()]
+        never = [i + 1 for i in np.flatnonzero(~measured).tolist()]
+        ages = (time.monotonic_ns() - self.received_ns[measured & ~self.stale]) / NS_PER_S
+        values = {'cycle rate achieved [Hz]': rate,
+                  'cycle rate target [Hz]': self.settings.rate,
+                  'cycles published': self.published_cycles,
+                  'max age [s]': self.settings.max_age,
+                  'stale robots': ', '.join(map(str, stale)) or 'none',
+                  'robots not measured yet': ', '.join(map(str, never)) or 'none',
+                  'oldest fresh measurement [s]': float(np.max(ages)) if len(ages) else 'none',
+                  'measurements': int(np.sum(self.measurements))}
+        for (robot, reason), count in sorted(self.refused.items(),
+                                             key=lambda item: (item[0][0], item[0][1].name)):
+            values[f'robot {robot}: refused measurements ({reason.value})'] = count
+        for topic, names in self.foreign_types.items():
+            values[f'{topic}: publishers of another type'] = ', '.join(names)
+        counts = [sub.get_publisher_count() for sub in self.source_subs]
+        values['robots whose source has no publisher'] = ', '.join(
+            str(i + 1) for i, count in enumerate(counts) if count == 0) or 'none'
+        shared = [i + 1 for i, count in enumerate(counts) if count > 1]
+        if shared:
+            values['robots whose source has several publishers'] = ', '.join(map(str, shared))
+        for robot in shared:
+            self.once.start(f'shared-{robot}', f'robot {robot}: {self.sources[robot - 1]} has '
+                                               'more than one publisher (two mocap nodes?); '
+                                               'the latest measurement of any of them is used')
+        if self.foreign_types:
+            level, message = 'error', (f'{len(self.foreign_types)} source topics with '
+                                       f'publishers of another type than {self.source_type_name}')
+        elif stale or never:
+            level, message = 'warn', ', '.join(
+                ([f"stale: robots {', '.join(map(str, stale))}"] if stale else [])
+                + ([f"not measured yet: robots {', '.join(map(str, never))}"] if never else []))
+        else:
+            level, message = 'ok', f'relaying {self.n} robots'
+        self.diagnostics_pub.publish(diagnostics('formation_ros/relay', level, message, values))
+
+
+def main(args: Optional[List[str]] = None) -> int:
+    """Entry point of ``ros2 run formation_ros relay``."""
+    return run(RelayNode, args, name='relay')
