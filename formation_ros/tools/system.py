@@ -14,14 +14,17 @@ and remappings. ``formation_ros.tools.launcher`` turns them into command lines
 ``launch_ros`` nodes (:func:`launch_nodes`), so that the two ways to start a run cannot drift
 apart. The discovery settings of the nodes (:func:`network_variables`) are also shared.
 
-Only the standard library is imported at the top (the launcher's ``--help`` needs no more);
-the parameter code and ``launch_ros`` are imported where they are used.
+Only the standard library and ``formation_ros.ros.topics`` (the topic names, no ROS) are
+imported at the top (the launcher's ``--help`` needs no more); the parameter code and
+``launch_ros`` are imported where they are used.
 """
 
 import dataclasses
 import os
 import re
 from typing import Any, List, Mapping, Optional, Sequence, Tuple
+
+from formation_ros.ros.topics import CMD_VEL, robot_namespace, robot_topic
 
 PACKAGE = 'formation_ros'
 DISCOVERY = ('localhost', 'subnet')
@@ -89,11 +92,6 @@ class Formation:
     cmd_topics: Tuple[str, ...] = ()
 
 
-def robot_namespace(robot_id: int) -> str:
-    """Return robot ``robot_id``'s namespace, as every node and the fleet name it."""
-    return f'/robot_{robot_id}'
-
-
 def plan(run: Run) -> List[NodePlan]:
     """
     Return the nodes of ``run`` in the order they start.
@@ -123,7 +121,7 @@ def plan(run: Run) -> List[NodePlan]:
     per_process = run.robots_per_process
     if per_process == 1:
         for i in range(1, run.num_robots + 1):
-            remaps = ((('cmd_vel', run.cmd_topics[i - 1]),) if run.cmd_topics else ())
+            remaps = (((CMD_VEL, run.cmd_topics[i - 1]),) if run.cmd_topics else ())
             nodes.append(NodePlan(f'robot_{i}', 'robot', namespace=robot_namespace(i),
                                   parameters=(('robot_id', i),) + robot, remappings=remaps))
         return nodes
@@ -143,7 +141,7 @@ def recorder_plan(record: str, cmd_topics: Sequence[str] = ()) -> NodePlan:
     It subscribes to ``/robot_<i>/cmd_vel`` (and stores it under that name, which
     ``formation_report`` reads); with command topics that is remapped onto each of them.
     """
-    remaps = tuple((f'{robot_namespace(i)}/cmd_vel', topic)
+    remaps = tuple((robot_topic(i, CMD_VEL), topic)
                    for i, topic in enumerate(cmd_topics, start=1))
     return NodePlan('record', 'record', parameters=(('record.path', record),),
                     remappings=remaps)
