@@ -11,12 +11,14 @@ file's ``world_frame``, about 50 Hz) on the relay's source topics. No ``/clock``
 relay, the reference node and the robots run on wall-clock time.
 """
 
+import json
 import time
 
 from formation_ros.core.frames import desired_positions
 from formation_ros.core.params import load_config
 from formation_ros.core.params_file import load_params_file
 from formation_ros.ros import fields, messages, qos
+from formation_ros.tools.bag import read_messages
 from geometry_msgs.msg import PoseStamped, TwistStamped
 from helpers import launch, project_processes, START_UP, stop_when, write_params
 import numpy as np
@@ -98,4 +100,25 @@ def test_a_lab_forms_with_the_relay_and_remapped_commands(processes, install, pr
     assert '[relay]' in log and '[plant]' not in log and 'Traceback' not in log
     assert unremapped and set(unremapped) == {0}, 'a robot publishes on /robot_<i>/cmd_vel'
     assert 0.0 < lab.largest <= lab.bound
+    assert project_processes(install) == []
+
+
+def test_a_recorded_lab_keeps_the_remapped_commands_and_reports_from_its_bag(
+        processes, install, probe, tmp_path):
+    params = write_params(tmp_path, 'square_4.yaml', {
+        'relay.source_names': NAMES, 'relay.source_topic': '/mocap/{name}/pose'})
+    lab = Lab(probe, params)
+    bag = tmp_path / 'bag'
+    launch(processes, install, params, record=bag,
+           options=('--no-plant', '--cmd-topic', '/base_{i}/cmd_vel'))
+    info = stop_when(probe, processes, lambda: min(lab.heard) > 20, timeout=START_UP + 60)
+    assert info.returncode == 0, processes.log('launcher')
+    recorded, _ = read_messages(str(bag))
+    for i in range(1, 5):
+        assert len(recorded.get(f'/robot_{i}/cmd_vel', [])) > 0, sorted(recorded)
+        assert len(recorded.get(f'/robot_{i}/pose', [])) > 0, sorted(recorded)
+    assert '/clock' not in recorded
+    metrics = json.loads((bag / 'metrics.json').read_text())
+    assert metrics['num_samples'] > 2
+    assert 0.0 < metrics['max_abs_u_component'] <= lab.bound
     assert project_processes(install) == []
