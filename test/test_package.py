@@ -128,7 +128,8 @@ def test_changelog_is_read_by_catkin_and_its_last_release_is_the_package_version
 
 def test_setup_py_installs_the_launch_files(setup_data):
     installed = dict(setup_data['data_files']).get(f'share/{PACKAGE}/launch', [])
-    assert 'launch/formation.launch.py' in installed, setup_data['data_files']
+    assert {'launch/formation.launch.py', 'launch/lab.launch.py'} <= set(installed), \
+        setup_data['data_files']
 
 
 class Recorded:
@@ -156,10 +157,9 @@ class LaunchConfiguration:
         return context[self.variable_name]
 
 
-@pytest.fixture
-def launch_file(monkeypatch):
+def load_launch_file(monkeypatch, file_name):
     """
-    Load launch/formation.launch.py with launch and launch_ros replaced by recorders.
+    Load launch/FILE_NAME with launch and launch_ros replaced by recorders.
 
     The ROS launch packages are not on PyPI; these stand-ins take the same arguments and keep
     them, so the test sees the nodes the file asks for. The package's share directory is the
@@ -180,15 +180,31 @@ def launch_file(monkeypatch):
         module = types.ModuleType(name)
         module.__dict__.update(attributes)
         monkeypatch.setitem(sys.modules, name, module)
-    path = os.path.join(ROOT, 'launch', 'formation.launch.py')
-    spec = importlib.util.spec_from_file_location('formation_launch', path)
+    path = os.path.join(ROOT, 'launch', file_name)
+    spec = importlib.util.spec_from_file_location(file_name.split('.')[0] + '_launch', path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
 
 
+@pytest.fixture
+def launch_file(monkeypatch):
+    """Give the test launch/formation.launch.py on stand-ins (:func:`load_launch_file`)."""
+    return load_launch_file(monkeypatch, 'formation.launch.py')
+
+
+@pytest.fixture
+def lab_launch_file(monkeypatch):
+    """Give the test launch/lab.launch.py on stand-ins (:func:`load_launch_file`)."""
+    return load_launch_file(monkeypatch, 'lab.launch.py')
+
+
 def launched_nodes(launch_file, **arguments):
-    """Return the Node stand-ins the launch file starts for the given launch arguments."""
+    """
+    Return the Node stand-ins the launch file starts for the given launch arguments.
+
+    Arguments not given take their declared defaults; one without a default must be given.
+    """
     description = launch_file.generate_launch_description()
     (actions,) = description.args
     declared = {action.args[0]: action.kwargs['default_value'] for action in actions

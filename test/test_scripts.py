@@ -82,6 +82,7 @@ signal.signal(signal.SIGINT, lambda *_: (print('closing', me, flush=True), sys.e
 up = os.environ['FAKE_UP_DIR']
 open(os.path.join(up, me), 'w').close()
 print('up', os.environ.get('FORMATION_LAUNCHER_PID'), flush=True)
+print('args', *sys.argv[1:], flush=True)
 print('network', *(os.environ.get(name, '-') for name in (
     'ROS_DOMAIN_ID', 'ROS_AUTOMATIC_DISCOVERY_RANGE', 'ROS_LOCALHOST_ONLY')), flush=True)
 if me == os.environ.get('FAKE_DIES'):

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import math
 import re
 import string
-from typing import Any, Dict, List, Mapping, Optional, Tuple, Union
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 from formation_ros.core.bodies import BodySettings, POINT_BODY, random_headings
 from formation_ros.core.declarations import (BodyKind, BY_NAME, check_values, CommandFrame,
@@ -123,8 +123,7 @@ class RelaySettings:
 
     def source(self, robot_id: int) -> str:
         """Return robot ``robot_id``'s (1-based) measured-pose topic."""
-        name = self.source_names[robot_id - 1] if self.source_names else ''
-        return self.source_topic.format(i=robot_id, name=name)
+        return fill_template(self.source_topic, robot_id, self.source_names)
 
 
 @dataclass(frozen=True)
@@ -601,35 +600,53 @@ def _imperfections(values: Mapping[str, Any], exe: Exe, problems: Problems) -> I
     return imperfections
 
 
-def _relay(values: Mapping[str, Any], n: int, problems: Problems) -> RelaySettings:
-    """``relay.*``: the topic template may name {i} and {name} (with one name per robot)."""
-    template = values['relay.source_topic']
-    names = tuple(values.get('relay.source_names') or ())
+def fill_template(template: str, robot_id: int, names: Sequence[str] = ()) -> str:
+    """Return robot ``robot_id``'s (1-based) topic: ``{i}`` its id, ``{name}`` its entry."""
+    name = names[robot_id - 1] if names else ''
+    return template.format(i=robot_id, name=name)
+
+
+def template_problems(template: str, names: Sequence[str], n: int,
+                      template_key: str = 'relay.source_topic',
+                      names_key: str = 'relay.source_names') -> Problems:
+    """
+    Return what is wrong with a per-robot topic template and its names (empty: nothing).
+
+    The template may use ``{i}`` (the robot id) and ``{name}`` (its entry of ``names``, which
+    then holds n distinct, non-empty names) and must tell the n robots' topics apart. Problems
+    are (key, message) with the keys given (the relay's parameters, or a launcher option).
+    """
+    problems: Problems = []
     try:
         fields = [name for _, name, spec, conv in string.Formatter().parse(template)
                   if name is not None]
     except ValueError as exc:
-        problems.append(('relay.source_topic', f'is not a topic template ({exc}): {template!r}'))
+        problems.append((template_key, f'is not a topic template ({exc}): {template!r}'))
         fields = []
     unknown = sorted(set(fields) - set(SOURCE_FIELDS))
     if unknown:
-        problems.append(('relay.source_topic', 'may use only {i} and {name}, got '
-                                               f"{', '.join('{' + f + '}' for f in unknown)} in "
-                                               f'{template!r}'))
+        problems.append((template_key, 'may use only {i} and {name}, got '
+                                       f"{', '.join('{' + f + '}' for f in unknown)} in "
+                                       f'{template!r}'))
     if names and len(names) != n:
-        problems.append(('relay.source_names', f'must hold num_robots = {n} names, '
-                                               f'got {len(names)}'))
+        problems.append((names_key, f'must hold num_robots = {n} names, got {len(names)}'))
     elif 'name' in fields and not names:
-        problems.append(('relay.source_names', f'is required: relay.source_topic {template!r} '
-                                               'uses {name}'))
+        problems.append((names_key, f'is required: {template_key} {template!r} uses {{name}}'))
     elif names and len(set(names)) != len(names):
-        problems.append(('relay.source_names', 'names must differ (two robots would read one '
-                                               'topic)'))
+        problems.append((names_key, 'names must differ (two robots would read one topic)'))
     elif names and not all(names):
-        problems.append(('relay.source_names', 'names must not be empty'))
+        problems.append((names_key, 'names must not be empty'))
     elif not unknown and fields.count('i') + fields.count('name') == 0 and n > 1:
-        problems.append(('relay.source_topic', f'{template!r} names no robot: use {{i}} or '
-                                               '{name}, or every robot would read one topic'))
+        problems.append((template_key, f'{template!r} names no robot: use {{i}} or {{name}}, '
+                                       'or every robot would have one and the same topic'))
+    return problems
+
+
+def _relay(values: Mapping[str, Any], n: int, problems: Problems) -> RelaySettings:
+    """``relay.*``: the topic template may name {i} and {name} (with one name per robot)."""
+    template = values['relay.source_topic']
+    names = tuple(values.get('relay.source_names') or ())
+    problems.extend(template_problems(template, names, n))
     return RelaySettings(source_topic=template, source_names=names,
                          source_type=SourceType(values['relay.source_type']),
                          rate=values['relay.rate'], max_age=values['relay.max_age'])
@@ -714,6 +731,6 @@ def validate_for_every_executable(raw: Mapping[str, Any]) -> Dict[Exe, Formation
     return checked
 
 
-__all__ = ['CommandSettings', 'FormationConfig', 'load_config', 'ParamError', 'PlantSettings',
-           'RecorderSettings', 'ReferenceSettings', 'RelaySettings', 'RobotSettings', 'validate',
-           'validate_for_every_executable']
+__all__ = ['CommandSettings', 'fill_template', 'FormationConfig', 'load_config', 'ParamError',
+           'PlantSettings', 'RecorderSettings', 'ReferenceSettings', 'RelaySettings',
+           'RobotSettings', 'template_problems', 'validate', 'validate_for_every_executable']

@@ -2,18 +2,18 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-The formation launcher: plant, reference node, N robots and optionally the recorder.
+The formation launcher: plant (or, in a lab, relay), reference node, N robots, the recorder.
 
 ``scripts/launch_formation.sh`` runs this module (``python -m formation_ros.tools.launcher``)
 with an interpreter that can import the installed package; the options and messages are those
 of :data:`USAGE`. Every node runs under :class:`formation_ros.tools.supervise.Supervisor`, its
 output prefixed with its name. The run ends when the duration is over, on SIGINT, SIGTERM or
-SIGHUP (the terminal closed), when the plant, the reference node or the recorder ends on its
-own, or when a robot does with ``--on-exit stop`` (a robot that ends on its own is otherwise
-left out or restarted); the nodes are then stopped in order (robots, reference and plant
-together, the recorder last) and, with ``--out`` or ``--record``, ``formation_report`` writes
-the metrics and figures. Exit codes: 0 done, 1 a node died or the report failed, 2 bad usage
-or parameters.
+SIGHUP (the terminal closed), when the plant (the relay), the reference node or the recorder
+ends on its own, or when a robot does with ``--on-exit stop`` (a robot that ends on its own is
+otherwise left out or restarted); the nodes are then stopped in order (robots, reference and
+plant or relay together, the recorder last) and, with ``--out`` or ``--record``,
+``formation_report`` writes the metrics and figures. Exit codes: 0 done, 1 a node died or the
+report failed, 2 bad usage or parameters.
 
 The nodes watch the launcher through :data:`LAUNCHER_PID_ENV` and :data:`LAUNCHER_START_ENV`
 (``formation_ros.ros.runner``), so they end on their own when it is killed with SIGKILL.
@@ -31,6 +31,10 @@ import time
 from typing import Callable, Mapping, Optional, Sequence, TextIO
 
 from formation_ros.tools.supervise import describe_returncode, ProcessSpec, Supervisor
+from formation_ros.tools.system import (DISCOVERY, DISCOVERY_ENV, discovery_problem,
+                                        DOMAIN_ENV, domain_problem, FLEET_REMAP, Formation,
+                                        network_variables, NodePlan, plan, PlanError,
+                                        read_formation, recorder_plan, ros_arguments, Run)
 
 PROG = 'launch_formation.sh'
 PACKAGE = 'formation_ros'
@@ -39,45 +43,48 @@ RECORDER_START_TIMEOUT = 15.0
 POLL = 0.2
 ON_EXIT = ('continue', 'stop', 'respawn')
 MAX_RESTARTS = 5
-ESSENTIAL = ('plant', 'reference', 'record')
+ESSENTIAL = ('plant', 'relay', 'reference', 'record')
 LAUNCHER_PID_ENV = 'FORMATION_LAUNCHER_PID'
 LAUNCHER_START_ENV = 'FORMATION_LAUNCHER_START'
-DISCOVERY = ('localhost', 'subnet')
-DISCOVERY_ENV = 'ROS_AUTOMATIC_DISCOVERY_RANGE'
-DOMAIN_ENV = 'ROS_DOMAIN_ID'
-MAX_DOMAIN_ID = 232
 
 USAGE = """\
 Usage: scripts/launch_formation.sh PARAMS.yaml [--duration S] [--out DIR] [--record DIR]
                                    [--on-exit continue|stop|respawn]
                                    [--robots-per-process K] [--prefix DIR]
                                    [--discovery localhost|subnet] [--domain-id N]
+                                   [--no-plant [--cmd-topic TEMPLATE] [--source-topic TEMPLATE]]
 
 Starts the plant, the reference node and N robot nodes (N = num_robots in PARAMS.yaml), robot i
 in namespace /robot_<i>, all with the same parameters file, the reference node on the plant's
-simulated time (/clock). Output lines are prefixed with the node's name. Stops every
-process it started when the duration ends, on Ctrl-C, SIGTERM or SIGHUP (then still writes
-the report of --out / --record), and when the plant, the reference node or the recorder exits
-on its own; what happens when a robot exits on its own is set by --on-exit. If the launcher
-itself is killed (even with kill -9), every node notices within 0.1 s and stops as on Ctrl-C.
+simulated time (/clock). With --no-plant (a lab), the relay instead of the plant, and the
+reference node and the robots on wall-clock time. Output lines are prefixed with the node's
+name. Stops every process it started when the duration ends, on Ctrl-C, SIGTERM or SIGHUP
+(then still writes the report of --out / --record), and when the plant (the relay), the
+reference node or the recorder exits on its own; what happens when a robot exits on its own is
+set by --on-exit. If the launcher itself is killed (even with kill -9), every node notices
+within 0.1 s and stops as on Ctrl-C.
 
 Options:
   --duration S   wall-clock seconds to run; 0 runs until Ctrl-C
-                 (default: 'duration' in PARAMS.yaml divided by plant.realtime_factor)
+                 (default: 'duration' in PARAMS.yaml divided by plant.realtime_factor;
+                 with --no-plant, 'duration' itself)
   --out DIR      run directory: the plant writes trajectory.npz and plant_stats.json there,
                  PARAMS.yaml is copied there, and formation_report writes metrics.json and the
-                 figures there at the end (the directory must not exist yet, or be empty)
+                 figures there at the end (the directory must not exist yet, or be empty).
+                 With --no-plant only together with --record: the report is made from the bag
   --record DIR   record every formation topic into a rosbag2 directory DIR (metadata.yaml +
                  MCAP; DIR must not exist yet), started before the other nodes and stopped
                  after them; at the end formation_report reads the bag and writes
-                 metrics.json and the figures (into --out if given, else into DIR)
+                 metrics.json and the figures (into --out if given, else into DIR). With
+                 --cmd-topic the recorder hears the remapped command topics and stores them
+                 as /robot_<i>/cmd_vel
   --on-exit MODE what to do when a robot exits on its own (default: continue):
                  continue: the others go on, the dead robot's body stays where it is;
                  stop:     stop every node;
                  respawn:  start the robot again (at most 5 times per robot, then as
                            continue); it rejoins the formation
-                 A plant, reference or recorder exit always stops the run. In every mode the
-                 exit code is 1 if any node exited on its own, with a line naming it.
+                 A plant, relay, reference or recorder exit always stops the run. In every
+                 mode the exit code is 1 if any node exited on its own, with a line naming it.
   --robots-per-process K
                  run the robots K to a process (executable 'fleet', processes fleet_1,
                  fleet_2, ...; each robot still its own node in /robot_<i>): ceil(N/K)
@@ -94,6 +101,22 @@ Options:
   --domain-id N  ROS 2 domain of the nodes, 0 to 232 (sets ROS_DOMAIN_ID; 0 to 101 is the
                  range that is safe on every Linux machine). Default: ROS_DOMAIN_ID as set
                  in the environment, else 0
+  --no-plant     a lab: no plant and no /clock. The relay (executable 'relay') reads every
+                 robot's measured pose (relay.source_topic, relay.source_names and
+                 relay.source_type in PARAMS.yaml) and publishes /robot_<i>/pose and
+                 /robot_<i>/neighbors; the reference node and the robots run on wall-clock
+                 time (use_sim_time false). A robot sends its first command once its base
+                 driver subscribes to its command topic (wait_for_subscribers 1; 2 with
+                 --record). The relay's exit stops the run, as the plant's does
+  --cmd-topic TEMPLATE
+                 (with --no-plant) remap each robot's cmd_vel onto its base's topic:
+                 {i} is the robot id, {name} its entry of relay.source_names, e.g.
+                 /tb{i}/cmd_vel or /{name}/cmd_vel; an absolute topic name per robot, one
+                 topic per robot. Not with --robots-per-process above 1 (a fleet's
+                 remappings apply to all its robots). Default: /robot_<i>/cmd_vel
+  --source-topic TEMPLATE
+                 (with --no-plant) the relay's relay.source_topic instead of PARAMS.yaml's,
+                 e.g. /vrpn_mocap/{name}/pose: {i} and {name} as for --cmd-topic
   -h, --help     show this help
 
 Executables: 'ros2 run formation_ros <exe>' where the ros2 command knows the package, else
@@ -104,24 +127,26 @@ parameters.
 """
 
 
-def read_parameters(path: str) -> tuple[int, float]:
+def read_parameters(options: 'Options') -> Formation:
     """
-    Validate PARAMS for every program the launcher starts; return (num_robots, wall seconds).
+    Validate PARAMS for every program the launcher starts; return what the run needs of it.
 
-    The wall seconds are the default duration of a run: ``duration`` divided by
-    ``plant.realtime_factor``. This is the launcher's only use of the parameter code. Raises
-    UsageError listing every problem.
+    The number of robots, the default duration of a run (``duration`` divided by
+    ``plant.realtime_factor``; in a lab, ``duration``) and the command topics of
+    ``--cmd-topic``. This is the launcher's only use of the parameter code. Raises UsageError
+    listing every problem, or naming the option at fault.
     """
     # Imported here so that --help and usage errors need nothing but the standard library.
-    from formation_ros.core.declarations import Exe, ParamError
-    from formation_ros.core.params import validate_for_every_executable
-    from formation_ros.core.params_file import load_params_file
+    from formation_ros.core.declarations import ParamError
     try:
-        plant = validate_for_every_executable(load_params_file(path))[Exe.PLANT]
+        return read_formation(options.params, plant=not options.no_plant,
+                              cmd_topic=options.cmd_topic, source_topic=options.source_topic,
+                              robots_per_process=options.robots_per_process,
+                              cmd_option='--cmd-topic', source_option='--source-topic')
     except ParamError as exc:
-        raise UsageError(f'invalid parameters in {path}:\n{exc}') from None
-    assert plant.plant is not None
-    return plant.num_robots, plant.duration / plant.plant.realtime_factor
+        raise UsageError(f'invalid parameters in {options.params}:\n{exc}') from None
+    except PlanError as exc:
+        raise UsageError(str(exc)) from None
 
 
 class UsageError(Exception):
@@ -141,6 +166,11 @@ class Options:
     robots_per_process: int = 1
     discovery: Optional[str] = None
     domain_id: Optional[int] = None
+    no_plant: bool = False
+    cmd_topic: Optional[str] = None
+    source_topic: Optional[str] = None
+    cmd_topics: tuple[str, ...] = ()
+    """Robot i's command topic at index i - 1, from ``cmd_topic`` (:func:`read_parameters`)."""
 
 
 def parse_args(argv: Sequence[str]) -> Optional[Options]:
@@ -148,16 +178,20 @@ def parse_args(argv: Sequence[str]) -> Optional[Options]:
     needs = {'duration': 'seconds', 'out': 'a directory', 'record': 'a directory',
              'prefix': 'a directory', 'on-exit': '|'.join(ON_EXIT),
              'robots-per-process': 'a number of robots', 'discovery': '|'.join(DISCOVERY),
-             'domain-id': 'a number'}
+             'domain-id': 'a number', 'cmd-topic': 'a topic template',
+             'source-topic': 'a topic template'}
     values: dict[str, Optional[str]] = dict.fromkeys(needs)
     params = None
+    no_plant = False
     args = list(argv)
     while args:
         arg = args.pop(0)
         name = arg[2:]
         if arg in ('-h', '--help'):
             return None
-        if arg.startswith('--') and name in values:
+        if arg == '--no-plant':
+            no_plant = True
+        elif arg.startswith('--') and name in values:
             value = args.pop(0) if args else ''
             if not value:
                 raise UsageError(f'--{name} needs {needs[name]}')
@@ -181,17 +215,34 @@ def parse_args(argv: Sequence[str]) -> Optional[Options]:
         raise UsageError('--robots-per-process must be a whole number >= 1, '
                          f"got '{per_process}'")
     discovery = values['discovery']
-    if discovery is not None and discovery not in DISCOVERY:
-        raise UsageError(f"--discovery must be one of {', '.join(DISCOVERY)}, got '{discovery}'")
+    if discovery is not None and discovery_problem(discovery):
+        raise UsageError(f'--discovery {discovery_problem(discovery)}')
     domain_id = values['domain-id']
-    if domain_id is not None and not (re.fullmatch(r'[0-9]{1,3}', domain_id)
-                                      and int(domain_id) <= MAX_DOMAIN_ID):
-        raise UsageError(f'--domain-id must be a whole number from 0 to {MAX_DOMAIN_ID}, '
-                         f"got '{domain_id}'")
+    if domain_id is not None and domain_problem(domain_id):
+        raise UsageError(f'--domain-id {domain_problem(domain_id)}')
+    _check_lab_options(no_plant, values)
     prefix = values['prefix'] or os.environ.get('FORMATION_PREFIX') or None
     return Options(params, None if duration is None else float(duration), values['out'],
                    values['record'], prefix, on_exit, int(per_process), discovery,
-                   None if domain_id is None else int(domain_id))
+                   None if domain_id is None else int(domain_id), no_plant,
+                   values['cmd-topic'], values['source-topic'])
+
+
+def _check_lab_options(no_plant: bool, values: Mapping[str, Optional[str]]) -> None:
+    """Refuse the options that a run with (or without) the plant cannot honour."""
+    if not no_plant:
+        if values['cmd-topic'] is not None:
+            raise UsageError("--cmd-topic needs --no-plant: the plant reads every robot's "
+                             'command on /robot_<i>/cmd_vel')
+        if values['source-topic'] is not None:
+            raise UsageError('--source-topic needs --no-plant: it is where the relay reads '
+                             'the measured poses')
+        return
+    if values['out'] is not None and values['record'] is None:
+        raise UsageError('--out with --no-plant needs --record: without a plant nothing '
+                         'writes trajectory.npz, the report is made from the bag')
+    if values['cmd-topic'] is not None and values['robots-per-process'] not in (None, '1'):
+        raise UsageError(f'--cmd-topic {FLEET_REMAP}')
 
 
 def discovery_environment(options: Options, base: Mapping[str, str]) -> dict[str, str]:
@@ -205,12 +256,8 @@ def discovery_environment(options: Options, base: Mapping[str, str]) -> dict[str
     """
     env = dict(base)
     if options.discovery is not None:
-        env[DISCOVERY_ENV] = options.discovery.upper()
         env.pop('ROS_LOCALHOST_ONLY', None)
-    elif not env.get(DISCOVERY_ENV):
-        env[DISCOVERY_ENV] = 'LOCALHOST'
-    if options.domain_id is not None:
-        env[DOMAIN_ENV] = str(options.domain_id)
+    env.update(network_variables(options.discovery, options.domain_id, base))
     return env
 
 
@@ -285,40 +332,31 @@ def find_install(prefix: Optional[str], env: Mapping[str, str]) -> Install:
     return Install(os.path.abspath(prefix))
 
 
+def run_of(options: Options, num_robots: int) -> Run:
+    """Return what ``options`` start for ``num_robots`` robots (``formation_ros.tools.system``)."""
+    return Run(num_robots, plant=not options.no_plant, record=options.record,
+               output_dir=options.out if not options.no_plant else None,
+               robots_per_process=options.robots_per_process, cmd_topics=options.cmd_topics,
+               source_topic=options.source_topic)
+
+
 def node_specs(install: Install, options: Options, num_robots: int,
                env: Mapping[str, str]) -> list[ProcessSpec]:
-    """Return the specs of plant, reference and robots, in the order they start."""
-    params = ['--ros-args', '--params-file', options.params]
-    plant = params.copy()
-    if options.out is not None:
-        plant += ['-p', f'plant.output_dir:={options.out}']
-    if options.record is not None:
-        plant += ['-p', 'plant.wait_for_subscribers:=2']
-    waits = 2 if options.record is not None else 1
-    specs = [ProcessSpec('plant', install.command('plant') + plant, env),
-             ProcessSpec('reference', install.command('reference') + params +
-                         ['-p', 'use_sim_time:=true'], env)]
-    robot_params = ['--params-file', options.params, '-p', f'wait_for_subscribers:={waits}',
-                    '-p', 'use_sim_time:=true']
-    per_process = options.robots_per_process
-    if per_process == 1:
-        for i in range(1, num_robots + 1):
-            specs.append(ProcessSpec(f'robot_{i}', install.command('robot') + [
-                '--ros-args', '-r', f'__ns:=/robot_{i}', '-p', f'robot_id:={i}'] + robot_params,
-                env))
-        return specs
-    for k, first in enumerate(range(1, num_robots + 1, per_process)):
-        last = min(first + per_process - 1, num_robots)
-        specs.append(ProcessSpec(f'fleet_{k + 1}', install.command('fleet') + [
-            '--robots', f'{first}-{last}', '--ros-args'] + robot_params, env))
-    return specs
+    """Return the specs of plant (or relay), reference and robots, in the order they start."""
+    return [_spec(install, node, options, env) for node in plan(run_of(options, num_robots))
+            if node.name != 'record']
 
 
 def recorder_spec(install: Install, options: Options, env: Mapping[str, str]) -> ProcessSpec:
     """Return the spec of the recorder writing into ``options.record``."""
-    return ProcessSpec('record', install.command('record') + [
-        '--ros-args', '--params-file', options.params, '-p', f'record.path:={options.record}'],
-        env)
+    assert options.record is not None
+    return _spec(install, recorder_plan(options.record, options.cmd_topics), options, env)
+
+
+def _spec(install: Install, node: NodePlan, options: Options,
+          env: Mapping[str, str]) -> ProcessSpec:
+    return ProcessSpec(node.name, install.command(node.executable) +
+                       ros_arguments(node, options.params), env)
 
 
 def watch_environment(pid: int) -> dict[str, str]:
@@ -528,15 +566,19 @@ def main(argv: Optional[Sequence[str]] = None, make: Optional[Callable[..., 'Lau
             return 0
         options = check_paths(options)
         install = find_install(options.prefix, os.environ)
-        num_robots, wall_seconds = read_parameters(options.params)
+        if options.no_plant and install.prefix is not None and not _has(install.prefix, 'relay'):
+            raise UsageError(f'--no-plant needs the relay: no '
+                             f'{os.path.join(install.prefix, "lib", PACKAGE, "relay")}')
+        formation = read_parameters(options)
     except UsageError as exc:
         if exc.args[0] is None:
             print(usage, end='', file=sys.stderr)
         else:
             say(exc.args[0])
         return 2
-    if options.duration is not None:
-        wall_seconds = options.duration
+    options = dataclasses.replace(options, cmd_topics=formation.cmd_topics)
+    num_robots = formation.num_robots
+    wall_seconds = formation.wall_seconds if options.duration is None else options.duration
     if options.out is not None:
         os.makedirs(options.out, exist_ok=True)
         shutil.copyfile(options.params, os.path.join(options.out, 'params.yaml'))
@@ -549,8 +591,9 @@ def main(argv: Optional[Sequence[str]] = None, make: Optional[Callable[..., 'Lau
     processes = ('' if per_process == 1 else
                  f' in {-(-num_robots // per_process)} fleet processes of up to {per_process}')
     network = discovery_environment(options, os.environ)
-    say(f'{num_robots} robots{processes} from {options.params} ({install.describe()}), {span}; '
-        f"ROS_DOMAIN_ID {network.get(DOMAIN_ENV) or '0'}, discovery "
+    lab = ', no plant (relay, wall-clock time)' if options.no_plant else ''
+    say(f'{num_robots} robots{processes}{lab} from {options.params} ({install.describe()}), '
+        f"{span}; ROS_DOMAIN_ID {network.get(DOMAIN_ENV) or '0'}, discovery "
         f'{network[DISCOVERY_ENV].lower()}', sys.stdout)
     return (make or Launch)(options, install, num_robots, wall_seconds).run()
 
@@ -566,7 +609,11 @@ def _ros2_knows_package(env: Mapping[str, str]) -> bool:
 
 
 def _has_plant(prefix: str) -> bool:
-    return os.access(os.path.join(prefix, 'lib', PACKAGE, 'plant'), os.X_OK)
+    return _has(prefix, 'plant')
+
+
+def _has(prefix: str, executable: str) -> bool:
+    return os.access(os.path.join(prefix, 'lib', PACKAGE, executable), os.X_OK)
 
 
 def _join_paths(first: Sequence[str], rest: Optional[str]) -> str:

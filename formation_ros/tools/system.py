@@ -1,0 +1,322 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+What a formation run starts, in one place: the launcher and both launch files plan from here.
+
+A run is the simulated system (``plant``, ``reference`` and the robots on the plant's simulated
+time) or a lab (``relay`` instead of the plant, turning measured poses into each robot's pose
+and neighbours; reference and robots on wall-clock time, as there is no ``/clock``), with the
+recorder in front when recording. :func:`plan` returns its nodes as :class:`NodePlan` s: the
+executable, namespace, own arguments, parameter overrides (on top of the one parameters file)
+and remappings. ``formation_ros.tools.launcher`` turns them into command lines
+(:func:`ros_arguments`), ``launch/formation.launch.py`` and ``launch/lab.launch.py`` into
+``launch_ros`` nodes (:func:`launch_nodes`), so that the two ways to start a run cannot drift
+apart. The discovery settings of the nodes (:func:`network_variables`) are also shared.
+
+Only the standard library and ``formation_ros.ros.topics`` (the topic names, no ROS) are
+imported at the top (the launcher's ``--help`` needs no more); the parameter code and
+``launch_ros`` are imported where they are used.
+"""
+
+import dataclasses
+import os
+import re
+from typing import Any, List, Mapping, Optional, Sequence, Tuple
+
+from formation_ros.ros.topics import CMD_VEL, robot_namespace, robot_topic
+
+PACKAGE = 'formation_ros'
+DISCOVERY = ('localhost', 'subnet')
+DISCOVERY_ENV = 'ROS_AUTOMATIC_DISCOVERY_RANGE'
+DOMAIN_ENV = 'ROS_DOMAIN_ID'
+MAX_DOMAIN_ID = 232
+TOPIC_NAME = re.compile(r'(/[A-Za-z_][A-Za-z0-9_]*)+')
+"""An absolute ROS 2 topic name: tokens of letters, digits and '_', none starting with a digit."""
+FLEET_REMAP = ('cannot be used with more than one robot per process: the ROS arguments of a '
+               "fleet apply to all of its robots (each named 'robot'), so their cmd_vel "
+               'cannot be remapped one by one')
+
+
+class PlanError(ValueError):
+    """A run that cannot be planned as asked: one line that names the option at fault."""
+
+
+@dataclasses.dataclass(frozen=True)
+class NodePlan:
+    """
+    One process of a run.
+
+    name: the process's name for the launcher's output (``robot_3``, ``fleet_2``, ``relay``);
+    namespace: absolute (``/robot_3``) or None; arguments: the executable's own arguments,
+    before ``--ros-args``; parameters: (name, value) overrides on top of the parameters file,
+    in order; remappings: (from, to) topic remappings.
+    """
+
+    name: str
+    executable: str
+    namespace: Optional[str] = None
+    arguments: Tuple[str, ...] = ()
+    parameters: Tuple[Tuple[str, Any], ...] = ()
+    remappings: Tuple[Tuple[str, str], ...] = ()
+
+
+@dataclasses.dataclass(frozen=True)
+class Run:
+    """
+    What to start.
+
+    plant: the simulated system (False: a lab, the relay instead of the plant); record: bag
+    directory of the recorder (None: no recorder); output_dir: where the plant writes its
+    trajectory (None: nowhere); robots_per_process: above 1, ``fleet`` processes;
+    cmd_topics: robot i's command topic at index i - 1 (empty: ``/robot_<i>/cmd_vel``, no
+    remapping); source_topic: ``relay.source_topic`` for the relay (None: the file's).
+    """
+
+    num_robots: int
+    plant: bool = True
+    record: Optional[str] = None
+    output_dir: Optional[str] = None
+    robots_per_process: int = 1
+    cmd_topics: Tuple[str, ...] = ()
+    source_topic: Optional[str] = None
+
+
+@dataclasses.dataclass(frozen=True)
+class Formation:
+    """What a run needs of its parameters file: robots, default length, command topics."""
+
+    num_robots: int
+    wall_seconds: float
+    """Default length of a run, s: ``duration`` / ``plant.realtime_factor`` (a lab: real time)."""
+    cmd_topics: Tuple[str, ...] = ()
+
+
+def plan(run: Run) -> List[NodePlan]:
+    """
+    Return the nodes of ``run`` in the order they start.
+
+    The recorder first (it must hear everything), then the plant or the relay, the reference
+    node and the robots. With the plant the reference and the robots run on its ``/clock``; in
+    a lab they are told ``use_sim_time: false`` (a file that says otherwise would stop them).
+    A robot's first command waits for 1 subscriber of its cmd_vel (the plant, or in a lab the
+    base driver on the remapped topic), 2 when the recorder listens too (remapped onto the
+    same topics). Raises PlanError for remapped commands in fleets.
+    """
+    nodes = [] if run.record is None else [recorder_plan(run.record, run.cmd_topics)]
+    if run.plant:
+        plant: List[Tuple[str, Any]] = []
+        if run.output_dir is not None:
+            plant.append(('plant.output_dir', run.output_dir))
+        if run.record is not None:
+            plant.append(('plant.wait_for_subscribers', 2))
+        nodes.append(NodePlan('plant', 'plant', parameters=tuple(plant)))
+    else:
+        relay = (() if run.source_topic is None
+                 else (('relay.source_topic', run.source_topic),))
+        nodes.append(NodePlan('relay', 'relay', parameters=relay))
+    sim_time = ('use_sim_time', run.plant)
+    nodes.append(NodePlan('reference', 'reference', parameters=(sim_time,)))
+    robot = (('wait_for_subscribers', 2 if run.record is not None else 1), sim_time)
+    per_process = run.robots_per_process
+    if per_process == 1:
+        for i in range(1, run.num_robots + 1):
+            remaps = (((CMD_VEL, run.cmd_topics[i - 1]),) if run.cmd_topics else ())
+            nodes.append(NodePlan(f'robot_{i}', 'robot', namespace=robot_namespace(i),
+                                  parameters=(('robot_id', i),) + robot, remappings=remaps))
+        return nodes
+    if run.cmd_topics:
+        raise PlanError(f'remapped commands {FLEET_REMAP}')
+    for k, first in enumerate(range(1, run.num_robots + 1, per_process), start=1):
+        last = min(first + per_process - 1, run.num_robots)
+        nodes.append(NodePlan(f'fleet_{k}', 'fleet', arguments=('--robots', f'{first}-{last}'),
+                              parameters=robot))
+    return nodes
+
+
+def recorder_plan(record: str, cmd_topics: Sequence[str] = ()) -> NodePlan:
+    """
+    Return the recorder writing into ``record``, hearing robot i's commands on cmd_topics[i-1].
+
+    It subscribes to ``/robot_<i>/cmd_vel`` (and stores it under that name, which
+    ``formation_report`` reads); with command topics that is remapped onto each of them.
+    """
+    remaps = tuple((robot_topic(i, CMD_VEL), topic)
+                   for i, topic in enumerate(cmd_topics, start=1))
+    return NodePlan('record', 'record', parameters=(('record.path', record),),
+                    remappings=remaps)
+
+
+def ros_value(value: Any) -> str:
+    """Return ``value`` as ``-p name:=value`` writes it (``true``/``false`` for booleans)."""
+    if isinstance(value, bool):
+        return 'true' if value else 'false'
+    return str(value)
+
+
+def ros_arguments(node: NodePlan, params_file: str) -> List[str]:
+    """Return the arguments after the executable that start ``node`` with ``params_file``."""
+    args = list(node.arguments) + ['--ros-args']
+    if node.namespace is not None:
+        args += ['-r', f'__ns:={node.namespace}']
+    args += ['--params-file', params_file]
+    for name, value in node.parameters:
+        args += ['-p', f'{name}:={ros_value(value)}']
+    for source, target in node.remappings:
+        args += ['-r', f'{source}:={target}']
+    return args
+
+
+def launch_file_nodes(arguments: Mapping[str, str], plant: bool = True) -> List[Any]:
+    """
+    Return the ``launch_ros`` nodes of a launch file for its launch arguments' values.
+
+    arguments: ``params_file``, ``record``, ``robots_per_process``, ``discovery``,
+    ``domain_id``, and ``output_dir`` (with the plant: ``launch/formation.launch.py``) or
+    ``cmd_topic`` and ``source_topic`` (without: ``launch/lab.launch.py``); '' is not given.
+    The parameters file is checked as the launcher checks it. Raises ValueError (ParamError,
+    PlanError) with what is wrong.
+    """
+    params_file = arguments['params_file']
+    per_process = int(arguments.get('robots_per_process') or 1)
+    if per_process < 1:
+        raise PlanError(f'robots_per_process must be >= 1, got {per_process}')
+    domain_id = arguments.get('domain_id') or None
+    if domain_id is not None and domain_problem(domain_id):
+        raise PlanError(f'domain_id {domain_problem(domain_id)}')
+    env = network_variables(arguments.get('discovery') or None,
+                            None if domain_id is None else int(domain_id), os.environ)
+    formation = read_formation(params_file, plant=plant,
+                               cmd_topic=arguments.get('cmd_topic') or None,
+                               source_topic=arguments.get('source_topic') or None,
+                               robots_per_process=per_process)
+    run = Run(formation.num_robots, plant=plant, record=arguments.get('record') or None,
+              output_dir=arguments.get('output_dir') or None, robots_per_process=per_process,
+              cmd_topics=formation.cmd_topics,
+              source_topic=arguments.get('source_topic') or None)
+    return launch_nodes(plan(run), params_file, env)
+
+
+def launch_nodes(nodes: Sequence[NodePlan], params_file: str,
+                 env: Mapping[str, str]) -> List[Any]:
+    """
+    Return ``launch_ros`` nodes for ``nodes``: what the launch files start.
+
+    Each with the parameters file and its overrides, a relative namespace (so that a
+    ``PushRosNamespace`` around the launch file still applies), its remappings, ``env`` added
+    to its environment, and a Shutdown when it exits: the first node to end ends the launch.
+    """
+    from launch.actions import Shutdown
+    from launch_ros.actions import Node
+    launched = []
+    for node in nodes:
+        parameters: List[Any] = [params_file]
+        if node.parameters:
+            parameters.append(dict(node.parameters))
+        launched.append(Node(
+            package=PACKAGE, executable=node.executable,
+            namespace=None if node.namespace is None else node.namespace.lstrip('/'),
+            arguments=list(node.arguments) or None, parameters=parameters,
+            remappings=list(node.remappings) or None, additional_env=dict(env),
+            output='screen', on_exit=Shutdown(reason=f'{node.executable} exited')))
+    return launched
+
+
+def discovery_problem(discovery: str) -> Optional[str]:
+    """Return what is wrong with a discovery range ('' and None are not checked here)."""
+    if discovery in DISCOVERY:
+        return None
+    return f"must be one of {', '.join(DISCOVERY)}, got {discovery!r}"
+
+
+def domain_problem(domain_id: str) -> Optional[str]:
+    """Return what is wrong with a ROS_DOMAIN_ID given as text, or None."""
+    if re.fullmatch(r'[0-9]{1,3}', domain_id) and int(domain_id) <= MAX_DOMAIN_ID:
+        return None
+    return f'must be a whole number from 0 to {MAX_DOMAIN_ID}, got {domain_id!r}'
+
+
+def network_variables(discovery: Optional[str], domain_id: Optional[int],
+                      base: Mapping[str, str]) -> dict:
+    """
+    Return the variables to set in the nodes' environment for a discovery range and domain.
+
+    ``discovery`` sets ROS_AUTOMATIC_DISCOVERY_RANGE (LOCALHOST or SUBNET); without it a range
+    already in ``base`` is kept, and LOCALHOST is set where there is none (so that a run on one
+    computer stays there; ROS's own default is SUBNET). ``domain_id`` sets ROS_DOMAIN_ID.
+    Raises PlanError for a range other than :data:`DISCOVERY`.
+    """
+    env = {}
+    if discovery:
+        problem = discovery_problem(discovery)
+        if problem:
+            raise PlanError(f'discovery {problem}')
+        env[DISCOVERY_ENV] = discovery.upper()
+    elif not base.get(DISCOVERY_ENV):
+        env[DISCOVERY_ENV] = 'LOCALHOST'
+    if domain_id is not None:
+        env[DOMAIN_ENV] = str(domain_id)
+    return env
+
+
+def topics_of(template: str, num_robots: int, names: Sequence[str],
+              option: str) -> Tuple[str, ...]:
+    """
+    Return robot 1..N's topics from a template (``{i}`` id, ``{name}`` relay.source_names).
+
+    The same checks as ``relay.source_topic`` (``core.params.template_problems``), and every
+    topic must be an absolute ROS name. Raises PlanError naming ``option``, one line.
+    """
+    from formation_ros.core.params import fill_template, template_problems
+    problems = template_problems(template, names, num_robots, template_key=option)
+    if problems:
+        key, message = problems[0]
+        raise PlanError(f'{key} {message}')
+    topics = tuple(fill_template(template, i, names) for i in range(1, num_robots + 1))
+    for i, topic in enumerate(topics, start=1):
+        if not TOPIC_NAME.fullmatch(topic):
+            raise PlanError(f'{option} {template!r} gives robot {i} {topic!r}, not an absolute '
+                            "ROS topic name ('/', then letters, digits and '_', no token "
+                            'starting with a digit)')
+    return topics
+
+
+def read_formation(params_file: str, plant: bool = True, cmd_topic: Optional[str] = None,
+                   source_topic: Optional[str] = None, robots_per_process: int = 1,
+                   cmd_option: str = 'cmd_topic', source_option: str = 'source_topic'
+                   ) -> Formation:
+    """
+    Check ``params_file`` for every program a run starts; return what the run needs of it.
+
+    cmd_topic: template of the robots' command topics (None: no remapping); source_topic:
+    ``relay.source_topic`` instead of the file's (None: the file's); cmd_option /
+    source_option: how the caller spells them (``--cmd-topic``). Raises ParamError for the
+    file, PlanError (one line, naming the option) for the templates.
+    """
+    from formation_ros.core.declarations import Exe, ParamError
+    from formation_ros.core.params import validate_for_every_executable
+    from formation_ros.core.params_file import load_params_file
+    raw = load_params_file(params_file)
+    if source_topic is not None:
+        raw['relay.source_topic'] = source_topic
+    try:
+        checked = validate_for_every_executable(raw)
+    except ParamError as exc:
+        mine = [line for line in (f'{key} {message}' for key, message in exc.problems)
+                if 'relay.source_topic' in line]
+        if source_topic is not None and mine:
+            raise PlanError(mine[0].replace('relay.source_topic', source_option)) from None
+        raise
+    config = checked[Exe.PLANT]
+    assert config.plant is not None
+    relay = checked[Exe.RELAY].relay
+    assert relay is not None
+    if source_topic is not None:
+        topics_of(source_topic, config.num_robots, relay.source_names, source_option)
+    cmd_topics: Tuple[str, ...] = ()
+    if cmd_topic is not None:
+        if robots_per_process > 1:
+            raise PlanError(f'{cmd_option} {FLEET_REMAP}')
+        cmd_topics = topics_of(cmd_topic, config.num_robots, relay.source_names, cmd_option)
+    seconds = config.duration / (config.plant.realtime_factor if plant else 1.0)
+    return Formation(config.num_robots, seconds, cmd_topics)
