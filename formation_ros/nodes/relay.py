@@ -120,7 +120,7 @@ class RelayNode(Node):
                                                      '(the relay would read what it writes, or '
                                                      'the commands): use e.g. '
                                                      "'/robot_{i}/measured_pose'")])
-        self.source_type_name = topics.MEASUREMENT_TYPES[settings.source_type]
+        self.source_type_name = topics.MEASUREMENT_TYPES[settings.source_type.value]
         self.once = OnceLog(self.get_logger())
         self.steady = Clock(clock_type=ClockType.STEADY_TIME)
 

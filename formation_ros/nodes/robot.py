@@ -61,11 +61,15 @@ from geometry_msgs.msg import PoseArray, PoseStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 import numpy as np
 from numpy.typing import NDArray
+import rclpy
 from rclpy.clock import Clock, ClockType
+from rclpy.duration import Duration
 from rclpy.node import Node
 
 Read = TypeVar('Read')
 REFERENCE_BUFFER = 64
+LAST_WORD = 0.5
+"""How long a stopping robot waits for its last (zero) command to be received, s."""
 RATE_TOLERANCE = 1e-3
 INPUTS = ('pose', 'neighbour', 'reference')
 
@@ -439,6 +443,18 @@ class RobotNode(Node):
             return
         self._publish_command(command, stamp)
         self.answered_count = self.pose_count
+
+    def finish(self) -> None:
+        """
+        On a clean stop, command zero, so that a base without a command timeout stops too.
+
+        The zero answers the latest state (a base that drops old stamps still takes it), and
+        the node waits up to :data:`LAST_WORD` s for its subscribers to have it.
+        """
+        if self.pose is None or not rclpy.ok(context=self.context):
+            return
+        self._publish_command(None, self.pose.stamp_ns)
+        self.cmd_pub.wait_for_all_acked(Duration(seconds=LAST_WORD))
 
     def on_diagnostics(self) -> None:
         """Publish this robot's status: input ages, neighbours in range, command size."""

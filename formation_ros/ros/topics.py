@@ -13,7 +13,6 @@ from dataclasses import dataclass
 import enum
 from typing import Dict, List
 
-from formation_ros.core.declarations import SourceType
 
 POSE = 'pose'
 NEIGHBOURS = 'neighbors'
@@ -27,11 +26,11 @@ SHAPE = '/formation/shape'
 STATUS = '/formation/status'
 STOP = '/formation/stop'
 START = '/formation/start'
-MEASUREMENT_TYPES: Dict[SourceType, str] = {
-    SourceType.POSE: 'geometry_msgs/msg/PoseStamped',
-    SourceType.ODOMETRY: 'nav_msgs/msg/Odometry',
+MEASUREMENT_TYPES: Dict[str, str] = {
+    'pose': 'geometry_msgs/msg/PoseStamped',
+    'odometry': 'nav_msgs/msg/Odometry',
 }
-"""ROS type of the relay's measured poses for each ``relay.source_type`` (topics: the template
+"""ROS type of the relay's measured poses by ``relay.source_type`` value (topics: the template
 ``relay.source_topic``, ``core.params.RelaySettings.source``)."""
 
 

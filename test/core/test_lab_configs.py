@@ -28,6 +28,7 @@ def test_turtlebot3_lab_reads_vrpn_mocap_and_keeps_within_a_burgers_limits():
     robot = configs[Exe.ROBOT]
     assert robot.body.is_unicycle and robot.world_frame == 'world'
     assert robot.command.frame is CommandFrame.BODY
+    assert robot.command.message is CommandType.TWIST_STAMPED
     v_bound, w_bound = command_bounds(robot.law().u_bound, robot.body.hand_distance)
     body = configs[Exe.SIM].body
     assert (body.max_linear, body.max_angular) == (0.22, 2.84)

@@ -11,6 +11,7 @@ plain Twists in their own frames, in a world frame called ``map``, recorded and 
 
 import json
 import math
+import signal
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.params import load_config
@@ -84,3 +85,22 @@ def test_a_robot_refuses_states_in_another_world_frame(processes, install, probe
     assert probe.spin_until(lambda: refused and refused[-1] >= 20, 60), processes.log('robot_1')
     assert processes.log('robot_1').count(line) == 1
     assert not heard
+
+
+def test_a_robot_that_stops_commands_zero_last(processes, install, probe, tmp_path):
+    params = write_params(tmp_path, 'square_4.yaml', {'command.type': 'twist'})
+    heard = []
+    probe.create_subscription(Twist, '/robot_1/cmd_vel',
+                              lambda m: heard.append((m.linear.x, m.linear.y)), qos.COMMAND)
+    processes.start(node(install, 'plant', params))
+    processes.start(node(install, 'reference', params, '-p', 'use_sim_time:=true'))
+    for i in range(1, 5):
+        processes.start(node(install, 'robot', params, '-r', f'__ns:=/robot_{i}',
+                             '-p', f'robot_id:={i}', '-p', 'use_sim_time:=true',
+                             process=f'robot_{i}'))
+    assert probe.spin_until(lambda: any(x or y for x, y in heard[-5:]), 60), \
+        processes.log('robot_1')
+    processes.send_signal('robot_1', signal.SIGINT)
+    assert probe.spin_until(lambda: not processes.running('robot_1'), 30)
+    assert processes.exit_info('robot_1').returncode == 0, processes.log('robot_1')
+    assert heard[-1] == (0.0, 0.0), heard[-5:]
