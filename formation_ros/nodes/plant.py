@@ -45,6 +45,7 @@ from formation_ros.core.declarations import CommandFrame, Exe
 from formation_ros.core.frames import desired_positions
 from formation_ros.core.plant import (Commands, CommandStatus, DurationHistogram, NS_PER_S,
                                       PLANT_STATS_FILE, PlantModel, StepReport)
+from formation_ros.core.team import team_values
 from formation_ros.core.timeline import Mode
 from formation_ros.core.trajectory import (CHUNKS_DIR, ChunkWriter, read_body_chunks,
                                            read_chunks, Trajectory)
@@ -58,6 +59,7 @@ from formation_ros.ros.markers import formation_markers, Paths
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
 from formation_ros.ros.runner import run
+from formation_ros.ros.team import announced, team_problems, TeamCheck
 from formation_ros.ros.wake import Wake
 from geometry_msgs.msg import PoseArray, PoseStamped, Twist, TwistStamped
 import numpy as np
@@ -66,6 +68,7 @@ from rclpy.node import Node
 from rosgraph_msgs.msg import Clock as ClockMsg
 from visualization_msgs.msg import MarkerArray
 
+PLANT_STATUS = 'formation_ros/plant'
 RESEND_AFTER = 0.05
 PUBLISHES_TIMED = 256
 """States whose first publish time is kept for the answer latency; answers to older states are
@@ -92,6 +95,7 @@ class PlantNode(Node):
         self.changes = Changes(self, config, self.steady, self._reject_change)
         self.reference = self.changes.reference
         self.held_steps = 0
+        self.team = TeamCheck(self, PLANT_STATUS)
         self.n, self.dim = config.num_robots, config.dim
         self.unicycles = config.body.is_unicycle
         self.body_frame = config.command.frame is CommandFrame.BODY
@@ -389,6 +393,11 @@ class PlantNode(Node):
         for state in ('alive', 'lost'):
             robots = [str(i + 1) for i, s in enumerate(states) if s == state]
             values[f'robots with {state} cmd_vel'] = ', '.join(robots) or 'none'
+        values.update(announced(team_values(self.config, self.changes.shapes.latest.vertices)))
+        others = team_problems(self.team, self.config, self.changes.shapes.latest.vertices,
+                               self.once)
+        if others:
+            values['nodes with other team values'] = ' | '.join(others)
         shared = self._shared_command_topics(now)
         for robot in shared:
             self.once.start(f'publishers-{robot}', f'robot {robot}: its cmd_vel has more than '
@@ -396,10 +405,11 @@ class PlantNode(Node):
                                                    'robot_id?)', 'error')
         if shared:
             values['cmd_vel with more than one publisher'] = ', '.join(map(str, shared))
-        if counts.collisions or counts.bound_violations or shared:
+        if counts.collisions or counts.bound_violations or shared or others:
             level, message = 'error', (f'{counts.collisions} collisions, '
                                        f'{counts.bound_violations} commands above the bound, '
-                                       f'{len(shared)} cmd_vel topics with several publishers')
+                                       f'{len(shared)} cmd_vel topics with several publishers, '
+                                       f'{len(others)} nodes with other team values')
         elif self.waiting:
             level, message = 'ok', 'waiting for the robots'
         elif 'lost' in states:
@@ -409,7 +419,7 @@ class PlantNode(Node):
             level, message = 'warn', f'stepping at {rate:.1f} Hz of {target:.1f} Hz'
         else:
             level, message = 'ok', 'running'
-        self.diagnostics_pub.publish(diagnostics('formation_ros/plant', level, message, values))
+        self.diagnostics_pub.publish(diagnostics(PLANT_STATUS, level, message, values))
 
     def _shared_command_topics(self, now: float) -> List[int]:
         """

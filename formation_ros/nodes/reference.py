@@ -48,6 +48,7 @@ from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.declarations import Exe, ParamError, ReferenceKind
 from formation_ros.core.frames import frame_to_pose
 from formation_ros.core.params import check_shape, tracking_problem
+from formation_ros.core.team import team_values
 from formation_ros.core.timeline import Mode, Shape, TeamState, Timeline
 from formation_ros.ros import fields, messages, qos, topics
 from formation_ros.ros.cdr import encode_odometry
@@ -55,6 +56,7 @@ from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
 from formation_ros.ros.runner import run
+from formation_ros.ros.team import announced, team_problems, TeamCheck
 from formation_ros.ros.wake import Wake
 from geometry_msgs.msg import PoseArray
 from nav_msgs.msg import Odometry
@@ -65,6 +67,7 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from std_srvs.srv import Trigger
 
+REFERENCE_STATUS = 'formation_ros/reference'
 RUNTIME = ('formation.vertices', 'formation.name', 'reference.origin', 'reference.speed')
 """The parameters that can be set while the node runs."""
 PERIODIC = (ReferenceKind.CIRCLE, ReferenceKind.FIGURE_EIGHT, ReferenceKind.HELIX)
@@ -95,6 +98,7 @@ class ReferenceNode(Node):
         self.state = TeamState.of(Mode.RUNNING, config.shape_name, self.base)
         self.states: Timeline[TeamState] = Timeline(self.state)
         self.pending: List[Tuple[str, Change]] = []
+        self.team = TeamCheck(self, REFERENCE_STATUS)
         self.pub = self.create_publisher(Odometry, topics.REFERENCE, qos.REFERENCE)
         self.shape_pub = self.create_publisher(PoseArray, topics.SHAPE, qos.CHANGES)
         self.status_pub = self.create_publisher(DiagnosticArray, topics.STATUS, qos.CHANGES)
@@ -302,17 +306,23 @@ class ReferenceNode(Node):
                          else self._reference_time(self.last_stamp)),
             'team': state.mode.value, 'shape in force': state.shape or 'formation.vertices',
             'shape changes': len(self.shapes.changes())}
+        shape = self.shapes.latest.vertices
+        values.update(announced(team_values(self.config, shape)))
+        others = team_problems(self.team, self.config, shape, self.once)
+        if others:
+            values['nodes with other team values'] = ' | '.join(others)
         level, message = ('ok', 'publishing') if self.published else ('warn', 'no sample yet')
         if state.mode is Mode.STOPPED:
             level, message = 'warn', 'team stopped'
+        if others:
+            level, message = 'error', f'{len(others)} nodes with other team values'
         if not self.sim_time and self.count_publishers(topics.CLOCK) > 0:
             level, message = 'error', 'on wall-clock time while /clock is published'
             self.once.start('clock', f'{topics.CLOCK} is published (a plant runs) but this node '
                                      'runs on wall-clock time: robots refuse its samples, '
                                      'stamped in another time base; restart it with '
                                      'use_sim_time:=true', 'error')
-        self.diagnostics_pub.publish(diagnostics('formation_ros/reference', level, message,
-                                                 values))
+        self.diagnostics_pub.publish(diagnostics(REFERENCE_STATUS, level, message, values))
 
 
 def main(args: Optional[List[str]] = None) -> int:

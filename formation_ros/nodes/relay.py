@@ -62,6 +62,7 @@ from formation_ros.core.bodies import make_bodies
 from formation_ros.core.declarations import Exe, ParamError, SourceType
 from formation_ros.core.frames import valid_quaternions
 from formation_ros.core.sensing import sensed_pairs, sensor_radii
+from formation_ros.core.team import team_values
 from formation_ros.core.unicycle import headings_from_quaternions
 from formation_ros.ros import qos, topics
 from formation_ros.ros.cdr import (CdrError, PoseData, read_odometry, read_pose_stamped,
@@ -70,6 +71,7 @@ from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
 from formation_ros.ros.runner import run
+from formation_ros.ros.team import announced
 from geometry_msgs.msg import PoseArray, PoseStamped
 from nav_msgs.msg import Odometry
 import numpy as np
@@ -98,6 +100,9 @@ class RelayNode(Node):
         """Declare and check parameters, then subscribe to every source and start the cycle."""
         super().__init__('relay')
         config = declare_parameters(self, Exe.RELAY)
+        team = team_values(config, config.vertices)
+        del team['shape in force']
+        self.team_keys = announced(team)
         settings = config.relay
         assert settings is not None
         if self.get_parameter('use_sim_time').value:
@@ -309,6 +314,7 @@ class RelayNode(Node):
             self.once.start(f'shared-{robot}', f'robot {robot}: {self.sources[robot - 1]} has '
                                                'more than one publisher (two mocap nodes?); '
                                                'the latest measurement of any of them is used')
+        values.update(self.team_keys)
         if self.foreign_types:
             level, message = 'error', (f'{len(self.foreign_types)} source topics with '
                                        f'publishers of another type than {self.source_type_name}')

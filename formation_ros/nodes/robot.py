@@ -44,6 +44,7 @@ from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.declarations import CommandFrame, Exe, PoseType
 from formation_ros.core.frames import advance, FrameSample, to_body_frame, valid_quaternions
 from formation_ros.core.law import Command, robot_command
+from formation_ros.core.team import team_values
 from formation_ros.core.timeline import Mode, TeamState
 from formation_ros.core.unicycle import (hand_points, headings_from_quaternions,
                                          unicycle_commands)
@@ -56,6 +57,7 @@ from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
 from formation_ros.ros.runner import run
+from formation_ros.ros.team import announced
 from formation_ros.ros.wake import Wake
 from geometry_msgs.msg import PoseArray, PoseStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
@@ -101,6 +103,7 @@ class RobotNode(Node):
         self.index = settings.robot_id - 1
         self.vertex = config.vertices[self.index]
         self.base_reference = config.reference()
+        self.config = config
         self.sensing_radius = float(config.sensing_radii[self.index])
         self.law = config.law()
         self.lockstep = config.lockstep
@@ -471,6 +474,7 @@ class RobotNode(Node):
             values['max |u| component [m/s]'] = float(np.max(np.abs(self.last.u)))
             values['max |u_hat| component [m/s]'] = float(np.max(np.abs(self.last.u_hat)))
         values['bound c*M1 [m/s]'] = self.law.u_bound
+        values.update(announced(team_values(self.config, self.changes.shapes.latest.vertices)))
         if self.last_body_command is not None and self.unicycle:
             values['|v| [m/s]'] = abs(float(self.last_body_command[0]))
             values['|w| [rad/s]'] = abs(float(self.last_body_command[1]))

@@ -1,0 +1,55 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+What every node of one team must agree on, as short texts that nodes announce and compare.
+
+Two nodes started with different parameters files (a robot on another computer with an old
+copy) run, but the team never forms. Each node announces these values in its ``/diagnostics``
+status; the plant and the reference compare them with their own and name the node that differs
+(``ros.team``).
+"""
+
+import hashlib
+from typing import Dict, Mapping
+
+from formation_ros.core.params import FormationConfig
+import numpy as np
+from numpy.typing import NDArray
+
+DIGITS = 12
+
+
+def digest(values: NDArray[np.float64]) -> str:
+    """Return a short fingerprint of an array's exact values (shape and float64 bytes)."""
+    array = np.ascontiguousarray(values, dtype=np.float64)
+    data = repr(array.shape).encode() + array.tobytes()
+    return hashlib.sha256(data).hexdigest()[:DIGITS]
+
+
+def team_values(config: FormationConfig, shape: NDArray[np.float64]) -> Dict[str, str]:
+    """
+    Return what must agree across the team: {name: text}.
+
+    num_robots, dim, the law's constants (c, kappa, psi, the jump function, b), the sensing radii
+    and the shape in force (``shape``, (N, dim): fingerprints of their exact values), the world
+    frame and the bodies.
+    """
+    body = config.body
+    return {
+        'num_robots': str(config.num_robots), 'dim': str(config.dim),
+        'law': (f'c={config.gain!r} kappa={config.kappa!r} psi={config.psi.value} '
+                f'jump={config.jump_kind.value}/{config.jump_order} '
+                f'b={config.repulsion_radius!r}'),
+        'sensing radii': digest(config.sensing_radii),
+        'shape in force': digest(shape),
+        'world_frame': config.world_frame,
+        'body': (f'{body.kind.value} l={body.hand_distance!r}' if body.is_unicycle
+                 else body.kind.value),
+    }
+
+
+def differences(own: Mapping[str, str], other: Mapping[str, str]) -> Dict[str, str]:
+    """Return {name: 'theirs (ours)'} for every value ``other`` announces differently."""
+    return {name: f'{other[name]} (here: {own[name]})' for name in own
+            if name in other and other[name] != own[name]}
