@@ -8,8 +8,8 @@ from formation_ros.ros import qos
 from helpers import node, write_params
 
 
-def test_a_robot_with_another_file_is_named_by_plant_and_reference(processes, install, probe,
-                                                                    tmp_path):
+def test_a_robot_with_another_file_is_named_by_plant_and_reference(
+        processes, install, probe, tmp_path):
     params = write_params(tmp_path, 'square_4.yaml', {})
     other = write_params(tmp_path, 'square_4.yaml', {'controller.gain': 1.0}, name='old.yaml')
     moved = write_params(tmp_path, 'square_4.yaml', {
@@ -29,8 +29,8 @@ def test_a_robot_with_another_file_is_named_by_plant_and_reference(processes, in
         status = statuses.get(status_name)
         if status is None or status.level != DiagnosticStatus.ERROR:
             return ''
-        return {kv.key: kv.value for kv in status.values}.get('nodes with other team values',
-                                                             '')
+        values = {kv.key: kv.value for kv in status.values}
+        return values.get('nodes with other team values', '')
 
     assert probe.spin_until(lambda: 'formation_ros/robot_4' in named('formation_ros/plant')
                             and 'formation_ros/robot_4' in named('formation_ros/reference'), 60)
