@@ -37,7 +37,7 @@ NOISE_SEED_OFFSET])``; a state reaches the robots ``state_delay`` s later, round
 from dataclasses import asdict, dataclass
 from typing import Dict, Tuple
 
-from formation_ros.core.unicycle import zoh_step
+from formation_ros.core.unicycle import heading_vectors
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -100,12 +100,13 @@ class Imperfections:
 IDEAL = Imperfections()
 
 
-def lagged_velocity(velocity: ArrayLike, command: ArrayLike, dt: float, lag: float,
+def lagged_velocity(velocity: ArrayLike, command: ArrayLike, dt: ArrayLike, lag: float,
                     max_acceleration: float) -> Tuple[Float, Float]:
     """
     Exact solution of (D1) over dt with the command held: (velocity at dt, its integral).
 
-    velocity, command: equal shapes (any), per component (m/s, or rad/s for w); dt, lag: s;
+    velocity, command: equal shapes (any), per component (m/s, or rad/s for w); dt: s, a
+    number or an array that broadcasts with them (several durations at once); lag: s;
     max_acceleration: a per component (0: none). Not both lag and max_acceleration 0 (the
     ideal body has no velocity state). With e = u - v, the body ramps at a for
     ``t1 = max(|e| - a tau, 0) / a``, then ``e(t) = e(t1) e^(-(t - t1) / tau)``; returns
@@ -156,13 +157,17 @@ def unicycle_step(q: ArrayLike, heading: ArrayLike, velocity: ArrayLike, command
 
     q: (N, 2) m; heading: (N,) rad; velocity, command: (N, 2) (v, w) in m/s and rad/s. The
     heading turns by the exact integral of w; the axle moves along ``substeps`` exact arcs, each
-    with the mean v and w of its substep (second order in dt / substeps).
+    with the mean v and w of its substep (second order in dt / substeps). The velocities and
+    their integrals at the substeps' ends come from the closed form of (D1) at once.
     """
     h = dt / substeps
-    position = np.asarray(q, dtype=float)
-    th = np.asarray(heading, dtype=float)
+    ends = h * np.arange(1, substeps + 1).reshape(-1, 1, 1)
     v = np.asarray(velocity, dtype=float)
-    for _ in range(substeps):
-        v, moved = lagged_velocity(v, command, h, lag, max_acceleration)
-        position, th = zoh_step(position, th, moved / h, h)
-    return position, th, v
+    speeds, moved = lagged_velocity(v, command, ends, lag, max_acceleration)
+    before = np.concatenate([np.zeros_like(moved[:1]), moved[:-1]])
+    mean = (moved - before) / h
+    th = np.asarray(heading, dtype=float)
+    half = 0.5 * h * mean[..., 1]
+    chords = h * mean[..., 0] * np.sinc(half / np.pi)
+    arcs = chords[..., None] * heading_vectors(th + before[..., 1] + half)
+    return np.asarray(q, dtype=float) + arcs.sum(axis=0), th + moved[-1, :, 1], speeds[-1]
