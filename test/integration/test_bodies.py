@@ -18,8 +18,8 @@ from rosgraph_msgs.msg import Clock as ClockMsg
 DELAY_STEPS = 5
 
 
-def test_plant_publishes_noisy_states_a_delay_late_stamped_when_measured(processes, install,
-                                                                          probe, tmp_path):
+def test_plant_publishes_noisy_states_a_delay_late_stamped_when_measured(
+        processes, install, probe, tmp_path):
     out = tmp_path / 'plant'
     params = write_params(tmp_path, 'square_4.yaml', {
         'plant.state_delay': 0.05, 'plant.pose_noise': 0.02, 'plant.rate': 100.0,
