@@ -487,7 +487,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         table[sweep] = {'parameter': spec['parameter'], 'unit': spec['unit'],
                         'note': spec.get('note', ''), 'rows': rows}
     result = {
-        'machine': host, 'arguments': vars(args), 'wall_s': time.monotonic() - started,
+        'machine': host, 'arguments': {**vars(args), 'out': os.path.relpath(args.out, ROOT)},
+        'wall_s': time.monotonic() - started,
         'load_after': list(os.getloadavg()),
         'configs': {name: {'path': CONFIGS[name], 'size': sizes[name], 'size_is': size_notes[name],
                            'settle_tolerance': SETTLE_TOLERANCE} for name in CONFIGS},
