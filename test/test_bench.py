@@ -288,3 +288,47 @@ def test_capacity_figure_is_drawn_from_earlier_results_alone(tmp_path):
                             timeout=120)
     assert result.returncode == 2 and 'is not a capacity.json' in result.stderr
     assert len(result.stderr.strip().splitlines()) == 1
+
+
+def test_robustness_benchmark_quick_run_writes_complete_results_and_figures(tmp_path):
+    script = os.path.join(ROOT, 'bench', 'bench_robustness.py')
+    robustness = load_bench(script)
+    result = subprocess.run([sys.executable, script, '--quick', '--out', str(tmp_path)],
+                            capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stdout + result.stderr
+    data = json.loads((tmp_path / 'bench' / 'robustness.json').read_text())
+    sweeps = data['sweeps']
+    assert set(sweeps) == set(robustness.SWEEPS) | {'delay_lag', 'gain'}
+    for name, sweep in sweeps.items():
+        assert (tmp_path / f'robustness_{name}.png').stat().st_size > 1000
+        assert {row['config'] for row in sweep['rows']} == set(robustness.CONFIGS)
+        for row in sweep['rows']:
+            summary = row['summary']
+            assert summary['starts'] == len(row['runs']) == 1
+            assert 0.0 < summary['closest_bodies'] <= summary['closest_points'] + 0.2
+            assert summary['max_abs_u_hat'] <= summary['u_bound'] * (1.0 + 1e-9)
+            assert summary['held'] == (summary['closest_bodies'] >= row['size']
+                                       and summary['collisions'] == 0)
+    ideal = sweeps['lag']['rows'][0]['runs'][0]
+    assert sweeps['noise']['rows'][0]['runs'][0] == ideal  # one run per distinct setting
+    assert ideal['delay_steps'] == 0 and sweeps['delay']['rows'][1]['runs'][0]['delay_steps'] == 20
+    assert data['configs']['unicycle']['size'] == 0.22
+    assert data['configs']['section5']['size'] == 0.1
+    assert set(data['limits']['delay']) == set(robustness.CONFIGS)
+    assert data['machine']['nproc'] == os.cpu_count() and data['machine']['python']
+    assert '| section5 | 0.2 |' in result.stdout and 'bench_robustness: 1/' in result.stderr
+    (tmp_path / 'robustness_gain.png').unlink()
+    again = subprocess.run([sys.executable, script, '--redraw', '--out', str(tmp_path)],
+                           capture_output=True, text=True, timeout=120)
+    assert again.returncode == 0 and (tmp_path / 'robustness_gain.png').stat().st_size > 1000
+    assert json.loads((tmp_path / 'bench' / 'robustness.json').read_text())['limits'] == data[
+        'limits']
+    (tmp_path / 'bench' / 'robustness.json').write_text('[1, 2]')
+    again = subprocess.run([sys.executable, script, '--redraw', '--out', str(tmp_path)],
+                           capture_output=True, text=True, timeout=120)
+    assert again.returncode == 2 and len(again.stderr.strip().splitlines()) == 1
+    for bad in (['--seeds', '0'], ['--jobs', '0']):
+        with pytest.raises(SystemExit) as info:
+            robustness.parse_args(bad)
+        assert info.value.code == 2
+    assert robustness.parse_args(['--quick', '--seeds', '5']).seeds == 1

@@ -15,7 +15,11 @@ depends on the kind:
   the model admits against the law's bound, and :meth:`body_command` turns such a velocity back
   (U3, U4);
 * the **step** with the command held over dt: ``q += dt u`` for a point, the exact arc of
-  :func:`formation_ros.core.unicycle.zoh_step` for a unicycle;
+  :func:`formation_ros.core.unicycle.zoh_step` for a unicycle; and, for bodies whose velocity
+  lags the command or is limited in acceleration (``plant.actuator_lag``,
+  ``plant.max_acceleration``: :mod:`formation_ros.core.dynamics`), the step that carries the
+  body's velocity along (:meth:`lagged_step`: exact for points, substeps of exact arcs for
+  unicycles);
 * the **actuator caps** a command is clipped to (``plant.max_speed`` per command component
   for points, in the world frame or, with ``command.frame: body``, the body's;
   ``body.max_linear`` on |v| and ``body.max_angular`` on |w| for unicycles);
@@ -28,6 +32,7 @@ from dataclasses import dataclass
 from typing import Optional, Tuple, Union
 
 from formation_ros.core.declarations import BodyKind
+from formation_ros.core.dynamics import Imperfections, point_step, unicycle_step
 from formation_ros.core.frames import from_body_frame, to_body_frame
 from formation_ros.core.unicycle import (hand_points, hand_velocity, quaternions_from_headings,
                                          unicycle_commands, zoh_step)
@@ -108,6 +113,18 @@ class PointBodies:
         """Zero-order hold over dt: (q + dt u, heading), u the command's world velocity."""
         return q + dt * self.world_velocity(command, heading), heading
 
+    def lagged_step(self, q: Float, heading: Float, velocity: Float, command: Float, dt: float,
+                    imperfections: Imperfections) -> Tuple[Float, Float, Float]:
+        """
+        Exact step with the world velocity (N, dim) lagging the command's (D2): (q, heading, v).
+
+        The lag and the acceleration limit act per world component, on the velocity the
+        command stands for (:meth:`world_velocity`).
+        """
+        moved, v = point_step(q, velocity, self.world_velocity(command, heading), dt,
+                              imperfections.actuator_lag, imperfections.max_acceleration)
+        return moved, heading, v
+
     def cap(self, command: Float, rows: NDArray[np.bool_]) -> NDArray[np.bool_]:
         """Clip (in place) the ``rows`` whose components exceed max_speed; return which."""
         if self.max_speed <= 0.0:
@@ -157,6 +174,12 @@ class UnicycleBodies:
     def step(self, q: Float, heading: Float, command: Float, dt: float) -> Tuple[Float, Float]:
         """Exact zero-order-hold step of the unicycles over dt: (q, heading) after it."""
         return zoh_step(q, heading, command, dt)
+
+    def lagged_step(self, q: Float, heading: Float, velocity: Float, command: Float, dt: float,
+                    imperfections: Imperfections) -> Tuple[Float, Float, Float]:
+        """Step with (v, w) (N, 2) lagging the command (D3): (q, heading, (v, w)) after it."""
+        return unicycle_step(q, heading, velocity, command, dt, imperfections.actuator_lag,
+                             imperfections.max_acceleration)
 
     def cap(self, command: Float, rows: NDArray[np.bool_]) -> NDArray[np.bool_]:
         """Clip (in place) |v| and |w| of the ``rows`` to the actuator caps; return which."""

@@ -597,6 +597,12 @@ def _imperfections(values: Mapping[str, Any], exe: Exe, problems: Problems) -> I
         problems.append(('plant.state_delay', f'{imperfections.state_delay:g} s would make '
                                               'every command stale: it must be less than '
                                               f'plant.input_timeout = {timeout:g} s'))
+    if exe is Exe.PLANT and values.get('plant.lockstep') and imperfections.state_delay > 0.0:
+        problems.append(('plant.state_delay', 'cannot be used with plant.lockstep: a lockstep '
+                                              'plant steps once every robot has answered the '
+                                              'present state, and with a delay the robots '
+                                              'only ever receive older ones; run free (no '
+                                              'lockstep), or use formation_sim --dt'))
     return imperfections
 
 

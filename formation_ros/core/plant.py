@@ -27,9 +27,23 @@ Each step the model
   reported;
 * integrates and checks collisions: a pair of bodies closer than ``collision_distance`` (or
   twice the body radius) is counted once when it comes closer;
-* senses (:meth:`PlantModel.neighbours`): what each robot's range sensor sees, the other bodies
-  strictly within its R_i (R_i + 2 l for unicycles, so that it sees every hand point within R_i
-  of its own), from one k-d tree per step.
+* senses (:meth:`PlantModel.sensed`, :meth:`PlantModel.neighbours`): what each robot's range
+  sensor sees, the other bodies strictly within its R_i (R_i + 2 l for unicycles, so that it
+  sees every hand point within R_i of its own), from one k-d tree per step.
+
+Non-ideal bodies (``core.dynamics``, beyond the paper; all ideal by default, and then none of
+this state exists and the model steps exactly as above): with ``actuator_lag`` or
+``max_acceleration`` the model keeps every body's velocity (:attr:`PlantModel.velocity`, from
+rest) and steps it with the dynamics of ``core.dynamics``; with ``pose_noise`` every state's
+positions are sensed with noise (one draw per body per state: a motion-capture system measures
+each body once, and every robot that sees body j gets the same measured position); with
+``state_delay`` the robots get, at time t, the state measured at t - d (d rounded to whole
+steps; before d has passed, the start state), stamped with t - d. Commands then answer that
+stamp, and the admission looks it up among the states it keeps (what the robots were sent:
+the sensed control points and headings). Collisions, distances and the recorded trajectory are
+the true bodies'; the range sensor's pairs are those of the sensed positions (the rule of
+``core.sensing`` applied to what the robots are sent, as the relay applies it to a
+motion-capture system's measurements).
 
 Positions are rows: ``q`` has shape (N, dim), in m; headings (N,) in rad; commands (N, dim) in m/s
 for points, (N, 2) holding (v, w) in m/s and rad/s for unicycles.
@@ -38,15 +52,19 @@ for points, (N, 2) holding (v, w) in m/s and rad/s for unicycles.
 from collections import OrderedDict
 from dataclasses import dataclass, field
 import enum
-from typing import Dict, List, Optional, Set, Tuple
+from typing import Dict, List, Optional, Set, Tuple, TYPE_CHECKING
 
 from formation_ros.core.bodies import Bodies, PointBodies
+from formation_ros.core.dynamics import IDEAL, Imperfections
 from formation_ros.core.frames import from_frame_velocity, to_frame_velocity
 from formation_ros.core.law import LawParams
 from formation_ros.core.reference import Reference
 from formation_ros.core.sensing import neighbour_lists, sensed_pairs, sensor_radii
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+if TYPE_CHECKING:
+    from scipy.spatial import cKDTree
 
 NS_PER_S = 1_000_000_000
 BOUND_TOLERANCE_FIXED = 1e-9
@@ -149,6 +167,30 @@ class StepReport:
     collisions: List[Tuple[int, int, float]]
     points: NDArray[np.float64]
     heading: NDArray[np.float64]
+    velocity: Optional[NDArray[np.float64]] = None
+    """The bodies' velocity at the end of the step, as the commands ((N, dim) world m/s for
+    points, (N, 2) (v, w) for unicycles): the held command itself for ideal bodies."""
+
+
+@dataclass(frozen=True)
+class SensedState:
+    """
+    What the robots receive now: a state as measured, stamped with when it was measured.
+
+    stamp_ns: measurement time (the present minus the delay), ns; q: (N, dim) sensed body
+    positions, m; heading: (N,) headings, rad (exact: the noise is on positions); points:
+    (N, dim) the control points of q and heading (what each robot's law computes from them).
+    tree, body_tree, pairs: k-d trees of points and q and the pairs within the model's
+    ``pair_radius``, when the model has them for this state (ideal sensing), else None.
+    """
+
+    stamp_ns: int
+    q: NDArray[np.float64]
+    heading: NDArray[np.float64]
+    points: NDArray[np.float64]
+    tree: Optional['cKDTree'] = None
+    body_tree: Optional['cKDTree'] = None
+    pairs: Optional[NDArray[np.intp]] = None
 
 
 @dataclass
@@ -318,18 +360,20 @@ class PlantModel:
     (default 0). pair_radius: with a value > 0 (``formation_sim`` gives the law's b), the model
     keeps every pair of control points within it of each new state (:attr:`pairs`, for the law)
     and, for points when it is at least the collision distance, checks collisions among them
-    instead of searching the tree a second time.
+    instead of searching the tree a second time. imperfections: how the bodies and their
+    sensing differ from the ideal (``core.dynamics``; default ideal).
 
     Public state: ``q`` (N, dim) body positions, ``heading`` (N,), ``points`` (N, dim) the
     control points the law acts on, ``tree`` a k-d tree of ``points`` and ``body_tree`` one of
-    ``q`` (the same object for points).
+    ``q`` (the same object for points), all true; ``velocity`` the bodies' velocity (None for
+    ideal bodies, whose velocity is their command).
     """
 
     def __init__(self, start: ArrayLike, sensing_radii: ArrayLike, step_ns: int,
                  law: LawParams, reference: Reference, input_timeout_ns: int,
                  collision_distance: float, max_speed: float = 0.0,
                  bodies: Optional[Bodies] = None, headings: Optional[ArrayLike] = None,
-                 pair_radius: float = 0.0):
+                 pair_radius: float = 0.0, imperfections: Imperfections = IDEAL):
         """Place the robots at ``start`` (and ``headings``) at time 0."""
         self.body: Bodies = PointBodies(max_speed) if bodies is None else bodies
         self.q = np.array(start, dtype=float)
@@ -358,12 +402,36 @@ class PlantModel:
         self._moved()
         self.counts = PlantCounts(status_steps=np.zeros((len(CommandStatus), self.num_robots),
                                                         dtype=np.int64))
-        self._states: 'OrderedDict[int, NDArray[np.float64]]' = OrderedDict([(0, self.points)])
-        self._headings: 'OrderedDict[int, NDArray[np.float64]]' = OrderedDict([(0, self.heading)])
-        self._states_kept = min(MAX_STATES_KEPT, 2 + self.input_timeout_ns // self.step_ns)
+        self.imperfections = imperfections
+        self.velocity: Optional[NDArray[np.float64]] = (
+            None if imperfections.ideal_body
+            else np.zeros((self.num_robots, self.body.command_width(self.dim))))
+        self.delay_steps = imperfections.delay_steps(self.step_ns)
+        self._noise = (imperfections.noise_generator() if imperfections.pose_noise > 0.0
+                       else None)
+        self._positions: 'Optional[OrderedDict[int, NDArray[np.float64]]]' = (
+            None if imperfections.ideal_sensing else OrderedDict())
+        """Sensed body positions of the kept states (None: ideal sensing, they are q)."""
+        self._states: 'OrderedDict[int, NDArray[np.float64]]' = OrderedDict()
+        self._headings: 'OrderedDict[int, NDArray[np.float64]]' = OrderedDict()
+        self._keep_state()
+        self._states_kept = max(min(MAX_STATES_KEPT, 2 + self.input_timeout_ns // self.step_ns),
+                                2 + self.delay_steps)
         self._audited = np.full(self.num_robots, -1, dtype=np.int64)
         self._robots = np.arange(self.num_robots)
         self._colliding = self._close_pairs()
+
+    def _keep_state(self) -> None:
+        """Keep the present state as the robots are sent it (noisy with ``pose_noise``)."""
+        points = self.points
+        if self._positions is not None:
+            q = self.q
+            if self._noise is not None:
+                q = q + self._noise.normal(0.0, self.imperfections.pose_noise, q.shape)
+                points = self.body.control_points(q, self.heading)
+            self._positions[self.t_ns] = q
+        self._states[self.t_ns] = points
+        self._headings[self.t_ns] = self.heading
 
     def _moved(self) -> None:
         """Update the control points and the k-d trees after the bodies moved."""
@@ -482,14 +550,21 @@ class PlantModel:
         counted = admission.counted
         violations = self._audit(commands, admission, counted)
         t_ns, q, points, heading = self.t_ns, self.q, self.points, self.heading
-        self.q, self.heading = self.body.step(q, heading, admission.u, self.dt)
+        if self.velocity is None:
+            self.q, self.heading = self.body.step(q, heading, admission.u, self.dt)
+            velocity = admission.u
+        else:
+            self.q, self.heading, self.velocity = self.body.lagged_step(
+                q, heading, self.velocity, admission.u, self.dt, self.imperfections)
+            velocity = self.velocity
         self.t_ns += self.step_ns
         self._moved()
-        self._states[self.t_ns] = self.points
-        self._headings[self.t_ns] = self.heading
+        self._keep_state()
         while len(self._states) > self._states_kept:
             self._states.popitem(last=False)
             self._headings.popitem(last=False)
+            if self._positions is not None:
+                self._positions.popitem(last=False)
         counts = self.counts
         counts.steps += 1
         counts.status_steps[admission.status, self._robots] += 1
@@ -500,16 +575,33 @@ class PlantModel:
         counts.age_steps[age_bin] += 1
         collisions = self._new_collisions()
         counts.collisions += len(collisions)
-        return StepReport(t_ns, q, admission, violations, collisions, points, heading)
+        return StepReport(t_ns, q, admission, violations, collisions, points, heading, velocity)
+
+    def sensed(self) -> SensedState:
+        """
+        Return what the robots receive now: the state measured ``delay_steps`` steps ago.
+
+        Its stamp is when it was measured (0, the start, while the delay has not passed); its
+        positions carry that state's noise. Ideal sensing: the present state itself, with the
+        model's trees and pairs.
+        """
+        if self._positions is None:
+            return SensedState(self.t_ns, self.q, self.heading, self.points, self.tree,
+                               self.body_tree, self.pairs)
+        stamp = max(self.t_ns - self.delay_steps * self.step_ns, 0)
+        return SensedState(stamp, self._positions[stamp], self._headings[stamp],
+                           self._states[stamp])
 
     def sensed_pairs(self) -> Tuple[NDArray[np.intp], NDArray[np.intp]]:
         """
         Every robot's range sensor now: (observer, seen) pairs (``core.sensing``).
 
         A sensor sees bodies, strictly within R_i for points and R_i + 2 l for unicycles
-        (``sensor_radii``), so that it sees every hand point within R_i of its own.
+        (``sensor_radii``), so that it sees every hand point within R_i of its own. The pairs
+        are those of the sensed positions (:meth:`sensed`): the true ones with ideal sensing.
         """
-        return sensed_pairs(self.q, self.sensor_radii, self.body_tree)
+        state = self.sensed()
+        return sensed_pairs(state.q, self.sensor_radii, state.body_tree)
 
     def neighbours(self) -> List[NDArray[np.intp]]:
         """Robot i's range sensor: indices of the other bodies it sees, each sorted."""

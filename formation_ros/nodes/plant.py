@@ -104,7 +104,8 @@ class PlantNode(Node):
         self.model = PlantModel(config.start, config.sensing_radii, settings.step_ns, self.law,
                                 self.reference, settings.input_timeout_ns,
                                 settings.collision_distance, settings.max_speed,
-                                bodies=self.bodies, headings=config.start_headings)
+                                bodies=self.bodies, headings=config.start_headings,
+                                imperfections=config.imperfections)
         self.commands = Commands.empty(self.n, self.bodies.command_width(self.dim))
         self.stamped = config.command.stamped
         self.command_frames = [messages.body_frame(i) if self.body_frame else config.world_frame
@@ -164,7 +165,10 @@ class PlantNode(Node):
             f'plant: {self.n} robots in {self.dim}D, dt = {self.model.dt:g} s, '
             f'reference {self.reference.kind}, '
             + ('lockstep' if self.lockstep
-               else f'realtime factor {settings.realtime_factor:g}'))
+               else f'realtime factor {settings.realtime_factor:g}')
+            + ('' if config.imperfections.is_ideal else ', bodies beyond the paper: ' + ', '.join(
+                f'{name} = {value:g}' for name, value in config.imperfections.as_dict().items()
+                if value)))
 
     def on_command(self, index: int, data: bytes) -> None:
         """
@@ -317,16 +321,23 @@ class PlantNode(Node):
         self.clock_pub.publish(encode_clock(self.model.t_ns))
 
     def _publish(self) -> None:
-        """Publish /clock, then every robot's pose and what its range sensor sees."""
+        """
+        Publish /clock, then what the robots sense: every pose and each range sensor's bodies.
+
+        That is the model's sensed state (``PlantModel.sensed``): the present one for ideal
+        sensing; with ``plant.pose_noise`` / ``plant.state_delay`` the noisy state measured the
+        delay ago, stamped with its measurement time (the clock stays the present).
+        """
         self._publish_clock()
-        self.state_stamp_ns = self.model.t_ns
-        self.published_ns.setdefault(self.model.t_ns, time.monotonic_ns())
+        state = self.model.sensed()
+        self.state_stamp_ns = state.stamp_ns
+        self.published_ns.setdefault(state.stamp_ns, time.monotonic_ns())
         while len(self.published_ns) > PUBLISHES_TIMED:
             self.published_ns.popitem(last=False)
         observer, seen = self.model.sensed_pairs()
         poses, arrays = self.state_encoder.encode(
-            self.model.q, observer, seen, self.model.t_ns,
-            self.model.heading if self.unicycles or self.body_frame else None)
+            state.q, observer, seen, state.stamp_ns,
+            state.heading if self.unicycles or self.body_frame else None)
         for publisher, message in zip(self.pose_pubs, poses):
             publisher.publish(message)
         for publisher, message in zip(self.neighbour_pubs, arrays):
@@ -496,6 +507,8 @@ class PlantNode(Node):
         stats.update(totals)
         stats['held_steps'] = self.held_steps
         stats['shape_changes'] = len(self.changes.shapes.changes())
+        stats['imperfections'] = self.config.imperfections.as_dict()
+        stats['state_delay_steps'] = self.model.delay_steps
         stats['oldest_command_counted'] = counts.oldest_counted_ns / NS_PER_S
         stats['command_age_steps'] = counts.age_steps.tolist()
         stats['answer_latency'] = {

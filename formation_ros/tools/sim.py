@@ -12,10 +12,16 @@ Unicycles (``body.kind: unicycle``): RK45 integrates the unicycles' own equation
 law acting on their hand points (the ideal continuous-time system: no actuator caps); ``--dt``
 steps the plant model, which holds (v, w) over each step, integrates the arcs exactly and
 clips to ``body.max_linear`` / ``body.max_angular``.
+
+Non-ideal bodies (``plant.actuator_lag``, ``plant.max_acceleration``, ``plant.pose_noise``,
+``plant.state_delay``; ``core.dynamics``, beyond the paper) exist only in the plant model, so
+only ``--dt`` runs have them: without ``--dt`` a file that sets any of them is refused. In a
+``--dt`` run the law acts on what the robots sense (noisy, late), the bodies move with their
+lagged velocity, and trajectory.npz holds the true states.
 """
 
 import argparse
-from dataclasses import replace
+from dataclasses import dataclass, replace
 import json
 import math
 import os
@@ -34,7 +40,7 @@ from formation_ros.core.metrics import body_metrics, compute_metrics
 from formation_ros.core.params import (FormationConfig, load_config,
                                        validate_for_every_executable)
 from formation_ros.core.params_file import load_params_file
-from formation_ros.core.plant import Commands, NS_PER_S, PlantModel
+from formation_ros.core.plant import Commands, NS_PER_S, PlantCounts, PlantModel
 from formation_ros.core.safety import guaranteed_min_distance
 from formation_ros.core.timeline import scheduled_shapes, Shape, Timeline
 from formation_ros.core.trajectory import Trajectory
@@ -157,6 +163,9 @@ def simulate(config: FormationConfig, duration: Optional[float] = None,
     progress = progress or Progress(duration, quiet=True)
     if dt is not None:
         return simulate_fixed_step(config, duration, dt, sample_dt, progress)
+    problem = continuous_time_problem(config)
+    if problem:
+        raise ValueError(problem)
     if config.body.is_unicycle:
         return simulate_unicycles(config, duration, sample_dt, progress)
     law = config.law()
@@ -209,34 +218,81 @@ def simulate_unicycles(config: FormationConfig, duration: float, sample_dt: floa
                    body_command=unicycle_commands(trajectory.u, heading, l_value))
 
 
+def continuous_time_problem(config: FormationConfig) -> Optional[str]:
+    """Say why RK45 (no ``--dt``) cannot run ``config``: its bodies are not ideal; or None."""
+    imperfections = config.imperfections
+    if imperfections.is_ideal:
+        return None
+    given = ', '.join(f'{name} = {value:g}' for name, value in imperfections.as_dict().items()
+                      if value != 0.0)
+    return (f"{given}: bodies that are not the paper's q' = u exist only in the fixed-step "
+            'plant model, not in RK45; give --dt (e.g. --dt 0.01)')
+
+
+@dataclass(frozen=True)
+class FixedStepRun:
+    """
+    A ``--dt`` run: its samples and what the plant model counted over every step.
+
+    trajectory: the samples (true states); counts: the model's counters (collisions below the
+    model's contact distance, ...); largest_u_hat: the largest |u_hat| component of any command
+    as sent, m/s (against c M1); largest_velocity: the largest |component| of the bodies'
+    velocity over the run, per command component ((dim,) world m/s for points, (2,) |v| in m/s
+    and |w| in rad/s for unicycles); delay_steps: the state delay in whole steps.
+    """
+
+    trajectory: Trajectory
+    counts: PlantCounts
+    largest_u_hat: float
+    largest_velocity: np.ndarray
+    delay_steps: int
+
+
 def simulate_fixed_step(config: FormationConfig, duration: float, dt: float,
                         sample_dt: float, progress: Progress) -> Trajectory:
+    """Step the plant model with the law's commands (:func:`run_fixed_step`): its samples."""
+    return run_fixed_step(config, duration, dt, sample_dt, progress).trajectory
+
+
+def run_fixed_step(config: FormationConfig, duration: float, dt: float, sample_dt: float,
+                   progress: Progress,
+                   collision_distance: float = DEFAULT_COLLISION_DISTANCE) -> FixedStepRun:
     """
     Step the plant model (``core.plant``) with the law's commands, as the plant node does.
 
-    Every robot answers every state at once (a lockstep run without the network): the model
-    admits the commands, audits the bound and integrates with zero-order hold over ``dt``.
+    Every robot answers every state it is sent at once (a lockstep run without the network):
+    the law acts on what the robots sense (:meth:`PlantModel.sensed`: with the reference at the
+    sensed state's stamp), the model admits the commands, audits the bound and steps the bodies
+    over ``dt``. With ``plant.state_delay`` the commands answer states that much older, so the
+    model's input timeout is one step more than the delay. collision_distance: pairs of bodies
+    closer than this (or twice ``body.radius``) count as collisions, m.
     """
     law = config.law()
     reference = config.reference()
     step_ns = int(round(dt * NS_PER_S))
     bodies = make_bodies(config.body, body_frame=config.command.frame is CommandFrame.BODY
                          and not config.body.is_unicycle)
+    imperfections = config.imperfections
+    delay_ns = imperfections.delay_steps(step_ns) * step_ns
     model = PlantModel(config.start, config.sensing_radii, step_ns, law, reference,
-                       input_timeout_ns=step_ns, collision_distance=DEFAULT_COLLISION_DISTANCE,
+                       input_timeout_ns=step_ns + delay_ns, collision_distance=collision_distance,
                        bodies=bodies, headings=config.start_headings,
-                       pair_radius=law.repulsion_radius)
+                       pair_radius=law.repulsion_radius, imperfections=imperfections)
     commands = Commands.empty(config.num_robots, bodies.command_width(config.dim))
     shapes = shapes_of(config)
     steps = int(round(duration / dt))
     stride = max(1, int(round(sample_dt / dt)))
+    largest_u_hat = 0.0
+    largest_velocity = np.zeros(bodies.command_width(config.dim))
     times, states, applied, frames, headings, q_body, held = [], [], [], [], [], [], []
     for k in range(steps + 1):
         frame = reference.sample(model.t)
-        u = team_command(model.points, shapes.at(model.t_ns).vertices, config.sensing_radii,
-                         law, frame,
-                         model.tree, model.pairs).u
-        commands.store_all(bodies.body_command(u, model.heading), model.t_ns)
+        sensed = model.sensed()
+        seen_frame = (frame if sensed.stamp_ns == model.t_ns
+                      else reference.sample(sensed.stamp_ns / NS_PER_S))
+        u = team_command(sensed.points, shapes.at(sensed.stamp_ns).vertices,
+                         config.sensing_radii, law, seen_frame, sensed.tree, sensed.pairs).u
+        commands.store_all(bodies.body_command(u, sensed.heading), sensed.stamp_ns)
         if k == steps:
             times.append(model.t)
             states.append(model.points)
@@ -250,6 +306,10 @@ def simulate_fixed_step(config: FormationConfig, duration: float, dt: float,
             break
         progress.update(model.t)
         report = model.advance(commands)
+        largest_u_hat = max(largest_u_hat, float(np.max(report.admission.largest_u_hat)))
+        if report.velocity is not None:
+            np.maximum(largest_velocity, np.max(np.abs(report.velocity), axis=0),
+                       out=largest_velocity)
         if k % stride == 0:
             times.append(report.t_ns / NS_PER_S)
             states.append(report.points)
@@ -260,10 +320,11 @@ def simulate_fixed_step(config: FormationConfig, duration: float, dt: float,
             held.append(report.admission.u)
     trajectory = Trajectory.from_frames(times, states, applied, frames,
                                         [vertices_at(shapes, t) for t in times])
-    if not bodies.has_heading:
-        return trajectory
-    return replace(trajectory, heading=np.array(headings), q_body=np.array(q_body),
-                   body_command=np.array(held))
+    if bodies.has_heading:
+        trajectory = replace(trajectory, heading=np.array(headings), q_body=np.array(q_body),
+                             body_command=np.array(held))
+    return FixedStepRun(trajectory, model.counts, largest_u_hat, largest_velocity,
+                        model.delay_steps)
 
 
 def run_metrics(trajectory: Trajectory, config: FormationConfig, integrator: str) -> dict:
@@ -279,6 +340,15 @@ def run_metrics(trajectory: Trajectory, config: FormationConfig, integrator: str
                           config.reference().sample(float(trajectory.t[0])))})
     return compute_metrics(trajectory.t, trajectory.q, trajectory.u, trajectory.u_hat,
                            trajectory.q_desired, config.law().u_bound, extra)
+
+
+def plant_metrics(run: FixedStepRun, config: FormationConfig) -> dict:
+    """metrics.json keys of a ``--dt`` run: the bodies' imperfections and what they did."""
+    return {'imperfections': config.imperfections.as_dict(),
+            'state_delay_steps': run.delay_steps,
+            'max_abs_u_hat_sent': run.largest_u_hat,
+            'max_abs_body_velocity': run.largest_velocity.tolist(),
+            'plant_collisions': run.counts.collisions}
 
 
 def _limit(metrics: dict, name: str, unit: str) -> str:
@@ -446,7 +516,8 @@ def main(argv: Optional[list] = None) -> int:
               'formation_sim, plant, reference and robot')
         return 0
     duration = config.duration if args.duration is None else args.duration
-    problem = (run_length_problem(duration, args.dt, args.sample_dt)
+    problem = ((continuous_time_problem(config) if args.dt is None else None)
+               or run_length_problem(duration, args.dt, args.sample_dt)
                or prepare_out(args.out, args.overwrite, output_names(not args.no_plots)))
     if problem:
         print(f'formation_sim: {problem}', file=sys.stderr)
@@ -454,8 +525,14 @@ def main(argv: Optional[list] = None) -> int:
     sample_dt = DEFAULT_SAMPLE_DT if args.sample_dt is None else args.sample_dt
     integrator = 'RK45' if args.dt is None else f'zero-order hold, dt = {args.dt:g} s'
     progress = Progress(duration, quiet=args.quiet)
-    trajectory = simulate(config, duration, args.dt, sample_dt, progress)
-    metrics = run_metrics(trajectory, config, integrator)
+    if args.dt is None:
+        trajectory = simulate(config, duration, None, sample_dt, progress)
+        metrics = run_metrics(trajectory, config, integrator)
+    else:
+        run = run_fixed_step(config, duration, args.dt, sample_dt, progress)
+        trajectory = run.trajectory
+        metrics = run_metrics(trajectory, config, integrator)
+        metrics.update(plant_metrics(run, config))
     metrics['wall_time'] = progress.elapsed
     trajectory.save(os.path.join(args.out, TRAJECTORY_FILE))
     _copy_params(args.params, args.out)
