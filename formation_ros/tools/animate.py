@@ -107,7 +107,7 @@ def write_animation(trajectory: Trajectory, config: FormationConfig, out_dir: st
         raise AnimationError(f'cannot write {path}: {exc.strerror or exc}') from None
     trajectory = shaped(trajectory, config, events)
     dimension = '' if trajectory.dim == 2 else ', x-y projection'
-    title = (f'N = {trajectory.num_robots} {config.body.kind.value}s{dimension}, '
+    title = (f'{trajectory.num_robots} {config.body.kind.value} robots{dimension}, '
              f'{plan.speed:.3g} s of the run per second')
     scene = Scene(trajectory, config.sensing_radii, config.repulsion_radius, config.body.radius,
                   events, title, FIGURE_WIDTH)

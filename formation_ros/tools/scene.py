@@ -184,7 +184,8 @@ class Scene:
 
     def _draw_strip(self):
         strip, t = self.strip, self.trajectory.t
-        strip.set_xlim(float(t[0]), float(t[-1]) if t[-1] > t[0] else float(t[0]) + 1.0)
+        span = float(t[-1] - t[0]) if t[-1] > t[0] else 1.0
+        strip.set_xlim(float(t[0]) - 0.01 * span, float(t[0]) + 1.01 * span)
         strip.set_ylim(0.0, 1.0)
         strip.set_yticks([])
         strip.tick_params(axis='x', labelsize=6)
