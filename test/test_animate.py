@@ -10,7 +10,8 @@ import shutil
 
 from formation_ros.core.events import Event, EventKind
 from formation_ros.core.params import load_config
-from formation_ros.tools.animate import AnimationError, GIF, MAX_FRAMES, MP4, plan_frames
+from formation_ros.tools.animate import (AnimationError, GIF, MAX_FRAMES, MP4, plan_frames,
+                                         write_animation)
 from formation_ros.tools.report import main as report_main
 from formation_ros.tools.scene import Scene
 from formation_ros.tools.sim import (format_summary, main as sim_main, run_metrics, shaped,
@@ -230,3 +231,12 @@ def test_metrics_of_segments_only_with_events():
     brute = next(t for k, t in enumerate(trajectory.t[before]) if np.all(errors[k:] <= 0.05))
     assert any(line.startswith(f'  segment 0.00-2.50 s from the start: settled in {brute:.2f} s')
                for line in lines)
+
+
+def test_a_shape_of_another_team_is_refused_before_anything_is_written(tmp_path):
+    config = load_config(SQUARE)
+    trajectory = simulate(config, duration=1.0, dt=0.01, sample_dt=0.1)
+    three = [Event(0.5, EventKind.SHAPE, 'three', np.zeros((3, 2)))]
+    with pytest.raises(AnimationError, match="shape event 'three' at t = 0.5 s"):
+        write_animation(trajectory, config, str(tmp_path), three)
+    assert os.listdir(tmp_path) == []

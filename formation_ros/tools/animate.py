@@ -101,11 +101,14 @@ def write_animation(trajectory: Trajectory, config: FormationConfig, out_dir: st
     writer, is_mp4 = choose_writer(plan.fps)
     path = os.path.join(out_dir, MP4 if is_mp4 else GIF)
     try:
+        trajectory = shaped(trajectory, config, events)
+    except ValueError as exc:
+        raise AnimationError(str(exc)) from None
+    try:
         with open(path, 'wb'):
             pass
     except OSError as exc:
         raise AnimationError(f'cannot write {path}: {exc.strerror or exc}') from None
-    trajectory = shaped(trajectory, config, events)
     dimension = '' if trajectory.dim == 2 else ', x-y projection'
     title = (f'{trajectory.num_robots} {config.body.kind.value} robots{dimension}, '
              f'{plan.speed:.3g} s of the run per second')

@@ -233,7 +233,9 @@ def main(argv: Optional[list] = None) -> int:
         description='Metrics and figures of a recorded formation run.',
         epilog='Examples: formation_report runs/demo/bag --out runs/demo; '
                'formation_report runs/cut_bag --repair (a bag whose recorder was killed: '
-               'rewritten in place as a whole bag, the damaged files kept as *.damaged)')
+               'rewritten in place as a whole bag, the damaged files kept as *.damaged); '
+               'formation_report runs/demo/bag --out runs/demo --animate (and a GIF or MP4 '
+               'of the run)')
     parser.add_argument('input', help='rosbag2 directory (metadata.yaml + MCAP), .mcap file, '
                                       'or run directory with trajectory.npz and params.yaml')
     parser.add_argument('--out', help='where to write metrics.json and figures (required '
@@ -301,6 +303,8 @@ def main(argv: Optional[list] = None) -> int:
                                events=events)
     except OSError as exc:
         return _fail(f'cannot write the report to {args.out}: {exc.strerror or exc}')
+    except ValueError as exc:
+        return _fail(f'{args.input}: {_one_line(str(exc))}')
     print(f'formation_report: {args.input}')
     print(format_summary(metrics, args.out))
     if plan is not None:

@@ -17,7 +17,7 @@ of that background (blitting), which makes a frame several times cheaper than a 
 
 from typing import List, Sequence, Tuple, Union
 
-from formation_ros.core.events import Event, EventKind, shape_in_force, stopped_at
+from formation_ros.core.events import Event, EventKind, ordered, shape_in_force, stopped_at
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.tools.plots import (DESIRED_COLOR, HEADING_COLOR, heading_length, is_moving,
                                        polygon, REFERENCE_STYLE, REPULSION_COLOR, robot_color,
@@ -114,7 +114,7 @@ class Scene:
                  title: str, width: float):
         """Lay out the figure and every artist (nothing drawn yet)."""
         self.trajectory = trajectory
-        self.events = tuple(events)
+        self.events = ordered(events)
         self.shown = shown_robots(trajectory.num_robots)
         self.colors = [robot_color(int(i)) for i in self.shown]
         x_lim, y_lim = _limits(trajectory, repulsion_radius)
