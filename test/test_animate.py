@@ -9,10 +9,11 @@ import os
 import shutil
 
 from formation_ros.core.events import Event, EventKind
+from formation_ros.core.frames import stationary_frame
 from formation_ros.core.params import load_config
 from formation_ros.tools.animate import (AnimationError, GIF, MAX_FRAMES, MP4, plan_frames,
                                          write_animation)
-from formation_ros.tools.report import main as report_main
+from formation_ros.tools.report import main as report_main, write_report
 from formation_ros.tools.scene import Scene
 from formation_ros.tools.sim import (format_summary, main as sim_main, run_metrics, shaped,
                                      simulate)
@@ -219,8 +220,8 @@ def test_metrics_of_segments_only_with_events():
     assert min(s['min_pair_distance'] for s in metrics['segments']) == \
         plain['min_pair_distance']
     moved = config.vertices + np.array([3.0, 0.0])
-    switched = run_metrics(trajectory, config, 'x',
-                           [Event(2.5, EventKind.SHAPE, 'moved', moved)])
+    switch = [Event(2.5, EventKind.SHAPE, 'moved', moved)]
+    switched = run_metrics(shaped(trajectory, config, switch), config, 'x', switch)
     assert switched['final_max_error'] == pytest.approx(3.0, abs=0.05)
     assert switched['segments'][1]['settle_time'] is None
     lines = format_summary(switched).splitlines()
@@ -240,3 +241,19 @@ def test_a_shape_of_another_team_is_refused_before_anything_is_written(tmp_path)
     with pytest.raises(AnimationError, match="shape event 'three' at t = 0.5 s"):
         write_animation(trajectory, config, str(tmp_path), three)
     assert os.listdir(tmp_path) == []
+
+
+def test_the_report_writes_segments_and_places_shapes_by_the_frames_given(tmp_path):
+    config = load_config(SQUARE)
+    trajectory = simulate(config, duration=2.0, dt=0.01, sample_dt=0.1)
+    switch = [Event(1.0, EventKind.SHAPE, 'same', config.vertices)]
+    metrics = write_report(trajectory, config, str(tmp_path / 'a'), plots=False, events=switch)
+    written = json.loads((tmp_path / 'a' / 'metrics.json').read_text())
+    assert [s['label'] for s in written['segments']] == ['start of the run', 'same']
+    assert written['final_max_error'] == metrics['final_max_error'] == \
+        run_metrics(trajectory, config, 'x')['final_max_error']
+    away = [stationary_frame(2, origin=[10.0, 0.0], t=float(t)) for t in trajectory.t]
+    moved = write_report(trajectory, config, str(tmp_path / 'b'), plots=False, events=switch,
+                         frames=away)
+    final = np.linalg.norm(trajectory.q[-1] - (config.vertices + [10.0, 0.0]), axis=1)
+    assert moved['final_max_error'] == pytest.approx(np.max(final))

@@ -21,6 +21,7 @@ import sys
 from typing import Optional, Sequence, TextIO
 
 from formation_ros.core.events import Event
+from formation_ros.core.frames import FrameSample
 from formation_ros.core.params import FormationConfig
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.tools.sim import Progress, shaped
@@ -61,10 +62,10 @@ def plan_frames(times: ArrayLike, fps: float = DEFAULT_FPS, speed: Optional[floa
     Choose the frames of a run sampled at ``times`` (T,) in s.
 
     The K frames are at K times spaced evenly from the first sample to the last, each showing
-    the latest sample at or before its time; K = round(duration fps / speed) + 1, at most
-    ``max_frames`` and at most T. ``speed`` (simulated s per video s) defaults to real time,
-    or faster where the run would need more frames than that; a ``speed`` that needs more is
-    refused (AnimationError).
+    the latest sample at or before its time (within 1e-9 of the duration);
+    K = round(duration fps / speed) + 1, at most ``max_frames`` and at most T. ``speed``
+    (simulated s per video s) defaults to real time, or faster where the run would need more
+    frames than that; a ``speed`` that needs more is refused (AnimationError).
     """
     t = np.asarray(times, dtype=float)
     duration = float(t[-1] - t[0])
@@ -81,18 +82,22 @@ def plan_frames(times: ArrayLike, fps: float = DEFAULT_FPS, speed: Optional[floa
                              f'give --speed {slowest:.4g} or more (or a lower --fps)')
     count = max(2, min(limit, int(round(duration * fps / speed)) + 1))
     wanted = np.linspace(t[0], t[-1], count)
-    indices = np.clip(np.searchsorted(t, wanted, side='right') - 1, 0, len(t) - 1)
+    late = 1e-9 * duration
+    indices = np.clip(np.searchsorted(t, wanted + late, side='right') - 1, 0, len(t) - 1)
     return FramePlan(indices.astype(np.int64), float(fps), float(speed))
 
 
 def write_animation(trajectory: Trajectory, config: FormationConfig, out_dir: str,
                     events: Sequence[Event] = (), plan: Optional[FramePlan] = None,
                     dpi: float = DEFAULT_DPI, stream: TextIO = sys.stderr,
-                    name: str = 'formation_report', quiet: bool = False) -> str:
+                    name: str = 'formation_report', quiet: bool = False,
+                    frames: Optional[Sequence[FrameSample]] = None) -> str:
     """
     Write the animation of a run into ``out_dir``: :data:`MP4` or :data:`GIF`; return its path.
 
-    plan: from :func:`plan_frames` (default: its defaults); events: ``core.events``; progress
+    plan: from :func:`plan_frames` (default: its defaults); events: ``core.events``, the
+    shapes placed by ``frames`` (the reference at each sample; default: the configured
+    reference's, see ``sim.shaped``); progress
     lines '<name>: animation at t = ...' go to ``stream`` at most every 10 % of the run once
     the render takes over 2 s. AnimationError (one line) when the file cannot be written.
     """
@@ -101,7 +106,7 @@ def write_animation(trajectory: Trajectory, config: FormationConfig, out_dir: st
     writer, is_mp4 = choose_writer(plan.fps)
     path = os.path.join(out_dir, MP4 if is_mp4 else GIF)
     try:
-        trajectory = shaped(trajectory, config, events)
+        trajectory = shaped(trajectory, config, events, frames)
     except ValueError as exc:
         raise AnimationError(str(exc)) from None
     try:

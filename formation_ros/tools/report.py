@@ -35,6 +35,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from formation_ros.core.declarations import ParamError
 from formation_ros.core.events import Event
+from formation_ros.core.frames import FrameSample
 from formation_ros.core.params import FormationConfig, load_config, validate
 from formation_ros.core.params_file import parse_params_text
 from formation_ros.core.plant import PLANT_STATS_FILE
@@ -199,16 +200,18 @@ def check_out(out: str) -> Optional[str]:
 
 def write_report(trajectory: Trajectory, config: FormationConfig, out_dir: str,
                  extra: Optional[Dict[str, Any]] = None, plots: bool = True,
-                 events: Sequence[Event] = ()) -> dict:
+                 events: Sequence[Event] = (),
+                 frames: Optional[Sequence[FrameSample]] = None) -> dict:
     """
     Write metrics.json (and the figures) to ``out_dir``; return the metrics.
 
-    events (``core.events``): the desired formation is the shape in force, and metrics.json
-    gets the per-segment metrics under ``segments``.
+    events (``core.events``): the desired formation is the shape in force (placed by
+    ``frames``, the reference at each sample; default the configured one's), and metrics.json
+    gets the per-segment metrics under ``segments``. ValueError when a shape does not fit.
     """
     extra = dict(extra or {})
     integrator = extra.pop('integrator', 'recorded run')
-    trajectory = shaped(trajectory, config, events)
+    trajectory = shaped(trajectory, config, events, frames)
     metrics = run_metrics(trajectory, config, integrator, events)
     metrics.update(extra)
     os.makedirs(out_dir, exist_ok=True)

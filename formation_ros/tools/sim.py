@@ -29,7 +29,7 @@ from formation_ros.core.bodies import make_bodies
 from formation_ros.core.declarations import (CommandFrame, DEFAULT_COLLISION_DISTANCE, Exe,
                                              ParamError)
 from formation_ros.core.events import Event, EventKind, with_shapes
-from formation_ros.core.frames import desired_positions
+from formation_ros.core.frames import desired_positions, FrameSample
 from formation_ros.core.law import team_command
 from formation_ros.core.metrics import body_metrics, compute_metrics, segment_metrics
 from formation_ros.core.params import (FormationConfig, load_config,
@@ -232,18 +232,21 @@ def simulate_fixed_step(config: FormationConfig, duration: float, dt: float,
                    body_command=np.array(held))
 
 
-def shaped(trajectory: Trajectory, config: FormationConfig,
-           events: Sequence[Event]) -> Trajectory:
+def shaped(trajectory: Trajectory, config: FormationConfig, events: Sequence[Event],
+           frames: Optional[Sequence[FrameSample]] = None) -> Trajectory:
     """
     Return the trajectory with its desired positions from the shape in force at each sample.
 
-    The reference frames are the configured reference's at the sample times
-    (``events.with_shapes``); the trajectory itself when no event is a shape.
+    frames: the reference at each sample (e.g. as recorded in a bag); default: the configured
+    reference's (``events.with_shapes``). The trajectory itself when no event is a shape;
+    ValueError when a shape does not fit the team.
     """
     if not any(event.kind is EventKind.SHAPE for event in events):
         return trajectory
-    reference = config.reference()
-    return with_shapes(trajectory, events, [reference.sample(float(t)) for t in trajectory.t])
+    if frames is None:
+        reference = config.reference()
+        frames = [reference.sample(float(t)) for t in trajectory.t]
+    return with_shapes(trajectory, events, frames)
 
 
 def run_metrics(trajectory: Trajectory, config: FormationConfig, integrator: str,
@@ -251,10 +254,10 @@ def run_metrics(trajectory: Trajectory, config: FormationConfig, integrator: str
     """
     metrics.json content for a simulated or recorded trajectory.
 
-    With events (``core.events``) the errors are against the shape in force and the key
-    ``segments`` holds :func:`core.metrics.segment_metrics`; without, it is left out.
+    With events (``core.events``) the key ``segments`` holds
+    :func:`core.metrics.segment_metrics`; without, it is left out. The errors are against
+    ``trajectory.q_desired``: give a trajectory of :func:`shaped` for the shape in force.
     """
-    trajectory = shaped(trajectory, config, events)
     extra = {'reference_kind': config.reference_kind.value, 'integrator': integrator}
     if trajectory.q_body is not None and trajectory.body_command is not None:
         body = config.body
