@@ -20,6 +20,7 @@ PACKAGE = 'formation_ros'
 # Imports whose rosdep key differs from the module name; a ROS package is imported by its name.
 ROSDEP_KEYS = {
     'matplotlib': 'python3-matplotlib',
+    'PIL': 'python3-pil',
     'numpy': 'python3-numpy',
     'scipy': 'python3-scipy',
     'yaml': 'python3-yaml',

@@ -9,8 +9,10 @@ Inputs are sampled trajectories: t (T,) in s, q and q_desired (T, N, dim) in m, 
 """
 
 import math
-from typing import Any, Mapping, Optional
+from typing import Any, List, Mapping, Optional, Sequence
 
+from formation_ros.core.events import Event, segments
+from formation_ros.core.trajectory import Trajectory
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial import cKDTree
@@ -137,3 +139,45 @@ def body_metrics(q_body: ArrayLike, body_command: ArrayLike, u_bound: float,
         'v_bound': v_bound,
         'omega_bound': v_bound / hand_distance,
     }
+
+
+def segment_metrics(trajectory: Trajectory, events: Sequence[Event],
+                    tolerance: float = SETTLE_TOLERANCE) -> List[dict[str, Any]]:
+    """
+    Return the metrics of each segment of the run between its events (``core.events``).
+
+    One dictionary per segment, in time order; [] without events. Keys: ``start``, ``end`` (s);
+    ``kind`` (the opening event's kind value, None before the first event) and ``label``;
+    ``num_samples``; ``settle_time``: s after ``start`` from which every error stays <=
+    ``tolerance`` to the segment's end (as :func:`settle_time` on the segment's samples; None
+    if it never does); ``min_pair_distance``: closest approach of two control points (m);
+    ``min_body_distance`` for unicycles: of two axle centres (m); ``max_abs_u_hat_component``
+    (m/s) and ``final_max_error`` (m, at the segment's last sample). A segment without samples
+    has None for the measured values. The errors are against ``trajectory.q_desired``: pass the
+    trajectory of ``events.with_shapes`` for the shape in force.
+    """
+    errors = formation_errors(trajectory.q, trajectory.q_desired)
+    times = np.asarray(trajectory.t, dtype=float)
+    rows = []
+    for part in segments(times, events):
+        row: dict[str, Any] = {
+            'start': part.start, 'end': part.end,
+            'kind': None if part.opened_by is None else part.opened_by.kind.value,
+            'label': 'start of the run' if part.opened_by is None else part.opened_by.label,
+            'num_samples': part.stop - part.first,
+            'settle_time': None, 'min_pair_distance': None,
+            'max_abs_u_hat_component': None, 'final_max_error': None}
+        if trajectory.q_body is not None:
+            row['min_body_distance'] = None
+        if part.stop > part.first:
+            span = slice(part.first, part.stop)
+            settled = settle_time(times[span], errors[span], tolerance)
+            row.update({
+                'settle_time': None if settled is None else settled - part.start,
+                'min_pair_distance': float(np.min(dis_min_series(trajectory.q[span]))),
+                'max_abs_u_hat_component': float(np.max(np.abs(trajectory.u_hat[span]))),
+                'final_max_error': float(np.max(errors[part.stop - 1]))})
+            if trajectory.q_body is not None:
+                row['min_body_distance'] = float(np.min(dis_min_series(trajectory.q_body[span])))
+        rows.append(row)
+    return rows

@@ -24,30 +24,57 @@ THICK = 2.2
 HEADING_MARKS = 12
 """Bodies drawn along each unicycle's path, at equal intervals of time."""
 MAX_HEADING_ROBOTS = 30
+DESIRED_COLOR = 'tab:red'
+HEADING_COLOR = 'tab:green'
+REPULSION_COLOR = 'tab:blue'
+FIRST_ROBOT_COLOR = 'k'
+REFERENCE_STYLE = {'color': '0.6', 'linestyle': '--', 'linewidth': 1.0}
+"""How the reference path q_od is drawn."""
+HEADING_SPAN = 0.04
+"""Length of a heading arrow, as a fraction of the larger side of the paths' bounding box."""
 
 
-def _polygon(points):
+def polygon(points):
+    """Close a polygon: the points (N, dim) and the first one again, (N + 1, dim)."""
     return np.vstack([points, points[:1]])
+
+
+def shown_robots(num_robots):
+    """Return the robots whose paths are drawn (indices): all, or MAX_PATHS spread over N."""
+    return np.unique(np.linspace(0, num_robots - 1, min(num_robots, MAX_PATHS)).astype(int))
+
+
+def robot_color(index):
+    """Return the colour of robot ``index`` (0-based): robot 1 black, then the cycle C0, C1, ..."""
+    return FIRST_ROBOT_COLOR if index == 0 else f'C{(index - 1) % 10}'
+
+
+def is_moving(traj):
+    """Tell whether the reference centre q_od moves during the run."""
+    return bool(np.ptp(traj.q_od, axis=0).max() > 1e-9)
+
+
+def heading_length(traj):
+    """Length of the heading arrows of a run, m (HEADING_SPAN of its paths' extent)."""
+    span = max(float(np.ptp(traj.q[..., 0])), float(np.ptp(traj.q[..., 1])), 1e-9)
+    return HEADING_SPAN * span
 
 
 def plot_trajectories(traj, path, title='Trajectories'):
     """Paths, start (o) and end (x) points, the desired formation polygon, the reference path."""
     q, desired = traj.q, traj.q_desired
     n = traj.num_robots
-    shown = np.unique(np.linspace(0, n - 1, min(n, MAX_PATHS)).astype(int))
+    shown = shown_robots(n)
     fig = plt.figure(figsize=(7, 6.5))
     three_d = traj.dim == 3
     ax = fig.add_subplot(111, projection='3d' if three_d else None)
     coords = (lambda pts: (pts[..., 0], pts[..., 1], pts[..., 2])) if three_d else \
         (lambda pts: (pts[..., 0], pts[..., 1]))
-    moving = np.ptp(traj.q_od, axis=0).max() > 1e-9
-    if moving:
-        ax.plot(*coords(traj.q_od), color='0.6', linestyle='--', linewidth=1.0,
-                label='reference path q_od')
+    if is_moving(traj):
+        ax.plot(*coords(traj.q_od), **REFERENCE_STYLE, label='reference path q_od')
     for i in shown:
-        ax.plot(*coords(q[:, i]), linewidth=THICK if i == 0 else 0.7,
-                color='k' if i == 0 else None)
-    ax.plot(*coords(_polygon(desired[-1])), color='tab:red', linewidth=1.2,
+        ax.plot(*coords(q[:, i]), linewidth=THICK if i == 0 else 0.7, color=robot_color(i))
+    ax.plot(*coords(polygon(desired[-1])), color=DESIRED_COLOR, linewidth=1.2,
             label='desired formation (end)')
     if traj.heading is not None and traj.q_body is not None:
         _draw_headings(ax, traj, shown)
@@ -77,11 +104,10 @@ def _draw_headings(ax, traj, shown):
     robots = shown[:MAX_HEADING_ROBOTS]
     q_body = traj.q_body[np.ix_(marks, robots)]
     heading = traj.heading[np.ix_(marks, robots)]
-    span = max(float(np.ptp(traj.q[..., 0])), float(np.ptp(traj.q[..., 1])), 1e-9)
-    length = 0.04 * span
+    length = heading_length(traj)
     ax.quiver(q_body[..., 0].ravel(), q_body[..., 1].ravel(),
               length * np.cos(heading).ravel(), length * np.sin(heading).ravel(),
-              angles='xy', scale_units='xy', scale=1.0, width=0.004, color='tab:green',
+              angles='xy', scale_units='xy', scale=1.0, width=0.004, color=HEADING_COLOR,
               label=f'body and heading ({len(marks)} times)')
 
 
@@ -100,7 +126,7 @@ def plot_distances(traj, law, path):
     t_all, values = dis_all_series(t, q)
     if len(values):
         top.plot(t_all, values, color='k', linewidth=THICK, label='dis_all (geometric mean)')
-    top.axhline(law.repulsion_radius, color='tab:blue', linestyle=':', label='b')
+    top.axhline(law.repulsion_radius, color=REPULSION_COLOR, linestyle=':', label='b')
     top.set_ylabel('distance [m]')
     top.set_yscale('log')
     top.legend(fontsize=8)
@@ -117,7 +143,7 @@ def plot_distances(traj, law, path):
 def plot_controls(traj, u_bound, path):
     """Components of u_hat (robot 1 thick, envelope of all robots) against +-c M1 (Fig. 1 B)."""
     t = traj.t
-    tracking = np.ptp(traj.q_od, axis=0).max() > 1e-9
+    tracking = is_moving(traj)
     rows = 2 if tracking else 1
     fig, axes = plt.subplots(rows, 1, figsize=(8, 3.6 * rows), sharex=True, squeeze=False)
     series = [('u_hat (bounded, eq. 14)', traj.u_hat)]

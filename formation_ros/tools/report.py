@@ -17,6 +17,9 @@ They are computed by the same code as ``formation_sim``. Input:
 * or a run directory holding ``trajectory.npz`` and ``params.yaml`` (``formation_sim`` output,
   or ``launch_formation.sh --out``; a ``plant_stats.json`` there is merged into the metrics).
 
+``--animate`` writes ``animation.mp4`` (ffmpeg on PATH) or ``animation.gif`` of the run
+(``tools.animate``) beside metrics.json, with or without the figures.
+
 Unreadable input, or an ``--out`` that cannot be written, ends with exit code 2 and one line
 that says what is wrong.
 """
@@ -24,20 +27,27 @@ that says what is wrong.
 import argparse
 from dataclasses import replace
 import json
+import math
 import os
 import sys
-from typing import Any, Dict, List, Optional, Tuple
+import time
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from formation_ros.core.declarations import ParamError
+from formation_ros.core.events import Event
+from formation_ros.core.frames import FrameSample
 from formation_ros.core.params import FormationConfig, load_config, validate
 from formation_ros.core.params_file import parse_params_text
 from formation_ros.core.plant import PLANT_STATS_FILE
 from formation_ros.core.trajectory import CHUNKS_DIR, read_body_chunks, read_chunks, Trajectory
 from formation_ros.ros import topics as names
 from formation_ros.ros.bag_writer import BagError, PARAMS_FILE
+from formation_ros.tools.animate import (AnimationError, DEFAULT_DPI, DEFAULT_FPS, describe,
+                                         FIGURE_WIDTH, GIF, MAX_FRAMES, MP4, plan_frames,
+                                         write_animation)
 from formation_ros.tools.bag import (bag_params_text, mcap_files, METADATA, plant_status,
                                      read_or_recover, repair_bag, trajectory_from_topics)
-from formation_ros.tools.sim import format_summary, run_metrics
+from formation_ros.tools.sim import format_summary, run_metrics, shaped
 
 Loaded = Tuple[Trajectory, FormationConfig, Dict[str, Any]]
 
@@ -189,11 +199,20 @@ def check_out(out: str) -> Optional[str]:
 
 
 def write_report(trajectory: Trajectory, config: FormationConfig, out_dir: str,
-                 extra: Optional[Dict[str, Any]] = None, plots: bool = True) -> dict:
-    """Write metrics.json (and the figures) to ``out_dir``; return the metrics."""
+                 extra: Optional[Dict[str, Any]] = None, plots: bool = True,
+                 events: Sequence[Event] = (),
+                 frames: Optional[Sequence[FrameSample]] = None) -> dict:
+    """
+    Write metrics.json (and the figures) to ``out_dir``; return the metrics.
+
+    events (``core.events``): the desired formation is the shape in force (placed by
+    ``frames``, the reference at each sample; default the configured one's), and metrics.json
+    gets the per-segment metrics under ``segments``. ValueError when a shape does not fit.
+    """
     extra = dict(extra or {})
     integrator = extra.pop('integrator', 'recorded run')
-    metrics = run_metrics(trajectory, config, integrator)
+    trajectory = shaped(trajectory, config, events, frames)
+    metrics = run_metrics(trajectory, config, integrator, events)
     metrics.update(extra)
     os.makedirs(out_dir, exist_ok=True)
     with open(os.path.join(out_dir, 'metrics.json'), 'w', encoding='utf-8') as stream:
@@ -217,7 +236,9 @@ def main(argv: Optional[list] = None) -> int:
         description='Metrics and figures of a recorded formation run.',
         epilog='Examples: formation_report runs/demo/bag --out runs/demo; '
                'formation_report runs/cut_bag --repair (a bag whose recorder was killed: '
-               'rewritten in place as a whole bag, the damaged files kept as *.damaged)')
+               'rewritten in place as a whole bag, the damaged files kept as *.damaged); '
+               'formation_report runs/demo/bag --out runs/demo --animate (and a GIF or MP4 '
+               'of the run)')
     parser.add_argument('input', help='rosbag2 directory (metadata.yaml + MCAP), .mcap file, '
                                       'or run directory with trajectory.npz and params.yaml')
     parser.add_argument('--out', help='where to write metrics.json and figures (required '
@@ -227,9 +248,31 @@ def main(argv: Optional[list] = None) -> int:
                              'whole again in place, keeping the damaged files as *.damaged; '
                              'then report if --out is given')
     parser.add_argument('--no-plots', action='store_true', help='skip the figures')
+    parser.add_argument('--animate', action='store_true',
+                        help=f'also write {MP4} or {GIF} of the run (mp4 where an ffmpeg '
+                             'executable is on PATH, else a GIF through Pillow)')
+    parser.add_argument('--fps', type=float, default=DEFAULT_FPS,
+                        help=f'frames per second of the animation (default {DEFAULT_FPS:g}; '
+                             'a GIF holds each frame a whole number of 1/100 s)')
+    parser.add_argument('--speed', type=float,
+                        help='simulated seconds per second of animation (default: real time, '
+                             f'faster where the run would need more than {MAX_FRAMES} frames)')
+    parser.add_argument('--max-frames', type=int, default=MAX_FRAMES,
+                        help=f'at most this many frames, 2 to {MAX_FRAMES} (default '
+                             f'{MAX_FRAMES}); never more than the run has samples')
+    parser.add_argument('--dpi', type=float, default=DEFAULT_DPI,
+                        help=f'resolution of the animation: {FIGURE_WIDTH:g} inches wide '
+                             f'at this many dots per inch (default {DEFAULT_DPI}), 20 to 300')
     args = parser.parse_args(argv)
     if args.out is None and not args.repair:
         parser.error('the following arguments are required: --out (or give --repair)')
+    for option, value, low, high in (('--fps', args.fps, 0.0, 100.0),
+                                     ('--speed', args.speed, 0.0, math.inf),
+                                     ('--dpi', args.dpi, 19.999, 300.0)):
+        if value is not None and not (math.isfinite(value) and low < value <= high):
+            parser.error(f'{option} must be a number in ({low:g}, {high:g}], got {value}')
+    if not 2 <= args.max_frames <= MAX_FRAMES:
+        parser.error(f'--max-frames must be 2 to {MAX_FRAMES}, got {args.max_frames}')
     if args.out is not None:
         problem = check_out(args.out)
         if problem is not None:
@@ -251,12 +294,29 @@ def main(argv: Optional[list] = None) -> int:
         return _fail(_one_line(str(exc)))
     for note in notes:
         print(f'formation_report: {note}', file=sys.stderr)
+    events: Tuple[Event, ...] = ()
+    plan = None
+    if args.animate:
+        try:
+            plan = plan_frames(trajectory.t, args.fps, args.speed, args.max_frames)
+        except AnimationError as exc:
+            return _fail(str(exc))
     try:
-        metrics = write_report(trajectory, config, args.out, extra, plots=not args.no_plots)
+        metrics = write_report(trajectory, config, args.out, extra, plots=not args.no_plots,
+                               events=events)
     except OSError as exc:
         return _fail(f'cannot write the report to {args.out}: {exc.strerror or exc}')
+    except ValueError as exc:
+        return _fail(f'{args.input}: {_one_line(str(exc))}')
     print(f'formation_report: {args.input}')
     print(format_summary(metrics, args.out))
+    if plan is not None:
+        start = time.monotonic()
+        try:
+            path = write_animation(trajectory, config, args.out, events, plan, args.dpi)
+        except AnimationError as exc:
+            return _fail(str(exc))
+        print(f'  {describe(path, plan, time.monotonic() - start)}')
     return 0
 
 

@@ -34,9 +34,10 @@ from typing import Callable, Optional, Sequence, TextIO, Tuple
 from formation_ros.core.bodies import make_bodies
 from formation_ros.core.declarations import (CommandFrame, DEFAULT_COLLISION_DISTANCE, Exe,
                                              ParamError)
-from formation_ros.core.frames import desired_positions
+from formation_ros.core.events import Event, EventKind, with_shapes
+from formation_ros.core.frames import desired_positions, FrameSample
 from formation_ros.core.law import team_command
-from formation_ros.core.metrics import body_metrics, compute_metrics
+from formation_ros.core.metrics import body_metrics, compute_metrics, segment_metrics
 from formation_ros.core.params import (FormationConfig, load_config,
                                        validate_for_every_executable)
 from formation_ros.core.params_file import load_params_file
@@ -59,11 +60,14 @@ PARAMS_COPY = 'params.yaml'
 class Progress:
     """Prints how far a long run is, at most every 10 % of simulated time, once past 2 s wall."""
 
-    def __init__(self, duration: float, stream: TextIO = sys.stderr, quiet: bool = False):
-        """Track a run of ``duration`` simulated seconds."""
+    def __init__(self, duration: float, stream: TextIO = sys.stderr, quiet: bool = False,
+                 name: str = 'formation_sim', what: str = 't'):
+        """Track a run of ``duration`` simulated seconds; lines read '<name>: <what> = ...'."""
         self.duration = duration
         self.stream = stream
         self.quiet = quiet
+        self.name = name
+        self.what = what
         self.start = time.monotonic()
         self.next_mark = 0.1
 
@@ -75,7 +79,7 @@ class Progress:
         elapsed = time.monotonic() - self.start
         self.next_mark = math.floor(fraction * 10.0 + 1.0) / 10.0
         if elapsed > 2.0:
-            print(f'formation_sim: t = {t:.2f} / {self.duration:.2f} s '
+            print(f'{self.name}: {self.what} = {t:.2f} / {self.duration:.2f} s '
                   f'({100.0 * fraction:.0f} %), {elapsed:.1f} s elapsed',
                   file=self.stream, flush=True)
 
@@ -327,8 +331,32 @@ def run_fixed_step(config: FormationConfig, duration: float, dt: float, sample_d
                         model.delay_steps)
 
 
-def run_metrics(trajectory: Trajectory, config: FormationConfig, integrator: str) -> dict:
-    """metrics.json content for a simulated trajectory."""
+def shaped(trajectory: Trajectory, config: FormationConfig, events: Sequence[Event],
+           frames: Optional[Sequence[FrameSample]] = None) -> Trajectory:
+    """
+    Return the trajectory with its desired positions from the shape in force at each sample.
+
+    frames: the reference at each sample (e.g. as recorded in a bag); default: the configured
+    reference's (``events.with_shapes``). The trajectory itself when no event is a shape;
+    ValueError when a shape does not fit the team.
+    """
+    if not any(event.kind is EventKind.SHAPE for event in events):
+        return trajectory
+    if frames is None:
+        reference = config.reference()
+        frames = [reference.sample(float(t)) for t in trajectory.t]
+    return with_shapes(trajectory, events, frames)
+
+
+def run_metrics(trajectory: Trajectory, config: FormationConfig, integrator: str,
+                events: Sequence[Event] = ()) -> dict:
+    """
+    metrics.json content for a simulated or recorded trajectory.
+
+    With events (``core.events``) the key ``segments`` holds
+    :func:`core.metrics.segment_metrics`; without, it is left out. The errors are against
+    ``trajectory.q_desired``: give a trajectory of :func:`shaped` for the shape in force.
+    """
     extra = {'reference_kind': config.reference_kind.value, 'integrator': integrator}
     if trajectory.q_body is not None and trajectory.body_command is not None:
         body = config.body
@@ -338,8 +366,11 @@ def run_metrics(trajectory: Trajectory, config: FormationConfig, integrator: str
                       'guaranteed_min_hand_point_distance': guaranteed_min_distance(
                           trajectory.q[0], config.vertices, config.law(),
                           config.reference().sample(float(trajectory.t[0])))})
-    return compute_metrics(trajectory.t, trajectory.q, trajectory.u, trajectory.u_hat,
-                           trajectory.q_desired, config.law().u_bound, extra)
+    metrics = compute_metrics(trajectory.t, trajectory.q, trajectory.u, trajectory.u_hat,
+                              trajectory.q_desired, config.law().u_bound, extra)
+    if events:
+        metrics['segments'] = segment_metrics(trajectory, events)
+    return metrics
 
 
 def plant_metrics(run: FixedStepRun, config: FormationConfig) -> dict:
@@ -354,6 +385,26 @@ def plant_metrics(run: FixedStepRun, config: FormationConfig) -> dict:
 def _limit(metrics: dict, name: str, unit: str) -> str:
     value = metrics.get(name)
     return '' if value is None else f', body.{name} = {value:g} {unit}'
+
+
+def _measured(value: Optional[float], unit: str) -> str:
+    return 'none' if value is None else f'{value:.4g} {unit}'
+
+
+def _segment_line(segment: dict) -> str:
+    """One summary line of a segment of ``core.metrics.segment_metrics``."""
+    opened = ('from the start' if segment['kind'] is None
+              else f"after {segment['kind']} '{segment['label']}'")
+    settle = segment['settle_time']
+    settled = ('not settled' if settle is None else f'settled in {settle:.2f} s')
+    body = ('' if 'min_body_distance' not in segment
+            else f", bodies {_measured(segment['min_body_distance'], 'm')}")
+    if not segment['num_samples']:
+        settled = 'no sample'
+    return (f"  segment {segment['start']:.2f}-{segment['end']:.2f} s {opened}: {settled}, "
+            f"closest {_measured(segment['min_pair_distance'], 'm')}{body}, max |u_hat| "
+            f"{_measured(segment['max_abs_u_hat_component'], 'm/s')}, final max error "
+            f"{_measured(segment['final_max_error'], 'm')}")
 
 
 def format_summary(metrics: dict, out_dir: Optional[str] = None) -> str:
@@ -387,6 +438,7 @@ def format_summary(metrics: dict, out_dir: Optional[str] = None) -> str:
             f"max |w|: {metrics['max_abs_omega']:.4g} rad/s (sqrt(2) c M1 / l = "
             f"{metrics['omega_bound']:.4g} rad/s{_limit(metrics, 'max_angular', 'rad/s')})",
         ]
+    lines += [_segment_line(segment) for segment in metrics.get('segments', ())]
     if out_dir:
         lines.append(f'  results in {out_dir}')
     return '\n'.join(lines)
