@@ -14,9 +14,10 @@ first opens at the first sample (opened by no event) unless an event is at or be
 from dataclasses import dataclass
 import enum
 import math
-from typing import List, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from formation_ros.core.frames import desired_positions, FrameSample
+from formation_ros.core.timeline import Mode, NS_PER_S, Shape, TeamState, Timeline
 from formation_ros.core.trajectory import Trajectory
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -95,6 +96,15 @@ def stopped_at(events: Sequence[Event], t: float) -> bool:
     return latest is not None and latest.kind is EventKind.STOP
 
 
+def check_fit(events: Sequence[Event], num_robots: int, dim: int) -> None:
+    """Raise ValueError for a shape event whose vertices are not (num_robots, dim)."""
+    for event in events:
+        if event.vertices is not None and event.vertices.shape != (num_robots, dim):
+            raise ValueError(f"shape event '{event.label}' at t = {event.t:g} s has vertices "
+                             f'{event.vertices.shape}, the run has {num_robots} robots in '
+                             f'{dim}D')
+
+
 def with_shapes(trajectory: Trajectory, events: Sequence[Event],
                 frames: Sequence[FrameSample]) -> Trajectory:
     """
@@ -108,13 +118,7 @@ def with_shapes(trajectory: Trajectory, events: Sequence[Event],
     shapes = [event for event in ordered(events) if event.kind is EventKind.SHAPE]
     if not shapes:
         return trajectory
-    expected = (trajectory.num_robots, trajectory.dim)
-    for event in shapes:
-        assert event.vertices is not None
-        if event.vertices.shape != expected:
-            raise ValueError(f"shape event '{event.label}' at t = {event.t:g} s has vertices "
-                             f'{event.vertices.shape}, the run has {expected[0]} robots in '
-                             f'{expected[1]}D')
+    check_fit(shapes, trajectory.num_robots, trajectory.dim)
     if len(frames) != len(trajectory.t):
         raise ValueError(f'{len(frames)} reference frames for {len(trajectory.t)} samples')
     desired = np.array(trajectory.q_desired, dtype=float)
@@ -165,3 +169,45 @@ def segments(times: ArrayLike, events: Sequence[Event]) -> List[Segment]:
     ends = [start for start, _ in openers[1:]] + [float(t[-1])]
     return [Segment(float(start), float(end), event, cut[k], max(cut[k], cut[k + 1]))
             for k, ((start, event), end) in enumerate(zip(openers, ends))]
+
+
+def timeline_events(shapes: Timeline[Shape], states: Timeline[TeamState]) -> Tuple[Event, ...]:
+    """
+    Return the events of a run's timelines: each shape switch, each stop and start.
+
+    A change that changes nothing (the reference's first shape when it is the file's, a status
+    that keeps the mode) is not an event. Times are the changes' stamps in s.
+    """
+    events = []
+    previous = shapes.initial
+    for stamp, shape in shapes.changes():
+        if not shape.same_as(previous):
+            events.append(Event(stamp / NS_PER_S, EventKind.SHAPE, shape.name or 'new shape',
+                                shape.vertices))
+        previous = shape
+    mode = states.initial.mode
+    for stamp, state in states.changes():
+        if state.mode is not mode:
+            kind = EventKind.STOP if state.mode is Mode.STOPPED else EventKind.START
+            events.append(Event(stamp / NS_PER_S, kind, kind.value))
+        mode = state.mode
+    return ordered(events)
+
+
+def event_records(events: Sequence[Event]) -> List[Dict[str, Any]]:
+    """Return the events as JSON-ready dicts (t, kind, label, vertices), e.g. for plant_stats."""
+    return [{'t': event.t, 'kind': event.kind.value, 'label': event.label,
+             'vertices': None if event.vertices is None else event.vertices.tolist()}
+            for event in events]
+
+
+def events_from_records(records: Any) -> Tuple[Event, ...]:
+    """Inverse of :func:`event_records`; ValueError when the records are not events."""
+    if not isinstance(records, list):
+        raise ValueError('events must be a list')
+    try:
+        return ordered([Event(float(record['t']), EventKind(record['kind']),
+                              str(record['label']), record.get('vertices'))
+                        for record in records])
+    except (KeyError, TypeError) as exc:
+        raise ValueError(f'not an event record ({exc})') from None

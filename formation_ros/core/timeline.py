@@ -102,6 +102,11 @@ class Timeline(Generic[Value]):
         return self._values[bisect.bisect_right(self._stamps, stamp_ns) - 1]
 
     @property
+    def initial(self) -> Value:
+        """Return the value in force before every change."""
+        return self._values[0]
+
+    @property
     def latest(self) -> Value:
         """Return the value of the latest change."""
         return self._values[-1]
@@ -142,6 +147,15 @@ class ReferenceTimeline:
     def sample(self, t: float) -> FrameSample:
         """Return the frame at t in s, from the reference in force then."""
         return self.at(int(round(t * NS_PER_S))).sample(t)
+
+
+def named_shape(vertices: NDArray[np.float64],
+                shapes: Mapping[str, NDArray[np.float64]]) -> Shape:
+    """Return the shape of these vertices, named after the named shape they are ('' if none)."""
+    for name, known in shapes.items():
+        if known.shape == vertices.shape and np.array_equal(known, vertices):
+            return Shape(name, vertices)
+    return Shape('', vertices)
 
 
 def scheduled_shapes(initial: Shape, schedule: Sequence[Tuple[float, str]],

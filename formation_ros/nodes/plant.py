@@ -42,6 +42,7 @@ from typing import Any, Dict, List, Optional
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.bodies import make_bodies
 from formation_ros.core.declarations import CommandFrame, Exe
+from formation_ros.core.events import event_records, timeline_events
 from formation_ros.core.frames import desired_positions
 from formation_ros.core.plant import (Commands, CommandStatus, DurationHistogram, NS_PER_S,
                                       PLANT_STATS_FILE, PlantModel, StepReport)
@@ -461,7 +462,8 @@ class PlantNode(Node):
                                     self.reference.sample(self.model.t))
         self.marker_pub.publish(formation_markers(
             self.model.q, self.config.sensing_radii, self.law.repulsion_radius, desired,
-            self.paths, self.model.t_ns, self.config.world_frame))
+            self.paths, self.model.t_ns, self.config.world_frame,
+            self.model.heading if self.unicycles else None))
 
     def trajectory(self) -> Optional[Trajectory]:
         """Return the run written so far (``plant.output_dir``): a sample per published state."""
@@ -507,6 +509,8 @@ class PlantNode(Node):
         stats.update(totals)
         stats['held_steps'] = self.held_steps
         stats['shape_changes'] = len(self.changes.shapes.changes())
+        stats['events'] = event_records(timeline_events(self.changes.shapes,
+                                                        self.changes.states))
         stats['imperfections'] = self.config.imperfections.as_dict()
         stats['state_delay_steps'] = self.model.delay_steps
         stats['oldest_command_counted'] = counts.oldest_counted_ns / NS_PER_S

@@ -17,7 +17,8 @@ from typing import Any, Callable, List
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.declarations import ParamError
 from formation_ros.core.params import check_shape, FormationConfig
-from formation_ros.core.timeline import Mode, ReferenceTimeline, Shape, TeamState, Timeline
+from formation_ros.core.timeline import (Mode, named_shape, ReferenceTimeline, Shape, TeamState,
+                                         Timeline)
 from formation_ros.ros import fields, qos, topics
 from formation_ros.ros.messages import team_state_of
 from formation_ros.ros.wake import Wake
@@ -85,18 +86,11 @@ class Changes:
             self.reject('shape', f'a shape the law cannot hold ({exc})')
             return None
         since = fields.stamp_to_ns(msg.header.stamp)
-        shape = Shape(self.shape_name(vertices), vertices)
+        shape = named_shape(vertices, self.config.shapes)
         if since == 0 and not shape.same_as(self.own):
             self.differs = True
         self.shapes.add(since, shape)
         return shape
-
-    def shape_name(self, vertices: Any) -> str:
-        """Return the name of the file's shape with these vertices ('' if none)."""
-        for name, known in self.config.shapes.items():
-            if Shape(name, known).same_as(Shape('', vertices)):
-                return name
-        return ''
 
     def _state(self, msg: DiagnosticArray) -> Any:
         try:

@@ -22,6 +22,8 @@ from visualization_msgs.msg import Marker, MarkerArray
 
 ROBOT_DIAMETER = 0.2
 DISC_THICKNESS = 0.01
+HEADING_LENGTH = 0.3
+"""Length of the line that shows a unicycle's heading in RViz, m."""
 
 
 def _point(row):
@@ -83,13 +85,14 @@ class Paths:
 
 
 def formation_markers(q, sensing_radii, repulsion_radius, desired, paths, stamp_ns,
-                      frame_id=WORLD_FRAME):
+                      frame_id=WORLD_FRAME, headings=None):
     """
     Build the MarkerArray of one moment.
 
     q: (N, dim) positions; sensing_radii: (N,); repulsion_radius: b; desired: (N, dim) desired
-    positions; paths: the robots' recent positions (:class:`Paths`); stamp_ns: time; frame_id:
-    the world frame (``world_frame``).
+    positions of the shape in force; paths: the robots' recent positions (:class:`Paths`);
+    stamp_ns: time; frame_id: the world frame (``world_frame``); headings: (N,) rad of
+    unicycles, drawn as a line :data:`HEADING_LENGTH` long from each body (None: none).
     """
     dim = q.shape[1]
     array = MarkerArray()
@@ -106,6 +109,14 @@ def formation_markers(q, sensing_radii, repulsion_radius, desired, paths, stamp_
     polygon.scale.x = 0.04
     polygon.points = [_point(row) for row in desired] + [_point(desired[0])]
     array.markers.append(polygon)
+    if headings is not None:
+        ahead = _marker('headings', 0, Marker.LINE_LIST, stamp_ns, (0.1, 0.6, 0.2, 1.0),
+                        frame_id)
+        ahead.scale.x = 0.03
+        tips = q[:, :2] + HEADING_LENGTH * np.column_stack([np.cos(headings), np.sin(headings)])
+        ahead.points = [point for body, tip in zip(q, tips)
+                        for point in (_point(body), _point(tip))]
+        array.markers.append(ahead)
     if len(paths) > 1:
         lines = _marker('paths', 0, Marker.LINE_LIST, stamp_ns, (0.3, 0.3, 0.3, 0.7), frame_id)
         lines.scale.x = 0.02

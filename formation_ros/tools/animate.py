@@ -20,7 +20,7 @@ import subprocess
 import sys
 from typing import Optional, Sequence, TextIO
 
-from formation_ros.core.events import Event
+from formation_ros.core.events import check_fit, Event
 from formation_ros.core.frames import FrameSample
 from formation_ros.core.params import FormationConfig
 from formation_ros.core.trajectory import Trajectory
@@ -95,9 +95,10 @@ def write_animation(trajectory: Trajectory, config: FormationConfig, out_dir: st
     """
     Write the animation of a run into ``out_dir``: :data:`MP4` or :data:`GIF`; return its path.
 
-    plan: from :func:`plan_frames` (default: its defaults); events: ``core.events``, the
-    shapes placed by ``frames`` (the reference at each sample; default: the configured
-    reference's, see ``sim.shaped``); progress
+    plan: from :func:`plan_frames` (default: its defaults); events: ``core.events`` (the
+    trajectory's desired positions are the shape in force already; with ``frames``, the
+    reference at each sample, they are rebuilt from the events' shapes: ``sim.shaped``);
+    progress
     lines '<name>: animation at t = ...' go to ``stream`` at most every 10 % of the run once
     the render takes over 2 s. AnimationError (one line) when the file cannot be written.
     """
@@ -106,7 +107,9 @@ def write_animation(trajectory: Trajectory, config: FormationConfig, out_dir: st
     writer, is_mp4 = choose_writer(plan.fps)
     path = os.path.join(out_dir, MP4 if is_mp4 else GIF)
     try:
-        trajectory = shaped(trajectory, config, events, frames)
+        check_fit(events, trajectory.num_robots, trajectory.dim)
+        if frames is not None:
+            trajectory = shaped(trajectory, config, events, frames)
     except ValueError as exc:
         raise AnimationError(str(exc)) from None
     try:

@@ -26,14 +26,16 @@ import tempfile
 from typing import Any, Dict, List, Optional, Tuple
 
 from formation_ros.core.declarations import CommandFrame
+from formation_ros.core.events import timeline_events
 from formation_ros.core.frames import advance, FrameSample, from_body_frame
 from formation_ros.core.params import check_shape, FormationConfig, ParamError
-from formation_ros.core.timeline import Shape, Timeline
+from formation_ros.core.timeline import Mode, named_shape, Shape, TeamState, Timeline
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.core.unicycle import hand_points, hand_velocity, headings_from_quaternions
 from formation_ros.ros import topics as names
 from formation_ros.ros.bag_writer import BagError, BagWriter, PARAMS_FILE, TYPESTORE
 from formation_ros.ros.fields import frame_of, NS_PER_S, points_of, position_of, stamp_to_ns
+from formation_ros.ros.messages import team_state_of
 from mcap.data_stream import ReadDataStream
 from mcap.opcode import Opcode
 from mcap.records import Channel, Chunk, Header, Message, Schema
@@ -44,6 +46,8 @@ from rosbags.rosbag2.metadata import parse_qos
 
 
 Recorded = Dict[str, List[Tuple[int, Any]]]
+EVENTS = 'events'
+"""The key of the run's events (``core.events``) in the info of :func:`trajectory_from_topics`."""
 MCAP_MAGIC = b'\x89MCAP0\r\n'
 METADATA = 'metadata.yaml'
 DAMAGED = '.damaged'
@@ -509,10 +513,14 @@ def trajectory_from_topics(recorded: Recorded,
         u[:, i - 1] = np.where((index >= 0)[:, None], values[np.maximum(index, 0)], 0.0)
     frames, source = _frames_at(stamps, recorded.get(names.REFERENCE, []), config)
     shapes = recorded_shapes(recorded, config)
+    states = recorded_states(recorded, config)
     vertices = [shapes.at(stamp).vertices for stamp in stamps]
     info: Dict[str, Any] = {'reference_source': source}
     if shapes.changes():
         info['shape_changes'] = len(shapes.changes())
+    events = timeline_events(shapes, states)
+    if events:
+        info[EVENTS] = events
     if other_frame:
         info['poses_in_another_frame'] = other_frame
     if not unicycles:
@@ -536,7 +544,7 @@ def recorded_shapes(recorded: Recorded, config: FormationConfig) -> Timeline[Sha
     A recorded shape in another frame, or that the law could not hold, is left out (the robots
     refused it too).
     """
-    shapes = Timeline(Shape(config.shape_name, config.vertices))
+    shapes = Timeline(named_shape(config.vertices, config.shapes))
     for _, message in recorded.get(names.SHAPE, []):
         if message.header.frame_id != config.world_frame:
             continue
@@ -545,8 +553,19 @@ def recorded_shapes(recorded: Recorded, config: FormationConfig) -> Timeline[Sha
             vertices = check_shape(flat, config.num_robots, config.dim, config.repulsion_radius)
         except ParamError:
             continue
-        shapes.add(stamp_to_ns(message.header.stamp), Shape('', vertices))
+        shapes.add(stamp_to_ns(message.header.stamp), named_shape(vertices, config.shapes))
     return shapes
+
+
+def recorded_states(recorded: Recorded, config: FormationConfig) -> Timeline[TeamState]:
+    """Return the team state in force at each stamp, from the recorded ``/formation/status``."""
+    states = Timeline(TeamState.of(Mode.RUNNING, config.shape_name, config.reference()))
+    for _, message in recorded.get(names.STATUS, []):
+        try:
+            states.add(stamp_to_ns(message.header.stamp), team_state_of(message, config.dim))
+        except ValueError:
+            continue
+    return states
 
 
 def _commands_by_state(recorded: Recorded, robot: int,

@@ -34,7 +34,7 @@ import time
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from formation_ros.core.declarations import ParamError
-from formation_ros.core.events import Event
+from formation_ros.core.events import Event, events_from_records
 from formation_ros.core.frames import FrameSample
 from formation_ros.core.params import FormationConfig, load_config, validate
 from formation_ros.core.params_file import parse_params_text
@@ -45,8 +45,9 @@ from formation_ros.ros.bag_writer import BagError, PARAMS_FILE
 from formation_ros.tools.animate import (AnimationError, DEFAULT_DPI, DEFAULT_FPS, describe,
                                          FIGURE_WIDTH, GIF, MAX_FRAMES, MP4, plan_frames,
                                          write_animation)
-from formation_ros.tools.bag import (bag_params_text, mcap_files, METADATA, plant_status,
-                                     read_or_recover, repair_bag, trajectory_from_topics)
+from formation_ros.tools.bag import (bag_params_text, EVENTS, mcap_files, METADATA,
+                                     plant_status, read_or_recover, repair_bag,
+                                     trajectory_from_topics)
 from formation_ros.tools.sim import format_summary, run_metrics, shaped
 
 Loaded = Tuple[Trajectory, FormationConfig, Dict[str, Any]]
@@ -180,6 +181,19 @@ def load_run(path: str, notes: Optional[List[str]] = None) -> Loaded:
     return trajectory, config, extra
 
 
+def run_events(extra: Dict[str, Any]) -> Tuple[Event, ...]:
+    """
+    Take the run's events out of the loaded extra metrics (they are not metrics themselves).
+
+    From a bag: the shape switches and stops recorded on ``/formation/shape`` and
+    ``/formation/status``; from a run directory: the records of ``plant_stats.json``.
+    """
+    events = extra.pop(EVENTS, ())
+    if events and not isinstance(events[0], Event):
+        return events_from_records(events)
+    return tuple(events)
+
+
 def check_out(out: str) -> Optional[str]:
     """Return why the report cannot be written to directory ``out``, or None if it can."""
     if os.path.exists(out):
@@ -205,13 +219,15 @@ def write_report(trajectory: Trajectory, config: FormationConfig, out_dir: str,
     """
     Write metrics.json (and the figures) to ``out_dir``; return the metrics.
 
-    events (``core.events``): the desired formation is the shape in force (placed by
-    ``frames``, the reference at each sample; default the configured one's), and metrics.json
-    gets the per-segment metrics under ``segments``. ValueError when a shape does not fit.
+    events (``core.events``): metrics.json gets the per-segment metrics under ``segments``.
+    The trajectory's desired positions are those of the shape in force already (every loader
+    builds them so); with ``frames`` (the reference at each sample) they are rebuilt from the
+    events' shapes. ValueError when a shape does not fit.
     """
     extra = dict(extra or {})
     integrator = extra.pop('integrator', 'recorded run')
-    trajectory = shaped(trajectory, config, events, frames)
+    if frames is not None:
+        trajectory = shaped(trajectory, config, events, frames)
     metrics = run_metrics(trajectory, config, integrator, events)
     metrics.update(extra)
     os.makedirs(out_dir, exist_ok=True)
@@ -294,7 +310,10 @@ def main(argv: Optional[list] = None) -> int:
         return _fail(_one_line(str(exc)))
     for note in notes:
         print(f'formation_report: {note}', file=sys.stderr)
-    events: Tuple[Event, ...] = ()
+    try:
+        events = run_events(extra)
+    except ValueError as exc:
+        return _fail(f'{args.input}: {PLANT_STATS_FILE} events: {_one_line(str(exc))}')
     plan = None
     if args.animate:
         try:

@@ -34,7 +34,7 @@ from typing import Callable, Optional, Sequence, TextIO, Tuple
 from formation_ros.core.bodies import make_bodies
 from formation_ros.core.declarations import (CommandFrame, DEFAULT_COLLISION_DISTANCE, Exe,
                                              ParamError)
-from formation_ros.core.events import Event, EventKind, with_shapes
+from formation_ros.core.events import Event, EventKind, timeline_events, with_shapes
 from formation_ros.core.frames import desired_positions, FrameSample
 from formation_ros.core.law import team_command
 from formation_ros.core.metrics import body_metrics, compute_metrics, segment_metrics
@@ -43,7 +43,7 @@ from formation_ros.core.params import (FormationConfig, load_config,
 from formation_ros.core.params_file import load_params_file
 from formation_ros.core.plant import Commands, NS_PER_S, PlantCounts, PlantModel
 from formation_ros.core.safety import guaranteed_min_distance
-from formation_ros.core.timeline import scheduled_shapes, Shape, Timeline
+from formation_ros.core.timeline import Mode, scheduled_shapes, Shape, TeamState, Timeline
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.core.unicycle import hand_points, unicycle_commands, unicycle_rates
 import numpy as np
@@ -102,6 +102,12 @@ def shapes_of(config: FormationConfig) -> Timeline[Shape]:
     """Return the shape in force at each time: the file's, then its scheduled switches."""
     return scheduled_shapes(Shape(config.shape_name, config.vertices), config.schedule,
                             config.shapes)
+
+
+def schedule_events(config: FormationConfig) -> Tuple[Event, ...]:
+    """Return the events of the file's switch schedule (``formation.schedule.*``)."""
+    start = TeamState.of(Mode.RUNNING, config.shape_name, config.reference())
+    return timeline_events(shapes_of(config), Timeline(start))
 
 
 def vertices_at(shapes: Timeline[Shape], t: float) -> np.ndarray:
@@ -577,13 +583,14 @@ def main(argv: Optional[list] = None) -> int:
     sample_dt = DEFAULT_SAMPLE_DT if args.sample_dt is None else args.sample_dt
     integrator = 'RK45' if args.dt is None else f'zero-order hold, dt = {args.dt:g} s'
     progress = Progress(duration, quiet=args.quiet)
+    events = schedule_events(config)
     if args.dt is None:
         trajectory = simulate(config, duration, None, sample_dt, progress)
-        metrics = run_metrics(trajectory, config, integrator)
+        metrics = run_metrics(trajectory, config, integrator, events)
     else:
         run = run_fixed_step(config, duration, args.dt, sample_dt, progress)
         trajectory = run.trajectory
-        metrics = run_metrics(trajectory, config, integrator)
+        metrics = run_metrics(trajectory, config, integrator, events)
         metrics.update(plant_metrics(run, config))
     metrics['wall_time'] = progress.elapsed
     trajectory.save(os.path.join(args.out, TRAJECTORY_FILE))

@@ -10,14 +10,16 @@ does, and a scheduled switch in lockstep is compared with ``formation_sim``.
 """
 
 import json
+import subprocess
 
 from formation_ros.core.params import load_config
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.ros import qos
 from formation_ros.tools.sim import simulate
 from geometry_msgs.msg import PoseStamped, TwistStamped
-from helpers import launch, SimClock, stop_when, write_params
+from helpers import exe, launch, SimClock, stop_when, write_params
 import numpy as np
+from PIL import Image
 from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import SetParameters
 from std_srvs.srv import Trigger
@@ -127,6 +129,21 @@ def test_shapes_switch_and_the_team_stops_and_goes(processes, install, probe, tm
     from_bag = json.loads((out / 'metrics.json').read_text())
     assert from_bag['source'] == 'rosbag2' and from_bag['shape_changes'] >= 3
     assert from_bag['final_max_error'] < 0.02 and from_bag['collisions'] == 0
+    segments = from_bag['segments']
+    assert [row['kind'] for row in segments] == [None, 'shape', 'shape', 'shape', 'stop',
+                                                 'start'], segments
+    assert [row['label'] for row in segments[1:4]] == ['line', 'wedge', 'line']
+    assert segments[1]['settle_time'] is not None and segments[-1]['settle_time'] is not None
+    anim = tmp_path / 'anim'
+    done = subprocess.run([exe(install, 'formation_report'), str(bag), '--out', str(anim),
+                           '--animate', '--max-frames', '12', '--dpi', '30'],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    if (anim / 'animation.mp4').exists():
+        assert (anim / 'animation.mp4').read_bytes()[4:8] == b'ftyp'
+    else:
+        with Image.open(anim / 'animation.gif') as gif:
+            assert gif.n_frames == 12
 
 
 def test_a_scheduled_switch_in_lockstep_is_formation_sims(processes, install, probe, tmp_path):

@@ -3,7 +3,7 @@
 
 """RViz markers: what each namespace shows, and a count of markers that does not grow with N."""
 
-from formation_ros.ros.markers import DISC_THICKNESS, formation_markers, Paths
+from formation_ros.ros.markers import DISC_THICKNESS, formation_markers, HEADING_LENGTH, Paths
 from geometry_msgs.msg import Point
 import numpy as np
 import pytest
@@ -58,3 +58,16 @@ def test_a_single_moment_draws_no_path_and_3d_zones_are_balls():
     sensing = array.markers[1]
     assert sensing.scale.x == sensing.scale.y == sensing.scale.z == 3.0
     assert isinstance(sensing.points[0], Point) and len(paths) == 1
+
+
+def test_unicycle_headings_are_lines_ahead_and_every_marker_is_in_the_world_frame():
+    paths = Paths(2, length=3)
+    q = np.array([[0.0, 0.0], [1.0, 2.0]])
+    paths.append(q)
+    array = formation_markers(q, np.array([1.0, 1.0]), 0.5, q, paths, 0, 'map',
+                              headings=np.array([0.0, np.pi / 2]))
+    (ahead,) = [m for m in array.markers if m.ns == 'headings']
+    assert ahead.type == Marker.LINE_LIST
+    assert np.allclose(as_rows(ahead.points), [(0.0, 0.0, 0.0), (HEADING_LENGTH, 0.0, 0.0),
+                                               (1.0, 2.0, 0.0), (1.0, 2.0 + HEADING_LENGTH, 0.0)])
+    assert {m.header.frame_id for m in array.markers} == {'map'}
