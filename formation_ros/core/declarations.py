@@ -364,8 +364,8 @@ DECLARATIONS = (
           low=at_least(0.0), high=at_least(LENGTH_LIMIT), users=START),
     Param('plant.state_delay', Kind.DOUBLE, 0.0,
           'A state reaches the robots this much later than it happened, s (0: at once; beyond '
-          'the paper); less than plant.input_timeout.', low=at_least(0.0),
-          high=at_least(1000.0), users=START),
+          'the paper); less than plant.input_timeout and than input_timeout (robots).',
+          low=at_least(0.0), high=at_least(1000.0), users=START | {Exe.ROBOT}),
     Param('plant.collision_distance', Kind.DOUBLE, DEFAULT_COLLISION_DISTANCE,
           'Two robots closer than this are logged as a collision, m.', low=at_least(0.0),
           users=PLANT),

@@ -27,6 +27,7 @@ Frames:
 from dataclasses import dataclass
 from typing import Optional, overload
 
+from formation_ros.core.unicycle import headings_from_quaternions
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -230,11 +231,8 @@ def quaternion_from_matrix(rotation: ArrayLike) -> NDArray[np.float64]:
 
 def matrix_from_quaternion(quat: ArrayLike) -> NDArray[np.float64]:
     """Return the rotation matrix (3, 3) of a quaternion (x, y, z, w) != 0, normalised first."""
-    x, y, z, w = np.asarray(quat, dtype=float) / np.linalg.norm(quat)
-    return np.array([
-        [1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w)],
-        [2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w)],
-        [2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)]])
+    matrix: NDArray[np.float64] = _rotations(quat)[0]
+    return matrix
 
 
 QUATERNION_TOLERANCE = 1e-3
@@ -264,8 +262,7 @@ def _rotations(quaternion: ArrayLike) -> NDArray[np.float64]:
 
 def _planar_rotations(quaternion: ArrayLike) -> NDArray[np.float64]:
     """Return the yaw rotations (N, 2, 2) of quaternions (N, 4): the plane's part of them."""
-    x, y, z, w = np.asarray(quaternion, dtype=float).reshape(-1, 4).T
-    yaw = np.arctan2(2.0 * (w * z + x * y), x * x + y * y + z * z + w * w - 2.0 * (y * y + z * z))
+    yaw = headings_from_quaternions(np.asarray(quaternion, dtype=float).reshape(-1, 4))
     c, s = np.cos(yaw), np.sin(yaw)
     return np.stack([np.stack([c, -s], -1), np.stack([s, c], -1)], axis=1)
 

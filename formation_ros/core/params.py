@@ -585,6 +585,11 @@ def _command(values: Mapping[str, Any], body: BodySettings,
 
 def _imperfections(values: Mapping[str, Any], exe: Exe, problems: Problems) -> Imperfections:
     """``plant.actuator_lag`` ...: the non-ideal bodies of the executables that step them."""
+    delay = values.get('plant.state_delay', 0.0)
+    if exe is Exe.ROBOT and delay >= values['input_timeout']:
+        problems.append(('plant.state_delay', f'{delay:g} s would make every state stale for '
+                                              'the robots: it must be less than input_timeout '
+                                              f"= {values['input_timeout']:g} s"))
     if exe not in (Exe.SIM, Exe.PLANT, Exe.RECORD):
         return IDEAL
     imperfections = Imperfections(

@@ -129,6 +129,8 @@ class Reference:
         """
         if self.kind in ('fixed', 'line'):
             return float(np.linalg.norm(self.velocity)), 0.0
+        if self.rate == 0.0:
+            return 0.0, 0.0
         times = np.arange(RATE_SAMPLES) * (2.0 * math.pi / self.rate / RATE_SAMPLES) \
             - self.phase / self.rate
         speed = turn = 0.0

@@ -78,7 +78,9 @@ class Timeline(Generic[Value]):
     Values that hold from their stamps (ns) on; the first holds from the beginning of time.
 
     :meth:`at` returns the value of the latest change stamped at or before a time. A change
-    with the stamp of one already kept replaces it. At most :data:`MAX_CHANGES` are kept.
+    with the stamp of one already kept replaces it. At most :data:`MAX_CHANGES` are kept: the
+    oldest change then becomes the value from the beginning (so ``at`` of a time before it
+    returns the value that held last, not the first one).
     """
 
     def __init__(self, initial: Value) -> None:
@@ -95,6 +97,7 @@ class Timeline(Generic[Value]):
             self._stamps.insert(index, stamp_ns)
             self._values.insert(index, value)
         while len(self._stamps) > MAX_CHANGES:
+            self._values[0] = self._values[1]
             del self._stamps[1], self._values[1]
 
     def at(self, stamp_ns: int) -> Value:
@@ -103,7 +106,7 @@ class Timeline(Generic[Value]):
 
     @property
     def initial(self) -> Value:
-        """Return the value in force before every change."""
+        """Return the value in force before every change kept."""
         return self._values[0]
 
     @property

@@ -258,9 +258,16 @@ class ReferenceNode(Node):
         return speed_up
 
     def on_changes(self) -> None:
-        """Apply the changes accepted since the last call, from now on, and publish them."""
+        """
+        Apply the changes accepted since the last call, from now on, and publish them.
+
+        In lockstep from the first step whose reference sample is not sent yet (the sample of
+        the next step goes out ahead), so that every node sees the change at the same state.
+        """
         pending, self.pending = self.pending, []
         since = self._now_ns()
+        if self.lockstep and self.last_stamp is not None:
+            since = max(since, self.last_stamp + self.step_ns)
         for name, change in pending:
             change(since)
             self.get_logger().info(f'{name} changed at t = {self._reference_time(since):.3f} s')

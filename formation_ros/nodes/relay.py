@@ -118,6 +118,8 @@ class RelayNode(Node):
         self.sources = [settings.source(i) for i in range(1, self.n + 1)]
         outputs = {topics.robot_topic(i, name) for i in range(1, self.n + 1)
                    for name in (topics.POSE, topics.NEIGHBOURS, topics.CMD_VEL)}
+        outputs |= {topics.REFERENCE, topics.CLOCK, topics.DIAGNOSTICS, topics.MARKERS,
+                    topics.PARAMS, topics.SHAPE, topics.STATUS}
         looped = sorted(set(self.sources) & outputs)
         if looped:
             raise ParamError([('relay.source_topic', f'{settings.source_topic!r} gives '

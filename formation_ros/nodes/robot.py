@@ -265,7 +265,7 @@ class RobotNode(Node):
                                                     f'{self.world_frame!r})')
         elif not msg.finite:
             self._reject('reference', Reason.NON_FINITE)
-        elif not self._plausible(msg):
+        elif not self._plausible(msg) and not (self.changes.take() and self._plausible(msg)):
             self._reject('reference', Reason.TOO_FAST)
         else:
             self.references.append(msg)

@@ -98,6 +98,11 @@ class Changes:
         except ValueError as exc:
             self.reject('status', f'bytes that are not a team status ({exc})')
             return None
+        if state.speed < 0.0 or (state.speed == 0.0 and not self.reference.base.is_stationary
+                                 and self.reference.base.kind != 'line'):
+            self.reject('status', f'a path speed this reference cannot have ({state.speed!r} '
+                                  'm/s)')
+            return None
         self.states.add(fields.stamp_to_ns(msg.header.stamp), state)
         self.on_state(state)
         return state

@@ -128,3 +128,10 @@ def test_a_lab_file_is_valid_for_every_executable():
     checked = validate_for_every_executable(raw)
     assert set(checked) == {Exe.SIM, Exe.PLANT, Exe.REFERENCE, Exe.ROBOT, Exe.RELAY}
     assert all(config.world_frame == 'map' for config in checked.values())
+
+
+def test_a_delay_the_robots_would_refuse_is_refused_for_them():
+    raw = section5(**{'plant.state_delay': 0.4, 'input_timeout': 0.3, 'robot_id': 1})
+    text = problem(raw, Exe.ROBOT)
+    assert "parameter 'plant.state_delay'" in text and 'input_timeout = 0.3 s' in text
+    assert validate({**raw, 'input_timeout': 0.5}, Exe.ROBOT).robot is not None

@@ -41,7 +41,9 @@ def test_a_change_with_the_same_stamp_replaces_it_and_old_ones_are_dropped():
     for k in range(MAX_CHANGES + 10):
         timeline.add(10 + k, k)
     assert len(timeline.changes()) == MAX_CHANGES - 1
-    assert timeline.at(0) == 0 and timeline.latest == MAX_CHANGES + 9
+    assert timeline.latest == MAX_CHANGES + 9
+    first_kept = timeline.changes()[0][0]
+    assert timeline.at(first_kept - 1) == timeline.at(first_kept) - 1 == first_kept - 11
 
 
 def test_shapes_compare_by_vertices():
