@@ -171,6 +171,9 @@ def launcher_views(params, argv):
 LAB_CASES = [
     ((), {}),
     (('--cmd-topic', '/base_{i}/cmd_vel'), {'cmd_topic': '/base_{i}/cmd_vel'}),
+    (('--cmd-topic', '/base{i}/cmd_vel'), {'cmd_topic': '/base{i}/cmd_vel'}),
+    (('--cmd-topic', '/{name}/cmd_vel', '--source-topic', '/vrpn_mocap/{name}/pose'),
+     {'cmd_topic': '/{name}/cmd_vel', 'source_topic': '/vrpn_mocap/{name}/pose'}),
     (('--cmd-topic', '/{name}/cmd_vel', '--source-topic', '/vrpn_mocap/{name}/pose',
       '--record', '/tmp/lab_bag'),
      {'cmd_topic': '/{name}/cmd_vel', 'source_topic': '/vrpn_mocap/{name}/pose',

@@ -26,7 +26,7 @@ the point of a lab test is that the robots meet bodies the package did not write
 from dataclasses import dataclass, field
 import enum
 import math
-from typing import Dict, List, Optional, Set, Tuple
+from typing import Dict, List, Optional, Sequence, Set, Tuple
 
 from formation_ros.ros.cdr import encode_pose_stamped
 from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
@@ -59,7 +59,8 @@ class Lab:
     The bodies, their bases and the mocap of ``len(q)`` robots.
 
     q: (N, 2) start positions, m; heading: (N,) headings, rad (fixed for holonomic bodies);
-    command_topic / mocap_topic: templates with ``{i}``.
+    command_topic / mocap_topic: templates with ``{i}`` (the robot's id, 1-based) and, when
+    ``names`` are given (one per robot, as ``relay.source_names``), ``{name}``.
     """
 
     q: np.ndarray
@@ -76,6 +77,7 @@ class Lab:
     cmd_vel_timeout: float = 0.5
     seed: int = 0
     hidden: Set[int] = field(default_factory=set)
+    names: Sequence[str] = ()
     velocity: np.ndarray = field(init=False)
     target: np.ndarray = field(init=False)
     heard_at: np.ndarray = field(init=False)
@@ -107,14 +109,18 @@ class Lab:
                                 else self.max_acceleration])
         """Largest change of each velocity component per second: m/s^2 (rad/s^2 for w)."""
 
+    def topic(self, template: str, i: int) -> str:
+        """Robot ``i``'s (0-based) topic of ``template``."""
+        return template.format(i=i + 1, **({'name': self.names[i]} if self.names else {}))
+
     def attach(self, probe) -> None:
         """Subscribe the bases to their commands, create the mocap publishers, start ticking."""
         kind = Twist if self.base is Base.HOLONOMIC_BODY else TwistStamped
         self.subscriptions = [
-            probe.create_subscription(kind, self.command_topic.format(i=i + 1),
+            probe.create_subscription(kind, self.topic(self.command_topic, i),
                                       lambda m, i=i: self.on_command(i, m), COMMANDS_QOS)
             for i in range(len(self.q))]
-        self.mocap = [probe.create_publisher(PoseStamped, self.mocap_topic.format(i=i + 1),
+        self.mocap = [probe.create_publisher(PoseStamped, self.topic(self.mocap_topic, i),
                                              qos_profile_sensor_data)
                       for i in range(len(self.q))]
         self.timer = probe.create_timer(1.0 / self.rate, self.tick)
