@@ -55,3 +55,17 @@ def _signals_left_as_found():
         left = {signal.Signals(number).name for number in (after - before)
                 if number in (signal.SIGINT, signal.SIGTERM)}
         assert not left, f'the test left {", ".join(sorted(left))} ignored in the test process'
+
+
+@pytest.fixture
+def launch_file(monkeypatch):
+    """Give the test launch/formation.launch.py on stand-ins (test_package.load_launch_file)."""
+    from test_package import load_launch_file
+    return load_launch_file(monkeypatch, 'formation.launch.py')
+
+
+@pytest.fixture
+def lab_launch_file(monkeypatch):
+    """Give the test launch/lab.launch.py on stand-ins (``test_package.load_launch_file``)."""
+    from test_package import load_launch_file
+    return load_launch_file(monkeypatch, 'lab.launch.py')

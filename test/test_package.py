@@ -188,18 +188,6 @@ def load_launch_file(monkeypatch, file_name):
     return module
 
 
-@pytest.fixture
-def launch_file(monkeypatch):
-    """Give the test launch/formation.launch.py on stand-ins (:func:`load_launch_file`)."""
-    return load_launch_file(monkeypatch, 'formation.launch.py')
-
-
-@pytest.fixture
-def lab_launch_file(monkeypatch):
-    """Give the test launch/lab.launch.py on stand-ins (:func:`load_launch_file`)."""
-    return load_launch_file(monkeypatch, 'lab.launch.py')
-
-
 def launched_nodes(launch_file, **arguments):
     """
     Return the Node stand-ins the launch file starts for the given launch arguments.

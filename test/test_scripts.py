@@ -96,19 +96,24 @@ while True:
 """A fake node: ready for Ctrl-C before it says it is up; the one that dies waits for all six."""
 
 
-@pytest.fixture
-def fake_install(tmp_path):
-    """Give the test an install prefix whose nodes are tiny Python scripts that need no ROS."""
-    prefix = tmp_path / 'fake install'
+def make_fake_install(folder, names=('plant', 'reference', 'robot', 'record')):
+    """Make an install prefix in ``folder`` whose nodes ``names`` are :data:`FAKE_NODE`."""
+    prefix = folder / 'fake install'
     programs = prefix / 'lib' / 'formation_ros'
     programs.mkdir(parents=True)
-    for name in ('plant', 'reference', 'robot', 'record'):
+    for name in names:
         (programs / name).write_text(FAKE_NODE.format(python=sys.executable))
         (programs / name).chmod(0o755)
     sites = prefix / 'lib' / 'python3' / 'site-packages'
     sites.mkdir(parents=True)
     (sites / 'formation_ros').symlink_to(os.path.join(ROOT, 'formation_ros'))
     return prefix
+
+
+@pytest.fixture
+def fake_install(tmp_path):
+    """Give the test an install prefix whose nodes are tiny Python scripts that need no ROS."""
+    return make_fake_install(tmp_path)
 
 
 def launch_fake(prefix, dies, *options):

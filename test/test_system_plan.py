@@ -11,8 +11,8 @@ import sys
 
 from formation_ros.core.params_file import load_params_file, write_params_file
 import pytest
-from test_package import launched_nodes, load_launch_file, node_parameters, Shutdown
-from test_scripts import FAKE_NODE, launch_fake, run
+from test_package import launched_nodes, node_parameters, Shutdown
+from test_scripts import launch_fake, make_fake_install, run
 import yaml
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -23,28 +23,8 @@ NAMES = ['tb1', 'tb2', 'tb3', 'tb4']
 @pytest.fixture
 def lab_install(tmp_path):
     """Give the test an install prefix of stand-in nodes (test_scripts' fake), relay included."""
-    prefix = tmp_path / 'fake install'
-    programs = prefix / 'lib' / 'formation_ros'
-    programs.mkdir(parents=True)
-    for name in ('plant', 'relay', 'reference', 'robot', 'record', 'fleet'):
-        (programs / name).write_text(FAKE_NODE.format(python=sys.executable))
-        (programs / name).chmod(0o755)
-    sites = prefix / 'lib' / 'python3' / 'site-packages'
-    sites.mkdir(parents=True)
-    (sites / 'formation_ros').symlink_to(os.path.join(ROOT, 'formation_ros'))
-    return prefix
-
-
-@pytest.fixture
-def launch_file(monkeypatch):
-    """Give the test launch/formation.launch.py on stand-ins (test_package)."""
-    return load_launch_file(monkeypatch, 'formation.launch.py')
-
-
-@pytest.fixture
-def lab_launch_file(monkeypatch):
-    """Give the test launch/lab.launch.py on stand-ins (test_package)."""
-    return load_launch_file(monkeypatch, 'lab.launch.py')
+    return make_fake_install(tmp_path, ('plant', 'relay', 'reference', 'robot', 'record',
+                                        'fleet'))
 
 
 @pytest.fixture
