@@ -260,8 +260,9 @@ DECLARATIONS = (
           high=at_least(LENGTH_LIMIT), users=START),
     Param('body.max_linear', Kind.DOUBLE, None,
           'Unicycles: actuator limit on |v|, m/s; a file whose bound sqrt(2) c M1 '
-          'exceeds it is refused, and the plant clips |v| to it.', low=above(0.0),
-          high=at_least(SPEED_LIMIT), users=START),
+          'exceeds it is refused, and the plant clips |v| to it; the reference refuses a '
+          'speed whose vertices it cannot carry.', low=above(0.0),
+          high=at_least(SPEED_LIMIT), users=START | {Exe.REFERENCE}),
     Param('body.max_angular', Kind.DOUBLE, None,
           'Unicycles: actuator limit on |w|, rad/s; a file whose bound '
           'sqrt(2) c M1 / l exceeds it is refused, and the plant clips |w| to it.',

@@ -405,9 +405,9 @@ class PlantNode(Node):
         for state in ('alive', 'lost'):
             robots = [str(i + 1) for i, s in enumerate(states) if s == state]
             values[f'robots with {state} cmd_vel'] = ', '.join(robots) or 'none'
-        values.update(announced(team_values(self.config, self.changes.shapes.latest.vertices)))
-        others = team_problems(self.team, self.config, self.changes.shapes.latest.vertices,
-                               self.once)
+        shape = self._vertices_at(self.model.t_ns)
+        values.update(announced(team_values(self.config, shape)))
+        others = team_problems(self.team, self.config, shape, self.once)
         if others:
             values['nodes with other team values'] = ' | '.join(others)
         shared = self._shared_command_topics(now)

@@ -313,7 +313,7 @@ class ReferenceNode(Node):
                          else self._reference_time(self.last_stamp)),
             'team': state.mode.value, 'shape in force': state.shape or 'formation.vertices',
             'shape changes': len(self.shapes.changes())}
-        shape = self.shapes.latest.vertices
+        shape = self.shapes.at(self.last_stamp if self.last_stamp is not None else 0).vertices
         values.update(announced(team_values(self.config, shape)))
         others = team_problems(self.team, self.config, shape, self.once)
         if others:

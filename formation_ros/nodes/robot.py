@@ -474,7 +474,8 @@ class RobotNode(Node):
             values['max |u| component [m/s]'] = float(np.max(np.abs(self.last.u)))
             values['max |u_hat| component [m/s]'] = float(np.max(np.abs(self.last.u_hat)))
         values['bound c*M1 [m/s]'] = self.law.u_bound
-        values.update(announced(team_values(self.config, self.changes.shapes.latest.vertices)))
+        now = self.pose.stamp_ns if self.pose is not None else 0
+        values.update(announced(team_values(self.config, self.changes.shapes.at(now).vertices)))
         if self.last_body_command is not None and self.unicycle:
             values['|v| [m/s]'] = abs(float(self.last_body_command[0]))
             values['|w| [rad/s]'] = abs(float(self.last_body_command[1]))

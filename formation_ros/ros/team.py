@@ -8,9 +8,12 @@ Every formation node adds ``core.team.team_values`` to its ``/diagnostics`` stat
 ``team: <name>``. The plant and the reference hear every node's status (:class:`TeamCheck`: the
 callback stores, the node's diagnostics timer compares) and name each node whose values differ
 from their own. The shape in force may differ for a moment after a switch (a node takes it a
-few milliseconds later), so only a shape that differs in two announcements in a row counts.
+few milliseconds later, and announcements are a second apart), so a shape counts as different
+only when it is none of the shapes this node itself had in force in its last
+:data:`RECENT` checks.
 """
 
+from collections import deque
 from typing import Dict, List, Mapping
 
 from diagnostic_msgs.msg import DiagnosticArray
@@ -24,6 +27,7 @@ from rclpy.node import Node
 
 PREFIX = 'team: '
 TRANSIENT = ('shape in force',)
+RECENT = 3
 
 
 def announced(values: Mapping[str, str]) -> Dict[str, str]:
@@ -38,7 +42,7 @@ class TeamCheck:
         """Subscribe ``node`` (whose own status is named ``own_name``) to /diagnostics."""
         self.own_name = own_name
         self.heard: Dict[str, Dict[str, str]] = {}
-        self.previous: Dict[str, Dict[str, str]] = {}
+        self.own_recent: deque = deque(maxlen=RECENT)
         node.create_subscription(DiagnosticArray, topics.DIAGNOSTICS, self.store,
                                  qos.DIAGNOSTICS)
 
@@ -50,17 +54,17 @@ class TeamCheck:
             values = {kv.key[len(PREFIX):]: kv.value for kv in status.values
                       if kv.key.startswith(PREFIX)}
             if values:
-                self.previous[status.name] = self.heard.get(status.name, values)
                 self.heard[status.name] = values
 
     def disagreeing(self, own: Mapping[str, str]) -> Dict[str, Dict[str, str]]:
         """Return {node: {value: 'theirs (here: ours)'}} of the nodes whose last word differs."""
+        self.own_recent.append(dict(own))
         found: Dict[str, Dict[str, str]] = {}
         for name, values in self.heard.items():
             differ = differences(own, values)
-            before = differences(own, self.previous.get(name, {}))
             for key in TRANSIENT:
-                if key in differ and key not in before:
+                if key in differ and any(values[key] == mine.get(key)
+                                         for mine in self.own_recent):
                     del differ[key]
             if differ:
                 found[name] = differ

@@ -30,12 +30,21 @@ SHAPES = {'formations.names': ['line', 'wedge'], 'formations.line.vertices': LIN
           'formations.wedge.vertices': WEDGE}
 
 
-def call(probe, client, request, timeout=30.0):
-    """Call a service from the probe and return its response (asserting it came)."""
+def call(probe, client, request, timeout=30.0, tries=3):
+    """
+    Call a service from the probe and return its response (asserting it came).
+
+    A request sent just after the service is discovered can lose its answer (the service
+    replies before the client's reply reader is matched); every request here can be repeated
+    without harm, so it is sent again if no answer came.
+    """
     assert probe.spin_until(lambda: client.service_is_ready(), timeout), client.srv_name
-    future = client.call_async(request)
-    assert probe.spin_until(future.done, timeout), f'{client.srv_name}: no answer'
-    return future.result()
+    for _ in range(tries):
+        future = client.call_async(request)
+        if probe.spin_until(future.done, timeout / tries):
+            return future.result()
+        client.remove_pending_request(future)
+    raise AssertionError(f'{client.srv_name}: no answer to {tries} requests')
 
 
 def set_parameter(probe, client, name, value):
