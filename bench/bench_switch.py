@@ -70,13 +70,13 @@ START_TIMEOUT = 180.0
 RUN_TIMEOUT = 300.0
 GIF_LINE = [-3.0, 0.0, -1.0, 0.0, 1.0, 0.0, 3.0, 0.0]
 GIF_WEDGE = [0.0, 1.5, -1.5, 0.0, 1.5, 0.0, 0.0, -1.5]
-GIF_OPTIONS = ['--fps', '10', '--speed', '1', '--dpi', '60']
+GIF_OPTIONS = ['--fps', '15', '--speed', '1', '--dpi', '100']
 GIF_MOVE, GIF_HOLD = 0.6, 2.0
 """--gif: stop this long after the switch to the wedge, s; stay stopped this long, s."""
 
 
 def say(text: str) -> None:
-    """A progress line on stderr."""
+    """Print a progress line on stderr."""
     print(f'bench_switch: {text}', file=sys.stderr, flush=True)
 
 
@@ -84,7 +84,8 @@ def build_parser() -> argparse.ArgumentParser:
     """Command line of the switch benchmark."""
     parser = argparse.ArgumentParser(
         prog='bench_switch.py', description=__doc__.split('\n\n')[2].strip(),
-        epilog='Quick check (seconds): python bench/bench_switch.py --quick --offline --out /tmp/s')
+        epilog='Quick check (seconds): python bench/bench_switch.py --quick --offline '
+               '--out /tmp/s')
     parser.add_argument('--quick', action='store_true',
                         help=f'switch at {QUICK_SWITCH_AT:g} s of {QUICK_DURATION:g} s instead '
                              f'of {SWITCH_AT:g} s of {DURATION:g} s: checks the benchmark')
@@ -171,7 +172,7 @@ def after_switch(metrics: Dict[str, Any], label: str = 'line') -> Dict[str, Any]
 
 
 def summary(metrics: Dict[str, Any]) -> Dict[str, Any]:
-    """The numbers of one run: the switch, the settle times before and after, the safety."""
+    """Return the numbers of one run: the switch, the settle times, the safety after it."""
     segment = after_switch(metrics)
     first = metrics['segments'][0]
     return {'switch_at': segment['start'], 'settle_time': segment['settle_time'],
@@ -344,7 +345,7 @@ def wait(probe: Probe, process: 'subprocess.Popen[bytes]', condition: Callable[[
 
 
 def report(folder: str, process: 'subprocess.Popen[bytes]') -> Dict[str, Any]:
-    """The launcher's exit and formation_report's metrics.json of the bag, after the run."""
+    """End the run; return formation_report's metrics.json of the bag (the launcher wrote it)."""
     stop_group(process)
     if process.returncode != 0:
         raise RuntimeError(f'launcher exit {process.returncode}; see {folder}/launcher.log')
@@ -408,14 +409,94 @@ def ros_lockstep(prefix: str, folder: str, switch_at: float, duration: float) ->
     return result
 
 
+def gif_params() -> Dict[str, Any]:
+    """Return config/square_4.yaml's parameters with the named shapes line and wedge."""
+    raw = load_params_file(os.path.join(ROOT, SQUARE))
+    raw.update({'formations.names': ['line', 'wedge'], 'formations.line.vertices': GIF_LINE,
+                'formations.wedge.vertices': GIF_WEDGE, 'duration': 1000.0})
+    validate(raw)
+    return raw
+
+
+def make_gif(args: argparse.Namespace, work: str) -> int:
+    """
+    Make OUT/changes.gif from a real run: two shape switches and a stop in the middle of a move.
+
+    Square -> ``formation.name line`` once settled -> ``formation.name wedge`` once settled ->
+    /formation/stop GIF_MOVE s later -> /formation/start GIF_HOLD s later -> settled on the
+    wedge; Ctrl-C, then ``formation_report BAG --out DIR --animate`` with GIF_OPTIONS.
+    """
+    from PIL import Image
+    prefix = args.prefix
+    if prefix is None:
+        say('building the package with colcon')
+        prefix = build_install(os.path.join(work, 'colcon'))
+    folder = os.path.join(work, 'gif')
+    os.makedirs(folder)
+    raw = gif_params()
+    params = write(folder, 'params', raw)
+    config = validate(raw)
+    shapes = {'square': config.vertices, **config.shapes}
+    steps: List[str] = []
+    with ros_run(prefix, params, folder, config) as (probe, process):
+        def settle(name: str) -> None:
+            wait(probe, process, lambda: probe.error(shapes[name]) < SETTLED,
+                 f'settled on the {name}', folder)
+            steps.append(f't = {probe.seconds:.2f} s: settled on the {name}')
+            say(steps[-1])
+
+        def after(seconds: float) -> None:
+            since = probe.seconds
+            wait(probe, process, lambda: probe.seconds >= since + seconds, f'+{seconds:g} s',
+                 folder)
+
+        settle('square')
+        for name in ('line', 'wedge'):
+            probe.set_shape(name)
+            steps.append(f't = {probe.seconds:.2f} s: formation.name {name}')
+            say(steps[-1])
+            if name == 'line':
+                settle(name)
+        after(GIF_MOVE)
+        steps.append(f't = {probe.seconds:.2f} s: {probe.trigger("stop")}')
+        say(steps[-1])
+        after(GIF_HOLD)
+        steps.append(f't = {probe.seconds:.2f} s: {probe.trigger("start")}')
+        say(steps[-1])
+        settle('wedge')
+        after(TAIL)
+        metrics = report(folder, process)
+    animation = os.path.join(folder, 'animation')
+    done = subprocess.run([sys.executable, '-m', 'formation_ros.tools.report',
+                           os.path.join(folder, 'bag'), '--out', animation, '--animate',
+                           *GIF_OPTIONS], capture_output=True, text=True, timeout=RUN_TIMEOUT)
+    if done.returncode != 0:
+        raise RuntimeError(f'formation_report --animate failed: {done.stderr[-2000:]}')
+    made = os.path.join(animation, 'animation.gif')
+    if not os.path.exists(made):
+        raise RuntimeError(f'no GIF in {animation} (an mp4 where ffmpeg is on PATH?)')
+    target = os.path.join(args.out, 'changes.gif')
+    os.makedirs(args.out, exist_ok=True)
+    shutil.copyfile(made, target)
+    with Image.open(target) as image:
+        frames = image.n_frames
+    size = os.path.getsize(target)
+    print('\n'.join(steps))
+    settles = [f"{row['label']} {fmt(row['settle_time'])} s" for row in metrics['segments']]
+    print(f"settle time of each segment: {', '.join(settles)}")
+    print(f'wrote {target}: {frames} frames, {size / 1e6:.2f} MB (formation_report BAG --out DIR '
+          f"--animate {' '.join(GIF_OPTIONS)})")
+    return 0
+
+
 def machine_line(host: Dict[str, Any]) -> str:
-    """The machine, for the table."""
+    """Return the machine as a line above the table."""
     return (f"machine: {host['nproc']} cores, {host['cpu']}, Python {host['python']}; load "
             f"{' '.join(f'{v:.2f}' for v in host['load_before'])}")
 
 
 def fmt(value: Optional[float], digits: int = 4) -> str:
-    """A number for the table ('-' for None)."""
+    """Format a number for the table ('-' for None)."""
     return '-' if value is None else f'{value:.{digits}g}'
 
 
@@ -460,9 +541,9 @@ def benchmark(args: argparse.Namespace, work: str) -> int:
         'machine': host, 'arguments': {k: v for k, v in vars(args).items() if k != 'work'},
         'team': SECTION5, 'shape': {
             'name': 'line', 'vertices': raw['formations.line.vertices'], 'spacing': SPACING,
-            'why': 'each robot gets the slot of its circle vertex\'s rank along x: the upper '
+            'why': "each robot gets the slot of its circle vertex's rank along x: the upper "
                    'and lower halves keep their order, no two straight paths cross, and every '
-                   'robot moves about the circle\'s radius (8 m), so the settle time measures '
+                   "robot moves about the circle's radius (8 m), so the settle time measures "
                    'the switch, not a crossing; 1.5 m apart > b = 1 m'},
         'schedule': {'times': [switch_at], 'names': ['line'], 'duration': duration},
         'settle_tolerance': SETTLE_TOLERANCE, 'runs': rows,
@@ -488,7 +569,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     work = args.work or tempfile.mkdtemp(prefix='bench_switch-')
     os.makedirs(work, exist_ok=True)
     try:
-        return benchmark(args, work)
+        return make_gif(args, work) if args.gif else benchmark(args, work)
     except RuntimeError as exc:
         print(f'bench_switch: {exc}', file=sys.stderr)
         return 1
