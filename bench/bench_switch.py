@@ -201,6 +201,7 @@ def run_sim(params: str, out: str, dt: Optional[float]) -> Dict[str, Any]:
 
 def build_install(folder: str) -> str:
     """Build the package with colcon into FOLDER (as the integration tests do); its prefix."""
+    os.makedirs(folder, exist_ok=True)
     done = subprocess.run(
         [sys.executable, '-m', 'colcon', '--log-base', os.path.join(folder, 'log'), 'build',
          '--base-paths', ROOT, '--build-base', os.path.join(folder, 'build'),
@@ -538,7 +539,8 @@ def benchmark(args: argparse.Namespace, work: str) -> int:
             'switch')
     raw = section5(switch_at, duration)
     result = {
-        'machine': host, 'arguments': {k: v for k, v in vars(args).items() if k != 'work'},
+        'machine': host, 'arguments': {**{k: v for k, v in vars(args).items() if k != 'work'},
+                                       'out': os.path.relpath(args.out, ROOT)},
         'team': SECTION5, 'shape': {
             'name': 'line', 'vertices': raw['formations.line.vertices'], 'spacing': SPACING,
             'why': "each robot gets the slot of its circle vertex's rank along x: the upper "
