@@ -10,6 +10,7 @@ import subprocess
 import sys
 import time
 
+import numpy as np
 import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -332,3 +333,44 @@ def test_robustness_benchmark_quick_run_writes_complete_results_and_figures(tmp_
             robustness.parse_args(bad)
         assert info.value.code == 2
     assert robustness.parse_args(['--quick', '--seeds', '5']).seeds == 1
+
+
+def test_switch_benchmark_offline_quick_run_measures_the_settle_after_the_switch(tmp_path):
+    script = os.path.join(ROOT, 'bench', 'bench_switch.py')
+    switch = load_bench(script)
+    result = subprocess.run([sys.executable, script, '--quick', '--offline', '--out',
+                             str(tmp_path)], capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stdout + result.stderr
+    data = json.loads((tmp_path / 'bench' / 'switch.json').read_text())
+    runs = data['runs']
+    assert set(runs) == {'formation_sim RK45', 'formation_sim --dt 0.01'}
+    for row in runs.values():
+        assert row['switch_at'] == switch.QUICK_SWITCH_AT
+        assert row['settle_time_before'] < switch.QUICK_SWITCH_AT
+        assert 0.0 < row['settle_time'] < switch.QUICK_DURATION - switch.QUICK_SWITCH_AT
+        assert row['max_abs_u_hat_after'] <= row['u_bound'] * (1.0 + 1e-9)
+        assert row['closest_after'] >= 1.0
+    rk45, fixed = runs['formation_sim RK45'], runs['formation_sim --dt 0.01']
+    assert abs(rk45['settle_time'] - fixed['settle_time']) <= 0.05
+    line = np.reshape(data['shape']['vertices'], (10, 2))
+    gaps = [np.linalg.norm(line[i] - line[j]) for i in range(10) for j in range(i)]
+    assert min(gaps) == pytest.approx(1.5) and np.all(line[:, 1] == 0.0)
+    assert data['machine']['nproc'] == os.cpu_count()
+    assert '| formation_sim RK45 | 6.00 |' in result.stdout
+    assert 'bench_switch: formation_sim RK45: settled' in result.stderr
+    for bad in (['--gif', '--offline'], ['--prefix', str(tmp_path)], ['--work', str(tmp_path)]):
+        with pytest.raises(SystemExit) as info:
+            switch.parse_args(bad)
+        assert info.value.code == 2
+
+
+def test_switch_benchmark_line_keeps_each_half_of_the_circle_in_order():
+    switch = load_bench(os.path.join(ROOT, 'bench', 'bench_switch.py'))
+    angles = np.arange(10) * 2.0 * np.pi / 10.0
+    circle = 8.0 * np.stack([np.sin(angles), np.cos(angles)], axis=1)
+    line = switch.line_shape(circle)
+    assert sorted(line[:, 0].tolist()) == pytest.approx([-6.75 + 1.5 * k for k in range(10)])
+    for half in (circle[:, 1] > 1e-9, circle[:, 1] < -1e-9):
+        order = np.argsort(circle[half, 0])
+        assert np.all(np.diff(line[half, 0][order]) > 0.0)
+    assert line[0, 0] == pytest.approx(0.75) and line[5, 0] == pytest.approx(-0.75)
