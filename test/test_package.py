@@ -309,3 +309,13 @@ def test_launch_file_refuses_a_bad_discovery_or_domain(launch_file, arguments):
     with pytest.raises(ValueError, match='discovery must be|domain_id must be'):
         launched_nodes(launch_file, params_file=os.path.join(ROOT, 'config', 'square_4.yaml'),
                        **arguments)
+
+
+def test_test_modules_have_distinct_names():
+    names = {}
+    for folder, _, files in os.walk(os.path.join(ROOT, 'test')):
+        for name in files:
+            if name.startswith('test_') and name.endswith('.py'):
+                names.setdefault(name, []).append(folder)
+    shared = {name: folders for name, folders in names.items() if len(folders) > 1}
+    assert not shared, f'pytest imports test modules by their basename: {shared}'
