@@ -10,6 +10,7 @@ does, and a scheduled switch in lockstep is compared with ``formation_sim``.
 """
 
 import json
+import math
 import subprocess
 
 from formation_ros.core.params import load_config
@@ -101,6 +102,8 @@ def test_shapes_switch_and_the_team_stops_and_goes(processes, install, probe, tm
     assert not refused.successful and 'b = 1 m must not exceed' in refused.reason
     short = set_parameter(probe, parameters, 'formation.vertices', LINE[:6])
     assert not short.successful and '4 x 2 = 8 values' in short.reason
+    nan = set_parameter(probe, parameters, 'formation.vertices', [math.nan] + LINE[1:])
+    assert not nan.successful and 'finite' in nan.reason
     unknown = set_parameter(probe, parameters, 'formation.name', 'circle')
     assert not unknown.successful and 'line, wedge' in unknown.reason
 
