@@ -52,6 +52,8 @@ def set_parameter(probe, client, name, value):
     """Set one parameter of the reference as ``ros2 param set`` does; return the result."""
     if isinstance(value, str):
         typed = ParameterValue(type=ParameterType.PARAMETER_STRING, string_value=value)
+    elif isinstance(value, float):
+        typed = ParameterValue(type=ParameterType.PARAMETER_DOUBLE, double_value=value)
     else:
         typed = ParameterValue(type=ParameterType.PARAMETER_DOUBLE_ARRAY,
                                double_array_value=value)

@@ -15,20 +15,8 @@ from formation_ros.ros import fields, qos
 from helpers import CONFIG, launch, node, stop_when, write_params
 from nav_msgs.msg import Odometry
 import numpy as np
-from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import SetParameters
-from test_changes import call, Poses
-
-
-def set_value(probe, client, name, value):
-    """Set a double or double array parameter of the reference; return the result."""
-    if isinstance(value, float):
-        typed = ParameterValue(type=ParameterType.PARAMETER_DOUBLE, double_value=value)
-    else:
-        typed = ParameterValue(type=ParameterType.PARAMETER_DOUBLE_ARRAY,
-                               double_array_value=value)
-    request = SetParameters.Request(parameters=[Parameter(name=name, value=typed)])
-    return call(probe, client, request).results[0]
+from test_changes import Poses, set_parameter
 
 
 def test_a_fixed_reference_moves_and_the_team_follows(processes, install, probe, tmp_path):
@@ -38,11 +26,11 @@ def test_a_fixed_reference_moves_and_the_team_follows(processes, install, probe,
     launch(processes, install, params)
     square = np.array([1.0, 1.0, -1.0, 1.0, -1.0, -1.0, 1.0, -1.0])
     assert probe.spin_until(lambda: poses.error(square) < 0.01, 90), processes.log('launcher')
-    refused = set_value(probe, client, 'reference.speed', 1.0)
+    refused = set_parameter(probe, client, 'reference.speed', 1.0)
     assert not refused.successful and 'circle, figure_eight and helix' in refused.reason
-    nan = set_value(probe, client, 'reference.origin', [math.nan, 0.0])
+    nan = set_parameter(probe, client, 'reference.origin', [math.nan, 0.0])
     assert not nan.successful and 'finite' in nan.reason
-    assert set_value(probe, client, 'reference.origin', [2.0, 1.0]).successful
+    assert set_parameter(probe, client, 'reference.origin', [2.0, 1.0]).successful
     moved = square + np.tile([2.0, 1.0], 4)
     info = stop_when(probe, processes, lambda: poses.error(moved) < 0.01)
     assert info.returncode == 0, processes.log('launcher')
@@ -57,11 +45,11 @@ def test_a_circle_changes_speed_without_a_jump(processes, install, probe, tmp_pa
     processes.start(node(install, 'reference', params))
     client = probe.create_client(SetParameters, '/reference/set_parameters')
     assert probe.spin_until(lambda: len(samples) > 20, 60), processes.log('reference')
-    refused = set_value(probe, client, 'reference.origin', [1.0, 0.0])
+    refused = set_parameter(probe, client, 'reference.origin', [1.0, 0.0])
     assert not refused.successful and 'moves only a fixed reference' in refused.reason
-    assert not set_value(probe, client, 'reference.speed', -1.0).successful
+    assert not set_parameter(probe, client, 'reference.speed', -1.0).successful
     before = len(samples)
-    assert set_value(probe, client, 'reference.speed', 2.0).successful
+    assert set_parameter(probe, client, 'reference.speed', 2.0).successful
     assert probe.spin_until(lambda: any(v > 1.9 for *_, v in samples[before:])
                             and len(samples) > before + 50, 30)
     track = np.array(samples)
@@ -79,6 +67,6 @@ def test_a_speed_unicycles_cannot_follow_is_refused(processes, install, probe):
     params = f'{CONFIG}/unicycle_circle_2d.yaml'
     processes.start(node(install, 'reference', params))
     client = probe.create_client(SetParameters, '/reference/set_parameters')
-    refused = set_value(probe, client, 'reference.speed', 1.0)
+    refused = set_parameter(probe, client, 'reference.speed', 1.0)
     assert not refused.successful and 'body.max_linear' in refused.reason
-    assert set_value(probe, client, 'reference.speed', 0.08).successful
+    assert set_parameter(probe, client, 'reference.speed', 0.08).successful
