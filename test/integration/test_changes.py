@@ -16,7 +16,6 @@ import subprocess
 from formation_ros.core.params import load_config
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.ros import qos
-from formation_ros.tools.sim import simulate
 from geometry_msgs.msg import PoseStamped, TwistStamped
 from helpers import exe, launch, SimClock, stop_when, write_params
 import numpy as np
@@ -24,6 +23,7 @@ from PIL import Image
 from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
 from rcl_interfaces.srv import SetParameters
 from std_srvs.srv import Trigger
+from test_system import lockstep_matches_simulation
 
 LINE = [-3.0, 0.0, -1.0, 0.0, 1.0, 0.0, 3.0, 0.0]
 WEDGE = [0.0, 1.5, -1.5, 0.0, 1.5, 0.0, 0.0, -1.5]
@@ -161,21 +161,11 @@ def test_shapes_switch_and_the_team_stops_and_goes(processes, install, probe, tm
 
 
 def test_a_scheduled_switch_in_lockstep_is_formation_sims(processes, install, probe, tmp_path):
-    params = write_params(tmp_path, 'square_4.yaml', {
-        **SHAPES, 'formation.schedule.times': [0.8], 'formation.schedule.names': ['wedge'],
-        'plant.lockstep': True, 'plant.realtime_factor': 200.0})
-    clock = SimClock(probe)
-    out = tmp_path / 'lockstep'
-    launch(processes, install, params, out=out)
-    info = stop_when(probe, processes, lambda: clock.seconds >= 1.6)
-    assert info.returncode == 0, processes.log('launcher')
-    plant = Trajectory.load(str(out / 'trajectory.npz'))
-    assert plant.t[-1] > 1.5
-    sim = simulate(load_config(params), duration=plant.t[-1], dt=0.01, sample_dt=0.01)
-    assert len(sim.t) == len(plant.t)
-    assert np.max(np.abs(sim.q - plant.q)) < 1e-9
-    assert np.max(np.abs(sim.u - plant.u)) < 1e-9
+    plant, params = lockstep_matches_simulation(
+        processes, install, probe, tmp_path, 'square_4.yaml',
+        {**SHAPES, 'formation.schedule.times': [0.8], 'formation.schedule.names': ['wedge']},
+        until=1.6)
     switched = plant.t >= 0.8 - 1e-9
-    assert np.allclose(plant.q_desired[switched][:, :, :].reshape(-1, 8), WEDGE)
+    assert np.allclose(plant.q_desired[switched].reshape(-1, 8), WEDGE)
     assert np.allclose(plant.q_desired[~switched].reshape(-1, 8),
                        load_config(params).vertices.ravel())

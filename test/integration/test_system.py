@@ -82,22 +82,29 @@ def test_robot_publishes_zero_when_its_plant_stops(processes, install, probe):
     assert log.count('publishing zero') == log.count('inputs fresh again') + 1, log
 
 
-def lockstep_matches_simulation(processes, install, probe, tmp_path, source):
+def lockstep_matches_simulation(processes, install, probe, tmp_path, source, changes=(),
+                                until=1.5):
+    """
+    Run ``source`` (with ``changes``) in lockstep to ``until`` s; assert it is formation_sim's.
+
+    Returns (the plant's trajectory, the parameters file).
+    """
     params = write_params(tmp_path, source, {'plant.lockstep': True,
-                                             'plant.realtime_factor': 200.0})
+                                             'plant.realtime_factor': 200.0, **dict(changes)})
     clock = SimClock(probe)
     out = tmp_path / 'lockstep'
     launch(processes, install, params, out=out)
-    info = stop_when(probe, processes, lambda: clock.seconds >= 1.5)
+    info = stop_when(probe, processes, lambda: clock.seconds >= until)
     assert info.returncode == 0, processes.log('launcher')
     plant = Trajectory.load(str(out / 'trajectory.npz'))
-    assert len(plant.t) >= 150  # 1.5 s of 0.01 s steps: a sample per step before it
+    assert len(plant.t) >= 100 * until  # 0.01 s steps: a sample per step before it
     assert np.allclose(np.diff(plant.t), 0.01)
     config = load_config(params)
     sim = simulate(config, duration=plant.t[-1], dt=0.01, sample_dt=0.01)
     assert len(sim.t) == len(plant.t)
     assert np.max(np.abs(sim.q - plant.q)) < 1e-9
     assert np.max(np.abs(sim.u - plant.u)) < 1e-9
+    return plant, params
 
 
 def test_lockstep_equals_formation_sim_fixed_reference(processes, install, probe, tmp_path):
