@@ -26,7 +26,7 @@ It runs until Ctrl-C; ``formation_report`` reads the bag or the output directory
 import os
 
 from ament_index_python.packages import get_package_share_directory
-from formation_ros.tools.system import launch_file_nodes
+from formation_ros.tools.system import launch_file_nodes, SHARED_LAUNCH_ARGUMENTS
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch.substitutions import LaunchConfiguration
@@ -49,17 +49,12 @@ def generate_launch_description():
     return LaunchDescription([
         DeclareLaunchArgument('params_file', default_value=default_params,
                               description='ROS 2 parameters file of the formation'),
-        DeclareLaunchArgument('record', default_value='',
-                              description='rosbag2 directory to record into (empty: none)'),
         DeclareLaunchArgument('output_dir', default_value='',
                               description='where the plant writes trajectory.npz and '
                                           'plant_stats.json (empty: nowhere)'),
         DeclareLaunchArgument('robots_per_process', default_value='1',
                               description="robots per process (above 1: 'fleet' processes)"),
-        DeclareLaunchArgument('discovery', default_value='',
-                              description="'localhost' or 'subnet' (empty: the environment's "
-                                          'ROS_AUTOMATIC_DISCOVERY_RANGE, else localhost)'),
-        DeclareLaunchArgument('domain_id', default_value='',
-                              description="ROS_DOMAIN_ID of the nodes (empty: the environment's)"),
+        *[DeclareLaunchArgument(name, default_value=default, description=text)
+          for name, default, text in SHARED_LAUNCH_ARGUMENTS],
         OpaqueFunction(function=formation_nodes),
     ])

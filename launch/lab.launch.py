@@ -26,7 +26,7 @@ relay's sources); ``robots_per_process`` above 1 runs ``fleet`` processes, but n
 It runs until Ctrl-C; ``formation_report`` reads the bag afterwards.
 """
 
-from formation_ros.tools.system import launch_file_nodes
+from formation_ros.tools.system import launch_file_nodes, SHARED_LAUNCH_ARGUMENTS
 from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch.substitutions import LaunchConfiguration
@@ -56,12 +56,7 @@ def generate_launch_description():
         DeclareLaunchArgument('robots_per_process', default_value='1',
                               description="robots per process (above 1: 'fleet' processes; "
                                           'not with cmd_topic)'),
-        DeclareLaunchArgument('discovery', default_value='',
-                              description="'localhost' or 'subnet' (empty: the environment's "
-                                          'ROS_AUTOMATIC_DISCOVERY_RANGE, else localhost)'),
-        DeclareLaunchArgument('domain_id', default_value='',
-                              description="ROS_DOMAIN_ID of the nodes (empty: the environment's)"),
-        DeclareLaunchArgument('record', default_value='',
-                              description='rosbag2 directory to record into (empty: none)'),
+        *[DeclareLaunchArgument(name, default_value=default, description=text)
+          for name, default, text in SHARED_LAUNCH_ARGUMENTS],
         OpaqueFunction(function=lab_nodes),
     ])

@@ -55,7 +55,7 @@ once from the diagnostics timer.
 
 import enum
 import time
-from typing import Dict, List, Optional, Tuple
+from typing import Callable, Dict, List, Optional, Tuple
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.bodies import make_bodies
@@ -179,22 +179,24 @@ class RelayNode(Node):
 
     def on_pose(self, index: int, data: bytes) -> None:
         """Store robot ``index``'s measured pose, read from a serialized PoseStamped."""
+        self._read(index, data, lambda raw: read_pose_stamped(raw, exact=True))
+
+    def on_odometry(self, index: int, data: bytes) -> None:
+        """Store robot ``index``'s measured pose, read from a serialized nav_msgs/Odometry."""
+        def pose_of(raw: bytes) -> PoseData:
+            odometry = read_odometry(raw, exact=True)
+            return PoseData(odometry.stamp_ns, odometry.frame_id, odometry.position,
+                            odometry.orientation)
+        self._read(index, data, pose_of)
+
+    def _read(self, index: int, data: bytes, reader: Callable[[bytes], PoseData]) -> None:
+        """Store what ``reader`` makes of the bytes; refuse (count, log once) what it cannot."""
         try:
-            pose = read_pose_stamped(data, exact=True)
+            pose = reader(data)
         except CdrError as exc:
             self._refuse(index, Reason.MALFORMED, f'{exc}, expected a {self.source_type_name}')
             return
         self._store(index, pose)
-
-    def on_odometry(self, index: int, data: bytes) -> None:
-        """Store robot ``index``'s measured pose, read from a serialized nav_msgs/Odometry."""
-        try:
-            odometry = read_odometry(data, exact=True)
-        except CdrError as exc:
-            self._refuse(index, Reason.MALFORMED, f'{exc}, expected a {self.source_type_name}')
-            return
-        self._store(index, PoseData(odometry.stamp_ns, odometry.frame_id, odometry.position,
-                                    odometry.orientation))
 
     def _store(self, index: int, pose: PoseData) -> None:
         """Keep a measurement that is in world_frame, finite and rotated by a unit quaternion."""

@@ -27,6 +27,13 @@ from typing import Any, List, Mapping, Optional, Sequence, Tuple
 from formation_ros.ros.topics import CMD_VEL, robot_namespace, robot_topic
 
 PACKAGE = 'formation_ros'
+SHARED_LAUNCH_ARGUMENTS = (
+    ('discovery', '', "'localhost' or 'subnet' (empty: the environment's "
+                      'ROS_AUTOMATIC_DISCOVERY_RANGE, else localhost)'),
+    ('domain_id', '', "ROS_DOMAIN_ID of the nodes (empty: the environment's)"),
+    ('record', '', 'rosbag2 directory to record into (empty: none)'),
+)
+"""(name, default, description) of the launch arguments both launch files take."""
 DISCOVERY = ('localhost', 'subnet')
 DISCOVERY_ENV = 'ROS_AUTOMATIC_DISCOVERY_RANGE'
 DOMAIN_ENV = 'ROS_DOMAIN_ID'
