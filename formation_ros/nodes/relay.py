@@ -29,7 +29,13 @@ wall-clock time at the cycle (``get_clock().now()``), so that a robot, which ans
 when its pose and neighbours carry the same stamp, answers every cycle. The age of a
 measurement is measured from its arrival on this host's monotonic clock, never from its header
 stamp: a mocap computer's clock may be off by any amount. A measurement's own stamp is not
-used (nor forwarded).
+forwarded; it is only compared with the same robot's previous one, which needs no common clock:
+a measurement stamped no later than the last one taken (a driver that repeats a frozen pose
+after it lost the body, or a reordered sample) is refused and does not keep the robot fresh,
+so a frozen source goes stale after ``relay.max_age`` like a silent one. Stamps that go back by
+more than ``relay.max_age`` are a restarted source: taken, and logged once. A source that
+stamps nothing (stamp 0, e.g. ``ros2 topic pub``) is taken by arrival alone, logged once:
+repeats cannot be told from fresh measurements there.
 
 What is forwarded: the positions (x, y and in 3D z; in 2D the height z is dropped) and the
 orientations. A unicycle's orientation is its heading (yaw of the measured quaternion) as a
@@ -81,6 +87,7 @@ from scipy.spatial import cKDTree
 
 NS_PER_S = 1_000_000_000
 NEVER = -1
+UNSTAMPED = 0
 MESSAGE_TYPES = {SourceType.POSE: PoseStamped, SourceType.ODOMETRY: Odometry}
 
 
@@ -91,6 +98,7 @@ class Reason(enum.Enum):
     FRAME = 'a frame other than world_frame'
     NON_FINITE = 'non-finite values'
     ROTATION = 'an orientation that is not a unit quaternion'
+    NOT_NEWER = 'a stamp no later than the last one taken (a repeated or reordered measurement)'
 
 
 class RelayNode(Node):
@@ -134,6 +142,7 @@ class RelayNode(Node):
         self.positions = np.zeros((self.n, 3))
         self.orientations = np.tile([0.0, 0.0, 0.0, 1.0], (self.n, 1))
         self.received_ns = np.full(self.n, NEVER, dtype=np.int64)
+        self.stamps_ns: List[Optional[int]] = [None] * self.n
         self.measurements = np.zeros(self.n, dtype=np.int64)
         self.refused: Dict[Tuple[int, Reason], int] = {}
         self.foreign_types: Dict[str, List[str]] = {}
@@ -208,11 +217,31 @@ class RelayNode(Node):
                                                    f'{pose.orientation}')
         elif not valid_quaternions(pose.orientation):
             self._refuse(index, Reason.ROTATION, f'orientation {pose.orientation}')
-        else:
+        elif self._advances(index, pose.stamp_ns):
             self.positions[index] = pose.position
             self.orientations[index] = pose.orientation
             self.received_ns[index] = time.monotonic_ns()
             self.measurements[index] += 1
+
+    def _advances(self, index: int, stamp_ns: int) -> bool:
+        """Return whether robot ``index``'s measurement stamped ``stamp_ns`` is a new one."""
+        last, self.stamps_ns[index] = self.stamps_ns[index], stamp_ns
+        source = self.sources[index]
+        if stamp_ns == UNSTAMPED:
+            self.once.start(f'unstamped-{index}',
+                            f'robot {index + 1}: measurements on {source} carry no stamp: '
+                            'taken as they arrive (a repeating source would look fresh)')
+        elif last is not None and last != UNSTAMPED and stamp_ns <= last:
+            if last - stamp_ns <= self.max_age_ns:
+                self.stamps_ns[index] = last
+                self._refuse(index, Reason.NOT_NEWER, f'stamp {stamp_ns / NS_PER_S:.9f} s '
+                                                      f'after {last / NS_PER_S:.9f} s')
+                return False
+            self.once.start(f'restarted-{index}',
+                            f'robot {index + 1}: stamps on {source} went back by '
+                            f'{(last - stamp_ns) / NS_PER_S:.3f} s (a restarted source?): '
+                            'taking its measurements from here on')
+        return True
 
     def on_cycle(self) -> None:
         """Publish the pose and sensor reading of every fresh robot, all with one stamp."""
@@ -263,7 +292,7 @@ class RelayNode(Node):
                                             f'{self.sources[i]}: publishing its pose')
             elif measured[i]:
                 where = np.round(self.positions[i, :self.dim], 3).tolist()
-                self.once.start(f'stale-{i}', f'robot {i + 1}: no measurement on '
+                self.once.start(f'stale-{i}', f'robot {i + 1}: no new measurement on '
                                               f'{self.sources[i]} for {self.settings.max_age:g}'
                                               ' s: no pose for it (its watchdog stops it); '
                                               'the others keep it in their neighbour lists at '

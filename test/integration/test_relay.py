@@ -8,6 +8,7 @@ The probe plays the motion-capture system; the neighbour lists are checked again
 reference of the sensing rule written here (strictly within R_i; R_i + 2 l for unicycles).
 """
 
+import itertools
 import math
 import os
 
@@ -122,10 +123,12 @@ def test_relay_publishes_every_pose_and_the_brute_force_neighbours_with_one_stam
                                          qos.STATE if i <= 2 else RELIABLE)
                   for i in range(1, 6)]
     turned = unit_quaternions(5, 1)
+    stamps = itertools.count(17)
 
     def measure():
+        stamp = next(stamps)
         for i, publisher in enumerate(publishers):
-            publisher.publish(encode_pose_stamped(17, 'map', POSITIONS[i], turned[i]))
+            publisher.publish(encode_pose_stamped(stamp, 'map', POSITIONS[i], turned[i]))
         return len(outputs.complete_cycles(range(1, 6))) >= 3
 
     assert probe.spin_until(measure, START_UP), processes.log('relay')
@@ -160,10 +163,12 @@ def test_relay_reads_odometry_by_name_and_lists_unicycles_within_r_plus_2l(
                     math.cos(tilt / 2) * math.sin(h / 2), math.cos(tilt / 2) * math.cos(h / 2))
                    for h in headings]
     """A rotation about z by th after a small roll about x: yaw th, not a pure z rotation."""
+    stamps = itertools.count(5)
 
     def measure():
+        stamp = next(stamps)
         for i, publisher in enumerate(publishers):
-            publisher.publish(encode_odometry(5, 'map', names[i], q[i], quaternions[i],
+            publisher.publish(encode_odometry(stamp, 'map', names[i], q[i], quaternions[i],
                                               (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)))
         return bool(outputs.complete_cycles(range(1, 6)))
 
@@ -216,6 +221,7 @@ def test_refused_measurements_are_counted_logged_once_and_never_published(
     sent = []
 
     def counted():
+        forged[1] = encode_pose_stamped(3 + len(sent), 'map', (0.0, 0.0))
         for i, publisher in pubs.items():
             publisher.publish(forged[i])
         sent.append(1)
@@ -241,6 +247,55 @@ def test_refused_measurements_are_counted_logged_once_and_never_published(
     assert values['/robot_6/measured_pose: publishers of another type'] == \
         'nav_msgs/msg/Odometry'
     assert outputs.statuses[-1].level == DiagnosticStatus.ERROR
+    assert 'Traceback' not in log
+
+
+def test_a_frozen_source_goes_stale_an_unstamped_one_is_taken_a_restarted_one_resumes(
+        processes, install, probe, tmp_path):
+    """
+    A frozen source goes stale; an unstamped one and one whose stamps jump back do not.
+
+    Robot 1's stamps advance (and later jump 100 s back), robot 2's stay at one value (a driver
+    repeating a lost body's pose), robot 3's are 0 (no stamps).
+    """
+    max_age = 0.3
+    triangle = [1.0, 0.0, -0.5, 0.866, -0.5, -0.866]
+    params = write_params(tmp_path, 'square_4.yaml', {
+        'num_robots': 3, 'world_frame': 'map', 'formation.vertices': triangle,
+        'sensing_radii': [5.0] * 3, 'relay.max_age': max_age})
+    outputs = Outputs(probe, 3)
+    processes.start(node(install, 'relay', params))
+    publishers = {i: probe.create_publisher(PoseStamped, f'/robot_{i}/measured_pose', RELIABLE)
+                  for i in range(1, 4)}
+    reason = 'a stamp no later than the last one taken (a repeated or reordered measurement)'
+    key = STATUS_KEY.format(robot=2, reason=reason)
+    ticks = itertools.count()
+    back = {'by': 0}
+
+    def measure():
+        tick = next(ticks)
+        stamps = {1: 1000 * NS_PER_S + tick * 1_000_000 - back['by'], 2: 500 * NS_PER_S, 3: 0}
+        for i, publisher in publishers.items():
+            publisher.publish(encode_pose_stamped(stamps[i], 'map', POSITIONS[i - 1]))
+        values = outputs.values()
+        return (values.get('stale robots') == '2' and int(values.get(key, 0)) > 10
+                and len(outputs.poses[1]) > 20 and len(outputs.poses[3]) > 20)
+
+    assert probe.spin_until(measure, START_UP), (outputs.values(), processes.log('relay'))
+    seen = {i: len(outputs.poses[i]) for i in range(1, 4)}
+    back['by'] = 100 * NS_PER_S
+    assert probe.spin_until(lambda: measure() and len(outputs.poses[1]) > seen[1] + 20,
+                            START_UP), (outputs.values(), processes.log('relay'))
+    values = outputs.values()
+    assert not [k for k in values if k.startswith('robot 1: refused')], values
+    assert not [k for k in values if k.startswith('robot 3: refused')], values
+    assert outputs.statuses[-1].level == DiagnosticStatus.WARN
+    log = processes.log('relay')
+    assert log.count('robot 2: ignoring measurements on /robot_2/measured_pose with a stamp '
+                     'no later than the last one taken') == 1, log
+    assert log.count('robot 3: measurements on /robot_3/measured_pose carry no stamp') == 1, log
+    assert log.count('robot 1: stamps on /robot_1/measured_pose went back by') == 1, log
+    assert log.count('robot 2: no new measurement on /robot_2/measured_pose') == 1, log
     assert 'Traceback' not in log
 
 
@@ -329,9 +384,9 @@ def test_mocap_dropout_stops_one_robot_and_the_others_keep_it_in_their_lists(
 
     assert probe.spin_until(back, 30), (outputs.values(), processes.log('relay'))
     log = processes.log('relay')
-    assert log.count('robot 3: no measurement on /robot_3/measured_pose') == 1, log
+    assert log.count('robot 3: no new measurement on /robot_3/measured_pose') == 1, log
     assert log.count('robot 3: measured again') == 1, log
-    assert 'robot 1: no measurement' not in log
+    assert 'robot 1: no new measurement' not in log
 
 
 @pytest.mark.parametrize('name, first_source', [('lab_turtlebot3.yaml', '/vrpn_mocap/tb1/pose'),
