@@ -157,5 +157,5 @@ def test_the_robustness_limits_are_those_of_the_sweeps():
     broke = [r['value'] for r in rows if r['config'] == 'section5' and not r['summary']['held']]
     line = next(line for line in formation_docs.robustness_limits(data)
                 if line.startswith('| delay'))
-    assert f'held up to {max(v for v in held if v < min(broke))}; first below at ' \
+    assert f'held through {max(v for v in held if v < min(broke))}; first below at ' \
            f'{min(broke)}' in line.split(' | ')[1]

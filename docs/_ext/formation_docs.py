@@ -281,7 +281,8 @@ def bench_capacity() -> List[str]:
     notes = []
     for name in BENCH_FILES['capacity']:
         data = read_json(name)
-        lines += [row(entry) for entry in data['rows']]
+        lines += [row({**entry, 'mode': f"lockstep {entry['mode']}"} if entry.get('lockstep')
+                      else entry) for entry in data['rows']]
         notes += ['', machine_line(data, name)]
     return lines + notes
 
@@ -308,19 +309,22 @@ def robustness_limits(data: Mapping[str, Any]) -> List[str]:
     rows = []
     for sweep, per_config in limits.items():
         entry = sweeps[sweep]
-        cells = [f"{sweep} ({code(entry['parameter'])}, {entry['unit']})"]
+        values = [row['value'] for row in entry['rows'] if row['config'] == configs[0]]
+        cells = [f"{sweep} ({code(entry['parameter'])}, {entry['unit']}; swept "
+                 f'{values[0]} to {values[-1]})']
         for config in configs:
             found = per_config[config]
             broke = [row for row in entry['rows'] if row['config'] == config
                      and row['value'] == found['first_below_size']]
-            held = f"held up to {found['held_up_to']}" if found['held_up_to'] is not None \
+            held = f"held through {found['held_up_to']}" if found['held_up_to'] is not None \
                 else 'held at no value'
             if broke:
                 summary = broke[0]['summary']
+                count = summary['collisions']
                 held += (f"; first below at {found['first_below_size']} "
-                         f"({summary['closest_bodies']:.3g} m, {summary['collisions']} "
-                         'collisions)')
-            settle = f"settles up to {found['converged_up_to']}"
+                         f"({summary['closest_bodies']:.3g} m, {count} "
+                         f"collision{'' if count == 1 else 's'})")
+            settle = f"settles through {found['converged_up_to']}"
             if found['first_not_converged'] is not None:
                 settle += f", not at {found['first_not_converged']}"
             cells.append(f'{held}; {settle}')
