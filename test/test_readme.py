@@ -96,7 +96,8 @@ def shell_blocks(path):
 
 
 def ros2_run_lines(path):
-    """Return (command, variables) for each ``ros2 run formation_ros`` line of a file.
+    """
+    Return (command, variables) for each ``ros2 run formation_ros`` line of a file.
 
     A variable (``P=...``) holds from its assignment to the end of the file.
     """
@@ -182,8 +183,8 @@ def test_every_ros2_run_line_starts_as_written(path):
 
 
 @pytest.mark.parametrize('command, says', [
-    ('ros2 run formation_ros robot --ros-args -r __ns:=/robot_1 --params-file config/square_4.yaml',
-     'needs -p use_sim_time:=true'),
+    ('ros2 run formation_ros robot --ros-args -r __ns:=/robot_1 '
+     '--params-file config/square_4.yaml', 'needs -p use_sim_time:=true'),
     ('ros2 run formation_ros plant --ros-args --params-file config/square_4.yaml '
      '-p use_sim_time:=true', 'must not wait for /clock'),
     ('ros2 run formation_ros robot --ros-args --params-file config/lab_turtlebot3.yaml '
