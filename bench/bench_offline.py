@@ -97,6 +97,10 @@ def run_case(args: argparse.Namespace, n: int, folder: str) -> Dict[str, Any]:
     return row
 
 
+HEADER = ('| N | wall (s) | peak RSS (MiB) | ms per step (whole command) | real-time factor | '
+          'min pair distance (m) | max abs u_hat (m/s) |\n|---:|---:|---:|---:|---:|---:|---|')
+
+
 def format_row(row: Dict[str, Any]) -> str:
     """One Markdown table row."""
     if 'error' in row:
@@ -114,9 +118,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     print(f'machine: {platform.machine()}, {os.cpu_count()} cores, Python '
           f'{platform.python_version()}; {args.duration:g} s simulated, dt {args.dt:g}, '
           f'samples every {args.sample_dt:g} s\n')
-    print('| N | wall (s) | peak RSS (MiB) | ms per step (whole command) | real-time factor | '
-          'min pair distance (m) | max abs u_hat (m/s) |\n|---:|---:|---:|---:|---:|---:|---|',
-          flush=True)
+    print(HEADER, flush=True)
     rows: List[Dict[str, Any]] = []
     for n in args.sizes:
         with tempfile.TemporaryDirectory(dir=args.out) as folder:

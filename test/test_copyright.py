@@ -19,7 +19,7 @@ LICENSE_TEXTS = {
     '0ffddef9e48f8a09aed5caf2d44f7ba1c1be2d9b8e0a6f693b1635b2d5566645': 'Apache-2.0',
 }
 ENCODING_LINE = re.compile(r'^[ \t\f]*#.*?coding[:=][ \t]*[-\w.]+')
-SOURCE_DIRS = ('formation_ros', 'test', 'bench', 'launch')
+SOURCE_DIRS = ('formation_ros', 'test', 'bench', 'launch', 'docs')
 
 
 def license_of_license_file():

@@ -14,6 +14,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 @pytest.mark.linter
 @pytest.mark.pep257
 def test_pep257():
-    paths = [os.path.join(ROOT, name) for name in ('formation_ros', 'test', 'bench', 'launch')]
+    names = ('formation_ros', 'test', 'bench', 'launch', 'docs')
+    paths = [os.path.join(ROOT, name) for name in names]
     rc = main(argv=[p for p in paths if os.path.exists(p)])
     assert rc == 0, 'pep257 findings: see the output above'

@@ -10,7 +10,8 @@ import sys
 import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-SCRIPTS = ('setup_env.sh', 'demo.sh', 'run_tests.sh', 'launch_formation.sh', 'hosts.sh')
+SCRIPTS = ('setup_env.sh', 'demo.sh', 'run_tests.sh', 'launch_formation.sh', 'hosts.sh',
+           'build_docs.sh')
 
 
 def run(script, *args):

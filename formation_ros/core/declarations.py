@@ -6,8 +6,9 @@ One declaration per parameter: name, type, allowed range, description, who reads
 
 This is the only list of parameters. ``core.params`` checks values against it and builds the
 typed settings; the ROS adapter declares each node's parameters from it (with the same
-descriptions and ranges); the README's table is checked against it. Adding a parameter means
-adding its :class:`Param` here and using it in ``core.params``.
+descriptions and ranges); the docs' parameter reference is generated from it (a declaration
+without a description fails the docs build). Adding a parameter means adding its
+:class:`Param` here and using it in ``core.params``.
 
 A range bound is inclusive or exclusive and says so in messages: ``> 0`` for a strictly
 positive value, ``>= 2`` for an inclusive one.

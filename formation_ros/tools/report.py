@@ -245,8 +245,8 @@ def _fail(message: str) -> int:
     return 2
 
 
-def main(argv: Optional[list] = None) -> int:
-    """Entry point of ``formation_report``; returns the exit code."""
+def build_parser() -> argparse.ArgumentParser:
+    """Command-line interface of formation_report."""
     parser = argparse.ArgumentParser(
         prog='formation_report',
         description='Metrics and figures of a recorded formation run.',
@@ -279,6 +279,12 @@ def main(argv: Optional[list] = None) -> int:
     parser.add_argument('--dpi', type=float, default=DEFAULT_DPI,
                         help=f'resolution of the animation: {FIGURE_WIDTH:g} inches wide '
                              f'at this many dots per inch (default {DEFAULT_DPI}), 20 to 300')
+    return parser
+
+
+def main(argv: Optional[list] = None) -> int:
+    """Entry point of ``formation_report``; returns the exit code."""
+    parser = build_parser()
     args = parser.parse_args(argv)
     if args.out is None and not args.repair:
         parser.error('the following arguments are required: --out (or give --repair)')
