@@ -2,8 +2,10 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-Exit codes that say why a process ended, in one place: the nodes exit with them, the launcher
-reads them (this module imports nothing, so the launcher's ``--help`` stays light).
+Exit codes that say why a process ended, in one place.
+
+The nodes exit with them and the launcher reads them (this module imports nothing, so the
+launcher's ``--help`` stays light).
 
 0 is a normal end, 1 a failure (a node's ``finish()`` failed, a report could not be written),
 2 bad parameters or usage (``formation_ros.ros.runner``, the launcher).

@@ -469,7 +469,7 @@ class PlantNode(Node):
             self.model.heading if self.unicycles else None))
 
     def write_chunk(self) -> None:
-        """Write the samples since the last chunk into ``plant.output_dir``; once, say a failure."""
+        """Write the samples since the last chunk into ``plant.output_dir`` (a failure: once)."""
         assert self.chunks is not None
         try:
             self.chunks.flush()

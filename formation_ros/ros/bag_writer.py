@@ -455,16 +455,8 @@ class _Rosbag2Writer(Writer):
 
     STORAGE_PLUGINS = {StoragePlugin.MCAP: McapStorage}
 
-    @property
-    def mcap(self) -> McapStorage:
-        """Return the storage (open or closed)."""
-        return self._mcap_storage
-
-    def open(self) -> None:
-        """Open as rosbags does; keep the storage for after it is closed."""
-        super().open()
-        assert isinstance(self.storage, McapStorage)
-        self._mcap_storage = self.storage
+    mcap: McapStorage
+    """The storage, kept once rosbags has dropped it (set by :class:`BagWriter`)."""
 
     def close(self) -> None:
         """Close as rosbags does, then list every MCAP file of the bag in metadata.yaml."""
@@ -522,7 +514,9 @@ class BagWriter:
         except OSError as exc:
             shutil.rmtree(self.path, ignore_errors=True)
             raise BagWriteError(f'cannot create {self.path}: {reason_of(exc)}') from None
-        self._storage = self._writer.mcap
+        storage = self._writer.storage
+        assert isinstance(storage, McapStorage)
+        self._writer.mcap = self._storage = storage
         self._storage.flushes_per_file = flushes_per_file
         self._connections: Dict[str, Connection] = {}
         self._written = 0

@@ -116,8 +116,8 @@ def test_a_full_disk_stops_the_recording_alone_and_leaves_a_readable_bag(
         assert simulated < LONG_RUN / 2
 
 
-def test_a_full_output_directory_stops_the_plant_output_alone(processes, install, probe,
-                                                               tmp_path, tiny_disk):
+def test_a_full_output_directory_stops_the_plant_output_alone(
+        processes, install, probe, tmp_path, tiny_disk):
     fill(tiny_disk, 20_000)
     out = tiny_disk / 'out'
     params = write_params(tmp_path, 'square_4.yaml', {'duration': RUN})

@@ -48,11 +48,11 @@ class Disk:
         disk = self
 
         class OnThisDisk(McapStorage):
-            OPENER = staticmethod(lambda path: disk.open(path))
+            OPENER = staticmethod(lambda path: disk.create(path))
 
         return OnThisDisk
 
-    def open(self, path):
+    def create(self, path):
         self.files.append(path)
         return DiskFile(self, path)
 
