@@ -55,11 +55,12 @@ class Trajectory:
         Write the arrays to ``path`` (a .npz file, not compressed); body arrays when present.
 
         Float trajectories compress by a few per cent only, and zlib was a tenth of a 1000-robot
-        formation_sim run; ``np.load`` reads either kind.
+        formation_sim run; ``np.load`` reads either kind. Written whole or not at all
+        (:func:`save_atomically`): an OSError leaves no partial file.
         """
         arrays = {name: getattr(self, name) for name in ARRAYS + BODY_ARRAYS
                   if getattr(self, name) is not None}
-        np.savez(path, **arrays)
+        save_atomically(path, lambda stream: np.savez(stream, **arrays))
 
     @classmethod
     def from_frames(cls, t: ArrayLike, q: ArrayLike, u: ArrayLike,
@@ -106,6 +107,10 @@ class ChunkWriter:
     short (even by SIGKILL) loses at most the chunk not yet written: :func:`read_chunks` reads
     back every complete file. t in s; q, u (N, dim); for unicycles also heading (N,), q_body
     (N, 2) and body_command (N, 2) (:data:`BODY_ARRAYS`, read back by :func:`read_body_chunks`).
+
+    A chunk that cannot be written (a full disk) is removed, and the writer stops: :meth:`flush`
+    raises that OSError once, then :attr:`failed` holds it and samples are no longer kept, so
+    the folder stays a gap-free run up to :attr:`written_until`.
     """
 
     def __init__(self, folder: str):
@@ -117,9 +122,14 @@ class ChunkWriter:
         self._q: List[NDArray[np.float64]] = []
         self._u: List[NDArray[np.float64]] = []
         self._body: Dict[str, List[NDArray[np.float64]]] = {name: [] for name in BODY_ARRAYS}
+        self.failed: Optional[OSError] = None
+        self.written_until: Optional[float] = None
+        """Time of the last sample in the chunks written, s (None before any)."""
 
     def append(self, t: float, q: ArrayLike, u: ArrayLike, **body: ArrayLike) -> None:
         """Keep one sample until the next :meth:`flush`; body: the :data:`BODY_ARRAYS`."""
+        if self.failed is not None:
+            return
         self._t.append(float(t))
         self._q.append(np.array(q, dtype=float))
         self._u.append(np.array(u, dtype=float))
@@ -128,20 +138,46 @@ class ChunkWriter:
 
     def flush(self) -> None:
         """Write the samples kept so far as the next chunk (atomically: a rename)."""
-        if not self._t:
+        if not self._t or self.failed is not None:
             return
         path = os.path.join(self.folder, f'{self.count:06d}.npz')
-        partial = path + '.part'
         arrays: Dict[str, Any] = {'t': np.array(self._t), 'q': np.array(self._q),
                                   'u': np.array(self._u)}
         arrays.update({name: np.array(values) for name, values in self._body.items()
                        if len(values) == len(self._t)})
-        with open(partial, 'wb') as stream:
-            np.savez(stream, **arrays)
-        os.replace(partial, path)
-        self.count += 1
+        last = self._t[-1]
         self._t, self._q, self._u = [], [], []
         self._body = {name: [] for name in BODY_ARRAYS}
+        try:
+            save_atomically(path, lambda stream: np.savez(stream, **arrays))
+        except OSError as exc:
+            self.failed = exc
+            raise
+        self.count += 1
+        self.written_until = last
+
+
+def _remove(path: str) -> None:
+    try:
+        os.remove(path)
+    except OSError:
+        pass
+
+
+def save_atomically(path: str, write: Any) -> None:
+    """
+    Write a file with ``write(stream)`` into ``path.part``, then rename it to ``path``.
+
+    A failure (OSError: a full disk) leaves no part file and no half-written ``path``.
+    """
+    partial = path + '.part'
+    try:
+        with open(partial, 'wb') as stream:
+            write(stream)
+        os.replace(partial, path)
+    except OSError:
+        _remove(partial)
+        raise
 
 
 def _chunk_files(folder: str) -> List[str]:

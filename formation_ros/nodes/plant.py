@@ -19,7 +19,9 @@ the collision check. This node only moves messages in and out:
   advances with the states, so nodes on simulated time wake once per state, not per step;
 * it logs what the model reports (once per condition), publishes ``/diagnostics`` and
   ``/formation/markers``, and with ``plant.output_dir`` writes ``trajectory.npz`` and
-  ``plant_stats.json`` when it stops.
+  ``plant_stats.json`` when it stops. Its output is not what it is for: when a write there
+  fails (a full disk) it says so in one line, keeps what was written (whole trajectory chunks,
+  which ``formation_report`` reads), writes nothing more and goes on controlling.
 
 With ``plant.lockstep`` it steps only when every robot has answered the latest state, which
 makes a run reproduce ``formation_sim --dt 1/plant.rate``.
@@ -49,7 +51,7 @@ from formation_ros.core.plant import (Commands, CommandStatus, DurationHistogram
 from formation_ros.core.team import team_values
 from formation_ros.core.timeline import Mode
 from formation_ros.core.trajectory import (CHUNKS_DIR, ChunkWriter, read_body_chunks,
-                                           read_chunks, Trajectory)
+                                           read_chunks, save_atomically, Trajectory)
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import (CdrError, encode_clock, read_twist, read_twist_stamped,
                                    StateEncoder)
@@ -119,6 +121,7 @@ class PlantNode(Node):
         self.publish_every = 1 if self.lockstep else settings.steps_per_publish
         self.chunks = (ChunkWriter(os.path.join(settings.output_dir, CHUNKS_DIR))
                        if settings.output_dir else None)
+        self.output_failure: Optional[str] = None
         self.closest = self.model.closest_pair_distance()
         self.largest_u_hat = 0.0
         self.command_subs = []
@@ -156,7 +159,7 @@ class PlantNode(Node):
         self.diagnostics_timer = self.create_timer(PERIOD, self.on_diagnostics,
                                                    clock=self.steady)
         if self.chunks is not None:
-            self.chunk_timer = self.create_timer(CHUNK_PERIOD, self.chunks.flush,
+            self.chunk_timer = self.create_timer(CHUNK_PERIOD, self.write_chunk,
                                                  clock=self.steady)
         if settings.marker_rate > 0.0:
             self.marker_pub = self.create_publisher(MarkerArray, topics.MARKERS, qos.MARKERS)
@@ -465,11 +468,33 @@ class PlantNode(Node):
             self.paths, self.model.t_ns, self.config.world_frame,
             self.model.heading if self.unicycles else None))
 
+    def write_chunk(self) -> None:
+        """Write the samples since the last chunk into ``plant.output_dir`` (a failure: once)."""
+        assert self.chunks is not None
+        try:
+            self.chunks.flush()
+        except OSError as exc:
+            self._output_failed(exc, self.chunks.folder)
+
+    def _output_failed(self, exc: OSError, where: str) -> None:
+        """Say in one line that the output stopped, where and why; write nothing more."""
+        assert self.chunks is not None
+        until = self.chunks.written_until
+        kept = ('nothing of the trajectory' if until is None else
+                f'the trajectory up to t = {until:.2f} s in {self.chunks.count} chunks '
+                f'({CHUNKS_DIR}/, which formation_report reads)')
+        reason = exc.strerror or ' '.join(str(exc).split()) or type(exc).__name__
+        self.output_failure = f'cannot write to {where} ({reason})'
+        self.get_logger().error(
+            f'plant: output stopped at t = {self.model.t:.2f} s: {self.output_failure}; '
+            f'{self.settings.output_dir} keeps {kept}; the plant goes on controlling and '
+            'writes nothing more there')
+
     def trajectory(self) -> Optional[Trajectory]:
         """Return the run written so far (``plant.output_dir``): a sample per published state."""
         if self.chunks is None:
             return None
-        self.chunks.flush()
+        self.write_chunk()
         try:
             t, q, u = read_chunks(self.chunks.folder)
         except ValueError:
@@ -497,9 +522,13 @@ class PlantNode(Node):
             f'final max error {error:.3g} m, min pair distance {self.closest:.4g} m{bodies}, '
             f'max |u_hat| {self.largest_u_hat:.4g} m/s (bound {self.law.u_bound:.4g}), '
             f"{totals['collisions']} collisions, {totals['bound_violations']} commands above "
-            f"the bound, {totals['stale_command_steps']} stale commands")
+            f"the bound, {totals['stale_command_steps']} stale commands"
+            + (f'; output stopped early: {self.output_failure}' if self.output_failure else ''))
         output_dir = self.settings.output_dir
-        if not output_dir:
+        if not output_dir or self.output_failure is not None:
+            return
+        self.write_chunk()
+        if self.output_failure is not None:
             return
         stats: Dict[str, Any] = {
             'integrator': f'plant, zero-order hold, dt = {self.model.dt:g} s'
@@ -528,12 +557,18 @@ class PlantNode(Node):
             i + 1: count for i, count in enumerate(self.wrong_frame.tolist()) if count}
         stats['malformed_command_messages'] = {
             i + 1: count for i, count in enumerate(self.malformed.tolist()) if count}
-        with open(os.path.join(output_dir, PLANT_STATS_FILE), 'w', encoding='utf-8') as stream:
-            json.dump(stats, stream, indent=2)
-            stream.write('\n')
-        trajectory = self.trajectory()
+        text = (json.dumps(stats, indent=2) + '\n').encode()
+        where = os.path.join(output_dir, PLANT_STATS_FILE)
+        try:
+            save_atomically(where, lambda stream: stream.write(text))
+            trajectory = self.trajectory()
+            where = os.path.join(output_dir, 'trajectory.npz')
+            if trajectory is not None:
+                trajectory.save(where)
+        except OSError as exc:
+            self._output_failed(exc, where)
+            return
         if trajectory is not None:
-            trajectory.save(os.path.join(output_dir, 'trajectory.npz'))
             assert self.chunks is not None
             shutil.rmtree(self.chunks.folder, ignore_errors=True)
         self.get_logger().info(f'plant: wrote trajectory.npz and {PLANT_STATS_FILE} to '

@@ -15,20 +15,26 @@ the bag whole again). Robot i's ``cmd_vel`` is subscribed only once the recorder
 of its ``pose`` and ``neighbors`` have matched a publisher: a robot that waits for the recorder
 on ``cmd_vel`` (``wait_for_subscribers``) then cannot start before its states are recorded,
 whichever side of the DDS discovery finishes first. The bag is finished (metadata.yaml written)
-when the node stops, on Ctrl-C or SIGTERM too. It carries the run's
+when the node stops, on Ctrl-C or SIGTERM too. When a write fails (the disk is full), the
+recorder closes the bag as its files hold it (readable, metadata.yaml written when it fits),
+logs one line saying how much it holds and up to which simulated time, and ends with exit code
+:data:`formation_ros.core.exits.RECORDING_FAILED`. It carries the run's
 parameters on /formation/params and in params.yaml, for ``formation_report``::
 
     ros2 run formation_ros record --ros-args --params-file config/paper_section5.yaml \\
         -p record.path:=runs/section5_bag
 """
 
+from dataclasses import replace
 import os
 from typing import Any, Dict, List, Optional, Tuple
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.declarations import Exe, ParamError, RECORDER_ONLY
+from formation_ros.core.exits import RECORDING_FAILED
 from formation_ros.ros import qos, topics
-from formation_ros.ros.bag_writer import BagError, BagWriter, FLUSHES_PER_FILE, qos_of
+from formation_ros.ros.bag_writer import (BagError, BagWriteError, BagWriter, FLUSHES_PER_FILE,
+                                          qos_of)
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
 from formation_ros.ros.runner import run
@@ -72,12 +78,17 @@ class RecorderNode(Node):
         settings = config.recorder
         assert settings is not None
         self.path = os.path.abspath(settings.path)
+        self.exit_code: Optional[int] = None
+        """Set when the recording failed: the process then ends with it (ros.runner)."""
+        self.pending: List[Tuple[str, int, bytes]] = []
         try:
             self.bag = BagWriter(self.path, overwrite=settings.overwrite,
                                  flushes_per_file=FLUSHES_PER_FILE)
+        except BagWriteError as exc:
+            self._stop_recording(exc)
+            return
         except BagError as exc:
             raise ParamError([('record.path', str(exc))]) from None
-        self.pending: List[Tuple[str, int, bytes]] = []
         self.once = OnceLog(self.get_logger())
         self.subscriptions_by_topic: Dict[str, Any] = {}
         recorded = topics.recorded_topics(config.num_robots, settings.markers,
@@ -90,9 +101,13 @@ class RecorderNode(Node):
             self.bag.add_topic(topic.name, topic.type_name, _bag_qos(qos.BY_KIND[topic.qos]))
             if topic.name not in self.commands_to_subscribe:
                 self._subscribe(topic)
-        self.bag.write_params({k: v for k, v in config.values.items()
-                               if k not in RECORDER_ONLY},
-                              self.get_clock().now().nanoseconds)
+        try:
+            self.bag.write_params({k: v for k, v in config.values.items()
+                                   if k not in RECORDER_ONLY},
+                                  self.get_clock().now().nanoseconds)
+        except BagWriteError as exc:
+            self._stop_recording(exc)
+            return
         steady = Clock(clock_type=ClockType.STEADY_TIME)
         self.timer = self.create_timer(FLUSH_PERIOD, self.flush, clock=steady)
         self.match_timer = self.create_timer(MATCH_PERIOD, self.subscribe_commands,
@@ -133,14 +148,39 @@ class RecorderNode(Node):
     def flush(self) -> None:
         """Write the buffered messages to the bag and the bag's file (one MCAP chunk)."""
         pending, self.pending = self.pending, []
-        for topic, stamp, data in pending:
-            self.bag.write(topic, stamp, data)
-        self.bag.flush()
+        if self.exit_code is not None:
+            return
+        handed = 0
+        try:
+            for topic, stamp, data in pending:
+                handed += 1
+                self.bag.write(topic, stamp, data)
+            self.bag.flush()
+        except BagWriteError as exc:
+            self._stop_recording(exc, len(pending) - handed)
+
+    def _stop_recording(self, exc: BagWriteError, unwritten: int = 0) -> None:
+        """Say once what the bag holds after a failed write; end the process (exit code)."""
+        failure = exc.failure
+        if failure is None:
+            self.get_logger().error(f'recording stopped before it began: {exc}')
+        else:
+            failure = replace(failure, lost=failure.lost + unwritten)
+            self.get_logger().error(f'recording stopped: cannot write {self.path} '
+                                    f'({failure.reason}); {failure.describe()}')
+        self.pending = []
+        self.exit_code = RECORDING_FAILED
 
     def finish(self) -> None:
-        """Write what is left and finish the bag (metadata.yaml)."""
+        """Write what is left and finish the bag (metadata.yaml); nothing after a failure."""
         self.flush()
-        self.bag.close()
+        if self.exit_code is not None:
+            return
+        try:
+            self.bag.close()
+        except BagWriteError as exc:
+            self._stop_recording(exc)
+            return
         total = sum(self.bag.counts.values())
         self.get_logger().info(f'wrote {total} messages on '
                                f'{sum(1 for c in self.bag.counts.values() if c)} topics to '

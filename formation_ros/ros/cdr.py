@@ -302,6 +302,12 @@ def encode_odometry(stamp_ns: int, frame_id: str, child_frame_id: str, position:
                          + _xyz(linear) + _xyz(angular) + zeros)
 
 
+def read_clock(data: bytes) -> int:
+    """Read a serialized rosgraph_msgs/Clock; return its time in ns; CdrError if not one."""
+    sec, nanosec = _Reader(data, 'Clock')._take('iI', 8, 4)
+    return int(sec) * NS_PER_S + int(nanosec)
+
+
 def encode_clock(stamp_ns: int) -> bytes:
     """Return a serialized rosgraph_msgs/Clock at ``stamp_ns`` (>= 0)."""
     return LITTLE + struct.pack('<iI', stamp_ns // NS_PER_S, stamp_ns % NS_PER_S)

@@ -192,6 +192,12 @@ def _exit_now(code: int) -> None:
     os._exit(code)
 
 
+def _exit_request(nodes: Sequence[Node]) -> Optional[int]:
+    """Return the exit code a node has asked for (its ``exit_code`` attribute), None if none."""
+    return next((code for code in (getattr(node, 'exit_code', None) for node in nodes)
+                 if code is not None), None)
+
+
 NodeFactory = Callable[[], Union[Node, Sequence[Node]]]
 """Builds the process's node, or its nodes (a fleet of robots): a node class, for one."""
 
@@ -205,9 +211,11 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
     nodes) is moved out of the garbage collector's sight (``gc.freeze``): a profile of the
     lockstep plant found a fifth of its time in full collections walking those objects. The
     spin also ends when the launcher named in the environment is gone (see
-    :class:`LauncherWatch`). Returns the exit code: 0; 1 if a node's ``finish()``
-    failed (the others still finish); 2 for invalid parameters (one line per bad parameter) or a
-    command line rclpy cannot start from.
+    :class:`LauncherWatch`), and when a node sets its ``exit_code`` attribute (the recorder
+    whose disk is full, :data:`formation_ros.core.exits.RECORDING_FAILED`): the node has said
+    why, in its own line. Returns the exit code: 0; 1 if a node's ``finish()`` failed (the
+    others still finish); 2 for invalid parameters (one line per bad parameter) or a command
+    line rclpy cannot start from; a node's ``exit_code``.
     """
     if not _init(args, name):
         return 2
@@ -227,6 +235,10 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
         gc.collect()
         gc.freeze()
         while rclpy.ok() and _StopRequest.signal_name is None:
+            requested = _exit_request(nodes)
+            if requested is not None:
+                code = requested
+                break
             executor.spin_once(timeout_sec=SIGNAL_LATENCY)
             if launcher is not None and launcher.gone():
                 nodes[0].get_logger().warning(
@@ -251,6 +263,9 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
             except Exception as exc:  # noqa: B902 - one node's failure must not stop the rest
                 node.get_logger().error(f'could not finish: {type(exc).__name__}: {exc}')
                 code = 1
+        requested = _exit_request(nodes)
+        if requested is not None and code == 0:
+            code = requested
         for node in nodes:
             node.destroy_node()
         if executor is not None:

@@ -12,8 +12,10 @@ SIGHUP (the terminal closed), when the plant (the relay), the reference node or 
 ends on its own, or when a robot does with ``--on-exit stop`` (a robot that ends on its own is
 otherwise left out or restarted); the nodes are then stopped in order (robots, reference and
 plant or relay together, the recorder last) and, with ``--out`` or ``--record``,
-``formation_report`` writes the metrics and figures. Exit codes: 0 done, 1 a node died or the
-report failed, 2 bad usage or parameters.
+``formation_report`` writes the metrics and figures. A recorder that could not write its bag
+(exit code :data:`RECORDING_FAILED`) ends the run only with ``--on-record-failure stop``.
+Exit codes: 0 done, 1 a node died or the report failed, 2 bad usage or parameters,
+:data:`RECORDING_FAILED` (74) the recording stopped early.
 
 The nodes watch the launcher through :data:`LAUNCHER_PID_ENV` and :data:`LAUNCHER_START_ENV`
 (``formation_ros.ros.runner``), so they end on their own when it is killed with SIGKILL.
@@ -30,7 +32,8 @@ import sys
 import time
 from typing import Callable, Mapping, Optional, Sequence, TextIO
 
-from formation_ros.tools.supervise import describe_returncode, ProcessSpec, Supervisor
+from formation_ros.core.exits import RECORDING_FAILED
+from formation_ros.tools.supervise import describe_returncode, ExitInfo, ProcessSpec, Supervisor
 from formation_ros.tools.system import (DISCOVERY, DISCOVERY_ENV, discovery_problem,
                                         DOMAIN_ENV, domain_problem, FLEET_REMAP, Formation,
                                         network_variables, NodePlan, plan, PlanError,
@@ -42,6 +45,7 @@ STOP_TIMEOUT = 10.0
 RECORDER_START_TIMEOUT = 15.0
 POLL = 0.2
 ON_EXIT = ('continue', 'stop', 'respawn')
+ON_RECORD_FAILURE = ('continue', 'stop')
 MAX_RESTARTS = 5
 ESSENTIAL = ('plant', 'relay', 'reference', 'record')
 LAUNCHER_PID_ENV = 'FORMATION_LAUNCHER_PID'
@@ -50,6 +54,7 @@ LAUNCHER_START_ENV = 'FORMATION_LAUNCHER_START'
 USAGE = """\
 Usage: scripts/launch_formation.sh PARAMS.yaml [--duration S] [--out DIR] [--record DIR]
                                    [--on-exit continue|stop|respawn]
+                                   [--on-record-failure continue|stop]
                                    [--robots-per-process K] [--prefix DIR]
                                    [--discovery localhost|subnet] [--domain-id N]
                                    [--no-plant [--cmd-topic TEMPLATE] [--source-topic TEMPLATE]]
@@ -83,8 +88,19 @@ Options:
                  stop:     stop every node;
                  respawn:  start the robot again (at most 5 times per robot, then as
                            continue); it rejoins the formation
-                 A plant, relay, reference or recorder exit always stops the run. In every
-                 mode the exit code is 1 if any node exited on its own, with a line naming it.
+                 A plant, relay, reference or recorder exit always stops the run (but see
+                 --on-record-failure). In every mode the exit code is 1 if any node exited
+                 on its own, with a line naming it.
+  --on-record-failure MODE
+                 what to do when the recorder cannot write its bag (a full disk): it closes
+                 the bag as it is (readable; its line says how many messages up to which
+                 simulated time) and exits with code 74 (default: continue):
+                 continue: the others go on to the end of the run (the control run is not
+                           the recorder's to end);
+                 stop:     stop every node.
+                 Either way the report is made from the shorter bag and the exit code is 74
+                 (unless another node failed: 1). A recorder that cannot write at all before
+                 the others start stops the run
   --robots-per-process K
                  run the robots K to a process (executable 'fleet', processes fleet_1,
                  fleet_2, ...; each robot still its own node in /robot_<i>): ceil(N/K)
@@ -123,7 +139,8 @@ Executables: 'ros2 run formation_ros <exe>' where the ros2 command knows the pac
 <prefix>/lib/formation_ros/<exe> with the install's Python path set, as 'ros2 run' would.
 
 Exit codes: 0 done, 1 a node exited on its own or the report failed, 2 bad usage or
-parameters.
+parameters, 74 the recording stopped early (the recorder could not write; its bag is readable
+and shorter than the run).
 """
 
 
@@ -163,6 +180,7 @@ class Options:
     record: Optional[str] = None
     prefix: Optional[str] = None
     on_exit: str = 'continue'
+    on_record_failure: str = 'continue'
     robots_per_process: int = 1
     discovery: Optional[str] = None
     domain_id: Optional[int] = None
@@ -177,6 +195,7 @@ def parse_args(argv: Sequence[str]) -> Optional[Options]:
     """Parse the command line as the shell launcher always has; None for --help."""
     needs = {'duration': 'seconds', 'out': 'a directory', 'record': 'a directory',
              'prefix': 'a directory', 'on-exit': '|'.join(ON_EXIT),
+             'on-record-failure': '|'.join(ON_RECORD_FAILURE),
              'robots-per-process': 'a number of robots', 'discovery': '|'.join(DISCOVERY),
              'domain-id': 'a number', 'cmd-topic': 'a topic template',
              'source-topic': 'a topic template'}
@@ -210,6 +229,10 @@ def parse_args(argv: Sequence[str]) -> Optional[Options]:
     on_exit = values['on-exit'] or ON_EXIT[0]
     if on_exit not in ON_EXIT:
         raise UsageError(f"--on-exit must be one of {', '.join(ON_EXIT)}, got '{on_exit}'")
+    on_record_failure = values['on-record-failure'] or ON_RECORD_FAILURE[0]
+    if on_record_failure not in ON_RECORD_FAILURE:
+        raise UsageError(f"--on-record-failure must be one of {', '.join(ON_RECORD_FAILURE)}, "
+                         f"got '{on_record_failure}'")
     per_process = values['robots-per-process'] or '1'
     if not re.fullmatch(r'[1-9][0-9]*', per_process):
         raise UsageError('--robots-per-process must be a whole number >= 1, '
@@ -223,8 +246,8 @@ def parse_args(argv: Sequence[str]) -> Optional[Options]:
     _check_lab_options(no_plant, values)
     prefix = values['prefix'] or os.environ.get('FORMATION_PREFIX') or None
     return Options(params, None if duration is None else float(duration), values['out'],
-                   values['record'], prefix, on_exit, int(per_process), discovery,
-                   None if domain_id is None else int(domain_id), no_plant,
+                   values['record'], prefix, on_exit, on_record_failure, int(per_process),
+                   discovery, None if domain_id is None else int(domain_id), no_plant,
                    values['cmd-topic'], values['source-topic'])
 
 
@@ -391,6 +414,9 @@ class Launch:
         self.supervisor = Supervisor(echo=sys.stdout, env=self.env)
         self.interrupted: Optional[str] = None
         self.failure: Optional[str] = None
+        self.record_failure: Optional[str] = None
+        self.starting = False
+        """What stopped the recording early (the recorder exited RECORDING_FAILED), or None."""
         self.restarts: dict[str, int] = {}
 
     def on_signal(self, signum: int, frame: object) -> None:
@@ -414,6 +440,12 @@ class Launch:
             if died:
                 say(f'exit code 1: {died}')
                 return 1
+            if self.record_failure is not None and code == 0:
+                ran = ('the others were stopped then (--on-record-failure stop)'
+                       if self.options.on_record_failure == 'stop' else
+                       'the others ran to the end of the run')
+                say(f'exit code {RECORDING_FAILED}: {self.record_failure}; {ran}')
+                return RECORDING_FAILED
             return code
         finally:
             self.supervisor.close()
@@ -424,7 +456,7 @@ class Launch:
         """Name the nodes that ended on their own and why ('' if none did)."""
         deaths: dict[str, list[str]] = {}
         for info in self.supervisor.exits():
-            if not info.stopped:
+            if not info.stopped and not _recording_failed(info):
                 deaths.setdefault(info.name, []).append(info.reason)
         parts = []
         for name, reasons in deaths.items():
@@ -482,6 +514,8 @@ class Launch:
         ended = self.supervisor.wait_exit(timeout)
         if ended is None or ended.stopped:
             return False
+        if _recording_failed(ended):
+            return self._recording_stopped()
         name, mode = ended.name, self.options.on_exit
         if name in ESSENTIAL or mode == 'stop':
             self.failure = f'{name} ended on its own ({ended.reason})'
@@ -508,10 +542,32 @@ class Launch:
             return True
         return False
 
+    def _recording_stopped(self) -> bool:
+        """
+        Note that the recorder could not write its bag; True if the run must stop.
+
+        Said once, here; the recorder's own line says what the bag holds. With
+        ``--on-record-failure continue`` the others go on; a recorder that fails before the
+        others are started stops the run (robots wait for it before their first command).
+        """
+        if self.starting:
+            self.failure = (f'the recorder could not begin to write {self.options.record} '
+                            f'(exit code {RECORDING_FAILED}, see its line above)')
+            return True
+        self.record_failure = ('the recording stopped early: the recorder could not write '
+                               f'{self.options.record}')
+        said = f'{self.record_failure} (exit code {RECORDING_FAILED})'
+        if self.options.on_record_failure == 'stop':
+            say(f'{said}; stopping the others (--on-record-failure stop)')
+            return True
+        say(f'{said}; the others go on (--on-record-failure continue)')
+        return False
+
     def _wait_for_recorder(self) -> bool:
         """Wait until the recorder has created its bag directory; False if it did not."""
         assert self.options.record is not None
         deadline = time.monotonic() + RECORDER_START_TIMEOUT
+        self.starting = True
         while not os.path.isdir(self.options.record):
             if self.interrupted or self._died(POLL):
                 return False
@@ -519,6 +575,7 @@ class Launch:
                 self.failure = ('the recorder did not start within '
                                 f'{RECORDER_START_TIMEOUT:g} s (see its output above)')
                 return False
+        self.starting = False
         return True
 
     def report(self) -> int:
@@ -527,7 +584,9 @@ class Launch:
         if options.record is not None:
             source, target = options.record, options.out or options.record
         elif options.out is not None:
-            if not os.path.isfile(os.path.join(options.out, 'trajectory.npz')):
+            from formation_ros.core.trajectory import CHUNKS_DIR
+            if not any(os.path.exists(os.path.join(options.out, name))
+                       for name in ('trajectory.npz', CHUNKS_DIR)):
                 say(f'the plant wrote no trajectory to {options.out}')
                 return 1
             source, target = options.out, options.out
@@ -540,6 +599,11 @@ class Launch:
             say(f'formation_report failed ({describe_returncode(code)})')
             return 1
         return 0
+
+
+def _recording_failed(info: ExitInfo) -> bool:
+    """Tell whether ``info`` is the recorder ending because it could not write its bag."""
+    return info.name == 'record' and info.returncode == RECORDING_FAILED
 
 
 def say(message: str, stream: Optional[TextIO] = None) -> None:
@@ -579,13 +643,17 @@ def main(argv: Optional[Sequence[str]] = None, make: Optional[Callable[..., 'Lau
     options = dataclasses.replace(options, cmd_topics=formation.cmd_topics)
     num_robots = formation.num_robots
     wall_seconds = formation.wall_seconds if options.duration is None else options.duration
-    if options.out is not None:
-        os.makedirs(options.out, exist_ok=True)
-        shutil.copyfile(options.params, os.path.join(options.out, 'params.yaml'))
-    if options.record is not None:
-        if os.path.isdir(options.record):
-            os.rmdir(options.record)
-        os.makedirs(os.path.dirname(options.record), exist_ok=True)
+    try:
+        if options.out is not None:
+            os.makedirs(options.out, exist_ok=True)
+            shutil.copyfile(options.params, os.path.join(options.out, 'params.yaml'))
+        if options.record is not None:
+            if os.path.isdir(options.record):
+                os.rmdir(options.record)
+            os.makedirs(os.path.dirname(options.record), exist_ok=True)
+    except OSError as exc:
+        say(f'cannot prepare {exc.filename or options.out}: {exc.strerror or exc}')
+        return 1
     span = 'until Ctrl-C' if wall_seconds == 0 else f'for {wall_seconds:g} s'
     per_process = options.robots_per_process
     processes = ('' if per_process == 1 else
