@@ -32,8 +32,8 @@ from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch.substitutions import LaunchConfiguration
 
 PACKAGE = 'formation_ros'
-ARGUMENTS = ('params_file', 'record', 'output_dir', 'robots_per_process', 'discovery',
-             'domain_id')
+ARGUMENTS = ('params_file', 'output_dir', 'robots_per_process',
+             *(name for name, _, _ in SHARED_LAUNCH_ARGUMENTS))
 
 
 def formation_nodes(context):

@@ -219,7 +219,7 @@ def test_launch_file_declares_its_arguments_and_defaults_to_section5(launch_file
     assert declared == {
         'params_file': os.path.join(ROOT, 'config', 'paper_section5.yaml'),
         'record': '', 'output_dir': '', 'robots_per_process': '1', 'discovery': '',
-        'domain_id': ''}
+        'domain_id': '', 'on_record_failure': 'continue'}
 
 
 def test_launch_file_spreads_robots_over_fleet_processes(launch_file):
@@ -254,7 +254,10 @@ def test_launch_file_starts_the_system_of_the_shell_launcher(launch_file, setup_
     for node in nodes:
         executable = node.kwargs['executable']
         assert node.kwargs['package'] == PACKAGE
-        assert isinstance(node.kwargs['on_exit'], Shutdown), f'{executable} exits alone'
+        on_exit = node.kwargs['on_exit']
+        if executable == 'record':
+            on_exit = on_exit.shutdown
+        assert isinstance(on_exit, Shutdown), f'{executable} exits alone'
         params_file, overrides = node_parameters(node)
         assert params_file == params
         assert overrides.pop('use_sim_time', False) == (executable in ('reference', 'robot'))

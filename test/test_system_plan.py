@@ -126,7 +126,10 @@ def node_view(node):
     """Return the same view of a launch_ros Node stand-in, its namespace made absolute."""
     params_file, overrides = node_parameters(node)
     namespace = node.kwargs['namespace']
-    assert isinstance(node.kwargs['on_exit'], Shutdown)
+    on_exit = node.kwargs['on_exit']
+    if node.kwargs['executable'] == 'record' and not isinstance(on_exit, Shutdown):
+        on_exit = on_exit.shutdown
+    assert isinstance(on_exit, Shutdown)
     assert node.kwargs['package'] == 'formation_ros'
     return {'executable': node.kwargs['executable'],
             'arguments': list(node.kwargs['arguments'] or []),
@@ -218,7 +221,7 @@ def test_lab_launch_file_declares_its_arguments(lab_launch_file):
                 for action in description.args[0] if action.args}
     assert declared == {'params_file': None, 'cmd_topic': '', 'source_topic': '',
                         'robots_per_process': '1', 'discovery': '', 'domain_id': '',
-                        'record': ''}
+                        'record': '', 'on_record_failure': 'continue'}
 
 
 @pytest.mark.parametrize('arguments, says', [
@@ -284,3 +287,37 @@ def test_launcher_module_runs_without_ros_for_help():
                             capture_output=True, text=True, cwd=ROOT, timeout=60)
     assert result.returncode == 0 and result.stdout.strip() == '[]', result.stdout + \
         result.stderr
+
+
+class Exited:
+    """Stands in for launch.events.process.ProcessExited: the exit code of a process."""
+
+    def __init__(self, returncode):
+        """Keep ``returncode``."""
+        self.returncode = returncode
+
+
+@pytest.mark.parametrize('policy', ['continue', 'stop', ''])
+def test_a_failed_recording_ends_a_launch_file_run_only_when_asked(launch_file, policy):
+    from formation_ros.core.exits import RECORDING_FAILED
+    nodes = launched_nodes(launch_file, params_file=SQUARE, record='/tmp/bag',
+                           on_record_failure=policy)
+    (recorder,) = [node for node in nodes if node.kwargs['executable'] == 'record']
+    on_exit = recorder.kwargs['on_exit']
+    if policy == 'stop':
+        assert isinstance(on_exit, Shutdown)
+        return
+    shutdown = on_exit.shutdown
+    assert isinstance(shutdown, Shutdown)
+    assert on_exit(Exited(RECORDING_FAILED), {}) is None
+    for code in (0, 1, 2, -9):
+        assert on_exit(Exited(code), {}) is shutdown
+    others = [node for node in nodes if node.kwargs['executable'] != 'record']
+    assert all(isinstance(node.kwargs['on_exit'], Shutdown) for node in others)
+
+
+def test_a_launch_file_refuses_an_unknown_record_failure_policy(launch_file):
+    with pytest.raises(ValueError, match='on_record_failure must be one of continue, stop, '
+                                         "got 'later'"):
+        launched_nodes(launch_file, params_file=SQUARE, record='/tmp/bag',
+                       on_record_failure='later')

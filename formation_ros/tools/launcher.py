@@ -36,8 +36,9 @@ from formation_ros.core.exits import RECORDING_FAILED
 from formation_ros.tools.supervise import describe_returncode, ExitInfo, ProcessSpec, Supervisor
 from formation_ros.tools.system import (DISCOVERY, DISCOVERY_ENV, discovery_problem,
                                         DOMAIN_ENV, domain_problem, FLEET_REMAP, Formation,
-                                        network_variables, NodePlan, plan, PlanError,
-                                        read_formation, recorder_plan, ros_arguments, Run)
+                                        network_variables, NodePlan, ON_RECORD_FAILURE, plan,
+                                        PlanError, read_formation, recorder_plan,
+                                        ros_arguments, Run)
 
 PROG = 'launch_formation.sh'
 PACKAGE = 'formation_ros'
@@ -45,7 +46,6 @@ STOP_TIMEOUT = 10.0
 RECORDER_START_TIMEOUT = 15.0
 POLL = 0.2
 ON_EXIT = ('continue', 'stop', 'respawn')
-ON_RECORD_FAILURE = ('continue', 'stop')
 MAX_RESTARTS = 5
 ESSENTIAL = ('plant', 'relay', 'reference', 'record')
 LAUNCHER_PID_ENV = 'FORMATION_LAUNCHER_PID'

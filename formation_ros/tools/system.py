@@ -24,16 +24,23 @@ import os
 import re
 from typing import Any, List, Mapping, Optional, Sequence, Tuple
 
+from formation_ros.core.exits import RECORDING_FAILED
 from formation_ros.ros.topics import CMD_VEL, robot_namespace, robot_topic
 
 PACKAGE = 'formation_ros'
+RECORDER = 'record'
+"""The recorder's executable (and process name)."""
 SHARED_LAUNCH_ARGUMENTS = (
     ('discovery', '', "'localhost' or 'subnet' (empty: the environment's "
                       'ROS_AUTOMATIC_DISCOVERY_RANGE, else localhost)'),
     ('domain_id', '', "ROS_DOMAIN_ID of the nodes (empty: the environment's)"),
     ('record', '', 'rosbag2 directory to record into (empty: none)'),
+    ('on_record_failure', 'continue', "'continue' or 'stop': whether the team goes on when "
+                                      'the recorder cannot write its bag (a full disk)'),
 )
 """(name, default, description) of the launch arguments both launch files take."""
+ON_RECORD_FAILURE = ('continue', 'stop')
+"""What a run does when its recorder exits RECORDING_FAILED; the first is the default."""
 DISCOVERY = ('localhost', 'subnet')
 DISCOVERY_ENV = 'ROS_AUTOMATIC_DISCOVERY_RANGE'
 DOMAIN_ENV = 'ROS_DOMAIN_ID'
@@ -150,7 +157,7 @@ def recorder_plan(record: str, cmd_topics: Sequence[str] = ()) -> NodePlan:
     """
     remaps = tuple((robot_topic(i, CMD_VEL), topic)
                    for i, topic in enumerate(cmd_topics, start=1))
-    return NodePlan('record', 'record', parameters=(('record.path', record),),
+    return NodePlan(RECORDER, RECORDER, parameters=(('record.path', record),),
                     remappings=remaps)
 
 
@@ -188,6 +195,10 @@ def launch_file_nodes(arguments: Mapping[str, str], plant: bool = True) -> List[
     per_process = int(arguments.get('robots_per_process') or 1)
     if per_process < 1:
         raise PlanError(f'robots_per_process must be >= 1, got {per_process}')
+    on_record_failure = arguments.get('on_record_failure') or ON_RECORD_FAILURE[0]
+    if on_record_failure not in ON_RECORD_FAILURE:
+        raise PlanError(f"on_record_failure must be one of {', '.join(ON_RECORD_FAILURE)}, "
+                        f"got '{on_record_failure}'")
     domain_id = arguments.get('domain_id') or None
     if domain_id is not None and domain_problem(domain_id):
         raise PlanError(f'domain_id {domain_problem(domain_id)}')
@@ -201,22 +212,26 @@ def launch_file_nodes(arguments: Mapping[str, str], plant: bool = True) -> List[
               output_dir=arguments.get('output_dir') or None, robots_per_process=per_process,
               cmd_topics=formation.cmd_topics,
               source_topic=arguments.get('source_topic') or None)
-    return launch_nodes(plan(run), params_file, env)
+    return launch_nodes(plan(run), params_file, env, on_record_failure)
 
 
-def launch_nodes(nodes: Sequence[NodePlan], params_file: str,
-                 env: Mapping[str, str]) -> List[Any]:
+def launch_nodes(nodes: Sequence[NodePlan], params_file: str, env: Mapping[str, str],
+                 on_record_failure: str = ON_RECORD_FAILURE[0]) -> List[Any]:
     """
     Return ``launch_ros`` nodes for ``nodes``: what the launch files start.
 
     Each with the parameters file and its overrides, a relative namespace (so that a
     ``PushRosNamespace`` around the launch file still applies), its remappings, ``env`` added
     to its environment, and a Shutdown when it exits: the first node to end ends the launch.
+    The recorder's exit with RECORDING_FAILED ends it only with ``on_record_failure`` 'stop'.
     """
     from launch.actions import Shutdown
     from launch_ros.actions import Node
     launched = []
     for node in nodes:
+        on_exit: Any = Shutdown(reason=f'{node.executable} exited')
+        if node.executable == RECORDER and on_record_failure == 'continue':
+            on_exit = RecorderExit(on_exit)
         parameters: List[Any] = [params_file]
         if node.parameters:
             parameters.append(dict(node.parameters))
@@ -225,8 +240,25 @@ def launch_nodes(nodes: Sequence[NodePlan], params_file: str,
             namespace=None if node.namespace is None else node.namespace.lstrip('/'),
             arguments=list(node.arguments) or None, parameters=parameters,
             remappings=list(node.remappings) or None, additional_env=dict(env),
-            output='screen', on_exit=Shutdown(reason=f'{node.executable} exited')))
+            output='screen', on_exit=on_exit))
     return launched
+
+
+@dataclasses.dataclass(frozen=True)
+class RecorderExit:
+    """
+    The recorder's ``on_exit`` in a launch file that goes on after a failed recording.
+
+    Called by launch with the ProcessExited event: ``shutdown`` (the launch's end) unless the
+    recorder exited RECORDING_FAILED, when launch has already printed the exit code and the
+    recorder its one line, and the team goes on.
+    """
+
+    shutdown: Any
+
+    def __call__(self, event: Any, context: Any) -> Optional[Any]:
+        """Return the actions to take when the recorder has exited."""
+        return None if event.returncode == RECORDING_FAILED else self.shutdown
 
 
 def discovery_problem(discovery: str) -> Optional[str]:
