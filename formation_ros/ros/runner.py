@@ -129,6 +129,22 @@ class LauncherWatch:
         return self._gone
 
 
+class _Refusals:
+    """The nodes' ``refusal`` texts, looked at every SIGNAL_LATENCY s (not per callback)."""
+
+    def __init__(self, nodes: Sequence[Node]) -> None:
+        self.nodes = [node for node in nodes if hasattr(node, 'refusal')]
+        self._next_check = 0.0
+
+    def due(self) -> Optional[str]:
+        """Return the first node's refusal, if one has refused (checked at most every 0.1 s)."""
+        now = time.monotonic()
+        if not self.nodes or now < self._next_check:
+            return None
+        self._next_check = now + SIGNAL_LATENCY
+        return next((node.refusal for node in self.nodes if node.refusal), None)
+
+
 def _params_files(args: List[str]) -> List[str]:
     return [args[k + 1] for k, arg in enumerate(args[:-1]) if arg == '--params-file']
 
@@ -205,9 +221,11 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
     nodes) is moved out of the garbage collector's sight (``gc.freeze``): a profile of the
     lockstep plant found a fifth of its time in full collections walking those objects. The
     spin also ends when the launcher named in the environment is gone (see
-    :class:`LauncherWatch`). Returns the exit code: 0; 1 if a node's ``finish()``
-    failed (the others still finish); 2 for invalid parameters (one line per bad parameter) or a
-    command line rclpy cannot start from.
+    :class:`LauncherWatch`), and when a node sets its ``refusal`` to a text (it cannot run
+    here, e.g. another team's plant is on the domain): that text is logged as one error line.
+    Returns the exit code: 0; 1 if a node's ``finish()`` failed (the others still finish); 2 for
+    invalid parameters (one line per bad parameter), a refusal, or a command line rclpy cannot
+    start from.
     """
     if not _init(args, name):
         return 2
@@ -224,6 +242,7 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
         executor = make_executor()
         for node in nodes:
             executor.add_node(node)
+        refusals = _Refusals(nodes)
         gc.collect()
         gc.freeze()
         while rclpy.ok() and _StopRequest.signal_name is None:
@@ -232,6 +251,11 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
                 nodes[0].get_logger().warning(
                     f'the launcher (process {launcher.pid}) is gone; stopping')
                 orphaned = True
+                break
+            refusal = refusals.due()
+            if refusal:
+                nodes[0].get_logger().error(refusal)
+                code = 2
                 break
     except ParamError as exc:
         logger = rclpy.logging.get_logger(name)
