@@ -491,10 +491,18 @@ class PlantNode(Node):
         if others:
             values['nodes with other team values'] = ' | '.join(others)
         shared = self._shared_topics(now)
+        plants = self.team.running(self.own_name, now) if self.looked else []
+        if plants:
+            self.once.start('other-plant', 'another plant runs on this domain: '
+                                           f'{self.team.describe(self.own_name, now)} (another '
+                                           'team? each needs a ROS_DOMAIN_ID of its own)', 'error')
+            values['other plants'] = self.team.describe(self.own_name, now)
+        else:
+            self.once.end('other-plant', 'the other plant is gone')
         if shared:
             values['topics with more than one publisher'] = ' | '.join(
                 f'{topic}: {names}' for topic, names in sorted(shared.items()))
-        if counts.collisions or counts.bound_violations or shared or others:
+        if counts.collisions or counts.bound_violations or shared or others or plants:
             level, message = 'error', (f'{counts.collisions} collisions, '
                                        f'{counts.bound_violations} commands above the bound, '
                                        f'{len(shared)} topics with several publishers, '
