@@ -7,9 +7,12 @@ import os
 import random
 import signal
 
+from formation_ros.tools.domain import ports_busy
 import pytest
 
-os.environ['ROS_DOMAIN_ID'] = str(random.SystemRandom().randint(1, 101))
+_DOMAINS = random.SystemRandom().sample(range(1, 102), 101)
+os.environ['ROS_DOMAIN_ID'] = str(next((d for d in _DOMAINS if not ports_busy(d)), _DOMAINS[0]))
+"""A domain no participant of this host is on (another test run's plant would refuse ours)."""
 os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
 os.environ.setdefault('MPLBACKEND', 'Agg')
 

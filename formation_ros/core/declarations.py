@@ -334,14 +334,14 @@ DECLARATIONS = (
     Param('plant.rate', Kind.DOUBLE, 100.0,
           'Integration rate of the plant, Hz of simulated time: step dt = 1 / rate.',
           low=above(0.0), high=at_least(100000.0),
-          users=frozenset({Exe.PLANT, Exe.REFERENCE})),
+          users=frozenset({Exe.PLANT, Exe.REFERENCE, Exe.ROBOT})),
     Param('plant.input_timeout', Kind.DOUBLE, 0.5,
           'A command whose state stamp is older than this counts as zero, s (simulated time).',
           low=above(0.0), users=PLANT),
     Param('plant.publish_rate', Kind.DOUBLE, 50.0,
           'Rate of /robot_<i>/pose, /robot_<i>/neighbors and /clock, Hz of simulated time '
-          '(at most plant.rate; every step in lockstep).', low=above(0.0), high=at_least(100000.0),
-          users=PLANT),
+          '(at most plant.rate; every step in lockstep). Robots answer at most about one state '
+          'per period.', low=above(0.0), high=at_least(100000.0), users=PLANT | {Exe.ROBOT}),
     Param('plant.realtime_factor', Kind.DOUBLE, 1.0,
           'Simulated seconds per wall-clock second (an upper bound in lockstep).',
           low=above(0.0), high=at_least(1000.0), users=PLANT),
@@ -403,8 +403,9 @@ DECLARATIONS = (
           "'odometry' (nav_msgs/Odometry).", choices=_choices(SourceType), users=RELAY),
     Param('relay.rate', Kind.DOUBLE, 50.0,
           'Cycles per second of the relay, Hz (wall clock): each publishes every pose and '
-          'neighbour list with one stamp.', low=above(0.0), high=at_least(10000.0),
-          users=RELAY),
+          'neighbour list with one stamp; robots on wall-clock time answer at most about one '
+          'state per cycle.', low=above(0.0), high=at_least(10000.0),
+          users=RELAY | {Exe.ROBOT}),
     Param('relay.max_age', Kind.DOUBLE, 0.2,
           'A robot whose latest measurement is older than this is stale, s: it gets no pose '
           "(its watchdog stops it) but stays in the others' neighbour lists at its last "

@@ -18,3 +18,9 @@ error on a write, flush or close). It closed the bag as it was, readable, logged
 saying how much it holds, and ended. The launcher ends with the same code when a run's
 recording stopped early. 74 is ``EX_IOERR`` of sysexits.h.
 """
+
+REFUSED = 2
+"""
+The node refused to run here, or was given bad parameters or usage: it logged one line saying
+why (another team's plant or ``/clock`` on the domain, an invalid parameter).
+"""

@@ -72,18 +72,39 @@ class PlantSettings:
     @property
     def steps_per_publish(self) -> int:
         """Return the number of steps between two published states (free-running)."""
-        return max(1, int(round(self.rate / self.publish_rate)))
+        return steps_per_publish(self.rate, self.publish_rate)
+
+
+def steps_per_publish(rate: float, publish_rate: float) -> int:
+    """Return the plant's steps between two published states (free-running): rate in Hz."""
+    return max(1, int(round(rate / publish_rate)))
+
+
+def state_period(rate: float, publish_rate: float, lockstep: bool) -> float:
+    """
+    Return the simulated time between two states the plant publishes, s.
+
+    rate: ``plant.rate``, publish_rate: ``plant.publish_rate`` (Hz); in lockstep every step.
+    """
+    return (1 if lockstep else steps_per_publish(rate, publish_rate)) / rate
 
 
 @dataclass(frozen=True)
 class RobotSettings:
-    """A robot node's own parameters."""
+    """
+    A robot node's own parameters.
+
+    plant_period: the simulated time between two states of the plant, s (``state_period``);
+    relay_period: the wall-clock time between two relay cycles, s (1 / ``relay.rate``).
+    """
 
     robot_id: int
     control_rate: float
     input_timeout: float
     wait_for_subscribers: int
     pose_type: PoseType = PoseType.POSE_STAMPED
+    plant_period: float = 0.02
+    relay_period: float = 0.02
 
 
 @dataclass(frozen=True)
@@ -492,7 +513,10 @@ def _own_settings(values: Mapping[str, Any], exe: Exe, n: int,
             robot_id=values['robot_id'], control_rate=values['control_rate'],
             input_timeout=values['input_timeout'],
             wait_for_subscribers=values['wait_for_subscribers'],
-            pose_type=PoseType(values['pose_type']))}
+            pose_type=PoseType(values['pose_type']),
+            plant_period=state_period(values['plant.rate'], values['plant.publish_rate'],
+                                      values.get('plant.lockstep', False)),
+            relay_period=1.0 / values['relay.rate'])}
     if exe is Exe.REFERENCE:
         step_ns = NS_PER_S / values['plant.rate']
         if not math.isfinite(step_ns):

@@ -8,16 +8,24 @@ Two nodes started with different parameters files (a robot on another computer w
 copy) run, but the team never forms. Each node announces these values in its ``/diagnostics``
 status; the plant and the reference compare them with their own and name the node that differs
 (``ros.team``).
+
+Two teams on one domain hear each other: a topic with a second publisher is found in the ROS
+graph and reported as :func:`duplicate_due` says.
 """
 
 import hashlib
-from typing import Dict, Mapping
+from typing import Dict, Mapping, Optional, Sequence
 
 from formation_ros.core.params import FormationConfig
 import numpy as np
 from numpy.typing import NDArray
 
 DIGITS = 12
+DUPLICATE_GRACE = 25.0
+"""A second publisher with the expected node's own name is reported after this many seconds
+without other evidence that it runs: a node restarted after a hard kill shares its topics with
+the dead process's publishers until DDS lets go of them (about 20 s with Fast DDS's default
+participant lease)."""
 
 
 def digest(values: NDArray[np.float64]) -> str:
@@ -53,3 +61,21 @@ def differences(own: Mapping[str, str], other: Mapping[str, str]) -> Dict[str, s
     """Return {name: 'theirs (ours)'} for every value ``other`` announces differently."""
     return {name: f'{other[name]} (here: {own[name]})' for name in own
             if name in other and other[name] != own[name]}
+
+
+def duplicate_due(names: Sequence[str], own: Optional[str], lasted: float,
+                  alive: bool = False) -> bool:
+    """
+    Tell whether a topic's publishers ``names`` (fully qualified node names) are to be reported.
+
+    own: the one node expected to publish (None: any single node); lasted: for how long, s, the
+    topic has had more than one publisher; alive: whether there is evidence that a second
+    publisher with the expected node's name runs (it announced itself from another process, or
+    DDS liveliness counts two). A second publisher with another name is due at once; one with
+    the expected name (a restart's dead predecessor, or a second copy) when ``alive``, or once
+    it has lasted :data:`DUPLICATE_GRACE` s.
+    """
+    if len(names) <= 1:
+        return False
+    expected = own if own is not None else names[0]
+    return alive or any(name != expected for name in names) or lasted >= DUPLICATE_GRACE

@@ -26,6 +26,16 @@ the collision check. This node only moves messages in and out:
 With ``plant.lockstep`` it steps only when every robot has answered the latest state, which
 makes a run reproduce ``formation_sim --dt 1/plant.rate``.
 
+One team per domain: before its first state the plant looks for :data:`LOOK_TIME` s (up to
+:data:`LOOK_LIMIT` s to hear the other's host) for another ``/clock`` publisher. If there is
+one, another plant or anything else, that sends ``/clock`` or announces itself on
+``/diagnostics`` from another process, the plant refuses to start: one line naming it and its
+host, exit 2. A silent one with the plant's own name is taken for a killed plant's leftover (DDS
+forgets it within about 20 s): said once, and the plant starts. While running, it looks up the
+graph once a second (:class:`formation_ros.ros.team.PublisherWatch`) for a second publisher on
+``/clock``, a robot's ``pose``, ``neighbors`` or ``cmd_vel``: ERROR in ``/diagnostics`` and
+one log line per topic, naming the other publisher.
+
 Unicycles (``body.kind: unicycle``): each pose carries the robot's heading as its orientation,
 and so does every neighbour in ``neighbors``, which lists the bodies within R_i + 2 l (so that a
 robot sees every hand point within R_i of its own); a command is read in the robot's body frame
@@ -45,6 +55,7 @@ from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.bodies import make_bodies
 from formation_ros.core.declarations import CommandFrame, Exe
 from formation_ros.core.events import event_records, timeline_events
+from formation_ros.core.exits import REFUSED
 from formation_ros.core.frames import desired_positions
 from formation_ros.core.plant import (Commands, CommandStatus, DurationHistogram, NS_PER_S,
                                       PLANT_STATS_FILE, PlantModel, StepReport)
@@ -62,7 +73,7 @@ from formation_ros.ros.markers import formation_markers, Paths
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
 from formation_ros.ros.runner import run
-from formation_ros.ros.team import announced, team_problems, TeamCheck
+from formation_ros.ros.team import announced, PublisherWatch, team_problems, TeamCheck
 from formation_ros.ros.wake import Wake
 from geometry_msgs.msg import PoseArray, PoseStamped, Twist, TwistStamped
 import numpy as np
@@ -78,7 +89,15 @@ PUBLISHES_TIMED = 256
 not timed."""
 PATH_LENGTH = 100
 CHUNK_PERIOD = 1.0
-DUPLICATE_GRACE = 25.0
+LOOK_TIME = 2.0
+"""How long the plant looks for another /clock publisher before its first state, s (steady
+clock). Fast DDS finds a participant on this host within its five initial announcements
+(0.1 s apart) and its endpoints a moment later; a running plant sends /clock at least every
+0.05 s and its status every second (diagnostics.PERIOD), so 2 s leave room for a busy machine
+at no cost: the robots take longer than that to start."""
+LOOK_LIMIT = 5.0
+"""With another /clock publisher found, how long the plant waits to hear its host on
+/diagnostics before refusing without it, s."""
 
 
 class PlantNode(Node):
@@ -99,6 +118,13 @@ class PlantNode(Node):
         self.reference = self.changes.reference
         self.held_steps = 0
         self.team = TeamCheck(self, PLANT_STATUS)
+        self.refusal: Optional[str] = None
+        self.exit_code: Optional[int] = None
+        self.looked = False
+        self.created_wall = time.monotonic()
+        self.clock_heard = 0
+        self.graph = PublisherWatch(self, self.team)
+        self.own_name = self.get_fully_qualified_name()
         self.n, self.dim = config.num_robots, config.dim
         self.unicycles = config.body.is_unicycle
         self.body_frame = config.command.frame is CommandFrame.BODY
@@ -125,7 +151,7 @@ class PlantNode(Node):
         self.closest = self.model.closest_pair_distance()
         self.largest_u_hat = 0.0
         self.command_subs = []
-        self.shared_since: Dict[int, float] = {}
+        self.shared: Dict[str, str] = {}
         self.last_publish_wall = 0.0
         self.started_wall: Optional[float] = None
         self.waiting = settings.wait_for_robots or self.lockstep
@@ -151,6 +177,15 @@ class PlantNode(Node):
                 lambda data, index=i - 1: self.on_command(index, data), qos.COMMAND, raw=True,
                 event_callbacks=self.command_liveliness[-1].callbacks()))
         self.clock_pub = self.create_publisher(ClockMsg, topics.CLOCK, qos.CLOCK)
+        self.clock_sub = self.create_subscription(ClockMsg, topics.CLOCK, self.on_clock,
+                                                  qos.CLOCK, raw=True)
+        self.expected_publishers: Dict[str, Optional[str]] = {self.clock_pub.topic_name:
+                                                              self.own_name}
+        for pose, neighbours in zip(self.pose_pubs, self.neighbour_pubs):
+            self.expected_publishers[pose.topic_name] = self.own_name
+            self.expected_publishers[neighbours.topic_name] = self.own_name
+        self.command_index = {sub.topic_name: i for i, sub in enumerate(self.command_subs)}
+        self.expected_publishers.update(dict.fromkeys(self.command_index))
         self.diagnostics_pub = self.create_publisher(
             DiagnosticArray, topics.DIAGNOSTICS, qos.DIAGNOSTICS)
         period = RESEND_AFTER if self.lockstep else self.model.dt / settings.realtime_factor
@@ -173,6 +208,10 @@ class PlantNode(Node):
             + ('' if config.imperfections.is_ideal else ', bodies beyond the paper: ' + ', '.join(
                 f'{name} = {value:g}' for name, value in config.imperfections.as_dict().items()
                 if value)))
+
+    def on_clock(self, data: bytes) -> None:
+        """Before the first state: count /clock messages, which only another node sends."""
+        self.clock_heard += 1
 
     def on_command(self, index: int, data: bytes) -> None:
         """
@@ -235,6 +274,8 @@ class PlantNode(Node):
         In lockstep this runs when a command arrives (:class:`Wake`) and every
         ``RESEND_AFTER`` s, to send a state again that was not answered.
         """
+        if not self.looked and not self._look():
+            return
         if self.started_wall is None:
             self.started_wall = time.monotonic()
             self._publish()
@@ -247,6 +288,49 @@ class PlantNode(Node):
         self._step()
         if self.model.counts.steps % self.publish_every == 0:
             self._publish()
+
+    def _look(self) -> bool:
+        """
+        Before the first state: True once the domain is known to hold no other /clock sender.
+
+        Sets :attr:`refusal` (logged; the runner then exits REFUSED) for a /clock publisher other
+        than this node that sends /clock, announces itself from another process, or has
+        another name than this node's.
+        """
+        now = time.monotonic()
+        waited = now - self.created_wall
+        if waited < LOOK_TIME or self.refusal:
+            return False
+        others = self.graph.publishers(self.clock_pub.topic_name)
+        if self.own_name in others:
+            others.remove(self.own_name)
+        if not others:
+            return self._looked()
+        running = any(self.team.running(name, now) for name in others)
+        ours = all(name == self.own_name for name in others)
+        if ours and not running and not self.clock_heard:
+            self.once.start('leftover-clock', f'{others[0]} is listed as a /clock publisher '
+                                              f'but sent nothing for {waited:.1f} s: taken '
+                                              'for what is left of a plant that was killed '
+                                              '(DDS forgets it within about 20 s); starting')
+            return self._looked()
+        if not running and waited < LOOK_LIMIT:
+            return False
+        plants = [name for name in others if name.rsplit('/', 1)[-1] == 'plant']
+        what = 'plant' if plants else '/clock publisher'
+        self.refusal = (f'refusing to start: another {what} is on ROS_DOMAIN_ID '
+                        f'{self.context.get_domain_id()}: '
+                        f'{self.graph.name_others(others, None, now)} publishes /clock (another '
+                        'team? stop it, or run this team on a domain of its own: export '
+                        'ROS_DOMAIN_ID=N, or the launcher without ROS_DOMAIN_ID set)')
+        self.get_logger().error(self.refusal)
+        self.exit_code = REFUSED
+        return False
+
+    def _looked(self) -> bool:
+        self.looked = True
+        self.destroy_subscription(self.clock_sub)
+        return True
 
     def _lockstep_tick(self) -> None:
         answered = bool(np.all(self.commands.present
@@ -409,22 +493,29 @@ class PlantNode(Node):
             robots = [str(i + 1) for i, s in enumerate(states) if s == state]
             values[f'robots with {state} cmd_vel'] = ', '.join(robots) or 'none'
         shape = self._vertices_at(self.model.t_ns)
-        values.update(announced(team_values(self.config, shape)))
+        values.update(announced(team_values(self.config, shape), self))
         others = team_problems(self.team, self.config, shape, self.once)
         if others:
             values['nodes with other team values'] = ' | '.join(others)
-        shared = self._shared_command_topics(now)
-        for robot in shared:
-            self.once.start(f'publishers-{robot}', f'robot {robot}: its cmd_vel has more than '
-                                                   'one publisher (a second node with this '
-                                                   'robot_id?)', 'error')
+        shared = self._shared_topics(now)
+        plants = self.team.running(self.own_name, now) if self.looked else []
+        if plants:
+            self.once.start('other-plant', 'another plant runs on this domain: '
+                                           f'{self.team.describe(self.own_name, now)} (another '
+                                           'team? each needs a ROS_DOMAIN_ID of its own)', 'error')
+            values['other plants'] = self.team.describe(self.own_name, now)
+        else:
+            self.once.end('other-plant', 'the other plant is gone')
         if shared:
-            values['cmd_vel with more than one publisher'] = ', '.join(map(str, shared))
-        if counts.collisions or counts.bound_violations or shared or others:
+            values['topics with more than one publisher'] = ' | '.join(
+                f'{topic}: {names}' for topic, names in sorted(shared.items()))
+        if counts.collisions or counts.bound_violations or shared or others or plants:
             level, message = 'error', (f'{counts.collisions} collisions, '
                                        f'{counts.bound_violations} commands above the bound, '
-                                       f'{len(shared)} cmd_vel topics with several publishers, '
+                                       f'{len(shared)} topics with several publishers, '
                                        f'{len(others)} nodes with other team values')
+        elif not self.looked:
+            level, message = 'ok', 'looking for another plant on this domain'
         elif self.waiting:
             level, message = 'ok', 'waiting for the robots'
         elif 'lost' in states:
@@ -436,20 +527,38 @@ class PlantNode(Node):
             level, message = 'ok', 'running'
         self.diagnostics_pub.publish(diagnostics(PLANT_STATUS, level, message, values))
 
-    def _shared_command_topics(self, now: float) -> List[int]:
+    def _shared_topics(self, now: float) -> Dict[str, str]:
         """
-        Return the robots whose cmd_vel has had more than one publisher for DUPLICATE_GRACE s.
+        Return {topic: its other publishers} of /clock and the robots' topics; log each once.
 
-        A robot restarted after a hard kill shares its topic with the dead process's publisher
-        until DDS lets go of it (about 20 s with Fast DDS's default lease): not a duplicate.
+        Only once the plant has looked (before, a second plant is the look's to refuse).
+        A second publisher with the expected name runs for sure when it announces itself
+        from another process, or (cmd_vel) when DDS liveliness counts two alive.
         """
-        for i, subscription in enumerate(self.command_subs):
-            if subscription.get_publisher_count() > 1:
-                self.shared_since.setdefault(i + 1, now)
-            else:
-                self.shared_since.pop(i + 1, None)
-        return [robot for robot, since in sorted(self.shared_since.items())
-                if now - since >= DUPLICATE_GRACE]
+        if not self.looked:
+            return {}
+        shared = self.graph.check(self.expected_publishers, now, self._alive)
+        by_names: Dict[str, List[str]] = {}
+        for topic, names in shared.items():
+            by_names.setdefault(names, []).append(topic)
+        for names, listed in by_names.items():
+            hint = ('a second node with this robot_id?' if listed[0] in self.command_index
+                    else 'another team on this domain, or a node forging them?')
+            self.once.start(f'publishers-{names}', f'{_some(listed)} more than one publisher: '
+                                                   f'{names} ({hint})', 'error')
+        for names in set(self.shared.values()) - set(by_names):
+            self.once.end(f'publishers-{names}', f'{names}: no longer publishing here')
+        self.shared = shared
+        return shared
+
+    def _alive(self, topic: str, names: List[str]) -> bool:
+        """Whether a same-named second publisher of ``topic`` is known to run."""
+        now = time.monotonic()
+        index = self.command_index.get(topic)
+        if index is None:
+            return bool(self.team.running(self.own_name, now))
+        return (self.command_liveliness[index].alive >= 2
+                or len(self.team.running(names[0], now)) >= 2)
 
     def on_markers(self) -> None:
         """
@@ -507,6 +616,8 @@ class PlantNode(Node):
 
     def finish(self) -> None:
         """Log a summary of the run; with ``plant.output_dir`` write trajectory and counters."""
+        if self.refusal:
+            return
         if self.started_wall is None or self.model.counts.steps == 0:
             self.get_logger().info('plant: stopped before the first step')
             return
@@ -573,6 +684,14 @@ class PlantNode(Node):
             shutil.rmtree(self.chunks.folder, ignore_errors=True)
         self.get_logger().info(f'plant: wrote trajectory.npz and {PLANT_STATS_FILE} to '
                                f'{output_dir}')
+
+
+def _some(topics: List[str], shown: int = 3) -> str:
+    """Return '/clock has' or '/clock, /robot_1/pose and 99 more topics have'."""
+    if len(topics) == 1:
+        return f'{topics[0]} has'
+    more = f' and {len(topics) - shown} more topics' if len(topics) > shown else ''
+    return f"{', '.join(topics[:shown])}{more} have"
 
 
 def main(args: Optional[List[str]] = None) -> int:

@@ -314,7 +314,7 @@ class ReferenceNode(Node):
             'team': state.mode.value, 'shape in force': state.shape or 'formation.vertices',
             'shape changes': len(self.shapes.changes())}
         shape = self.shapes.at(self.last_stamp if self.last_stamp is not None else 0).vertices
-        values.update(announced(team_values(self.config, shape)))
+        values.update(announced(team_values(self.config, shape), self))
         others = team_problems(self.team, self.config, shape, self.once)
         if others:
             values['nodes with other team values'] = ' | '.join(others)

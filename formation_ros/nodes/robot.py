@@ -27,6 +27,16 @@ neighbours' hand points within R_i, and publishes (v, w) in its body frame
 ``pose_type: odometry`` the pose comes from a nav_msgs/Odometry (a real base's localisation)
 instead of a PoseStamped.
 
+A robot answers at most about one state per expected state period
+(``formation_ros.core.answers``: the plant's, ``plant.publish_rate`` of simulated time, every
+step in lockstep; on wall-clock time the relay's, ``relay.rate``), and a state once: a copy of
+the state it answered last is not answered again. States beyond that (a flood of forged poses)
+are counted in ``/diagnostics``, logged once, and not answered, so a flood on ``pose`` is never
+one on ``cmd_vel``. A robot also looks up, once a second, who publishes ``/clock`` and
+``/formation/reference``: more than one is an ERROR in its ``/diagnostics``, logged once,
+naming them (two teams on one domain), and a robot refusing stamps from another clock says so
+then instead of advising ``use_sim_time``.
+
 Every state and reference message must be in ``world_frame`` (default ``world``). Commands for
 real bases: ``command.type: twist`` publishes a geometry_msgs/Twist (no stamp) instead of a
 TwistStamped, and ``command.frame: body`` publishes a point robot's u in its
@@ -41,6 +51,7 @@ import time
 from typing import Callable, Dict, List, Optional, Tuple, TypeVar
 
 from diagnostic_msgs.msg import DiagnosticArray
+from formation_ros.core.answers import AnswerBudget
 from formation_ros.core.declarations import CommandFrame, Exe, PoseType
 from formation_ros.core.frames import advance, FrameSample, to_body_frame, valid_quaternions
 from formation_ros.core.law import Command, robot_command
@@ -57,7 +68,7 @@ from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
 from formation_ros.ros.runner import run
-from formation_ros.ros.team import announced
+from formation_ros.ros.team import announced, PublisherWatch
 from formation_ros.ros.wake import Wake
 from geometry_msgs.msg import PoseArray, PoseStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
@@ -74,6 +85,9 @@ LAST_WORD = 0.5
 """How long a stopping robot waits for its last (zero) command to be received, s."""
 RATE_TOLERANCE = 1e-3
 INPUTS = ('pose', 'neighbour', 'reference')
+COPY_GAP_NS = 25_000_000
+"""A copy of the state answered last that arrives sooner than this after the previous state
+counts as flooding (the plant sends a state again 0.05 s after the last, while it waits)."""
 
 
 class Reason(enum.Enum):
@@ -133,6 +147,15 @@ class RobotNode(Node):
         self.last: Optional[Command] = None
         self.waiting = True
         self.wait_subscribers = settings.wait_for_subscribers
+        period = settings.plant_period if self.sim_time else settings.relay_period
+        self.budget = AnswerBudget(max(1, int(round(period * fields.NS_PER_S))))
+        self.answered_stamp: Optional[int] = None
+        self.flooded = 0
+        self.flooded_reported = 0
+        self.flood_stamp: Optional[int] = None
+        self.copy_arrived_ns = 0
+        self.graph = PublisherWatch(self)
+        self.shared: Dict[str, str] = {}
 
         if settings.pose_type is PoseType.ODOMETRY:
             self.create_subscription(Odometry, topics.POSE, self.on_odometry, qos.STATE_INPUT,
@@ -142,8 +165,11 @@ class RobotNode(Node):
                                      raw=True)
         self.create_subscription(PoseArray, topics.NEIGHBOURS, self.on_neighbours,
                                  qos.STATE_INPUT, raw=True)
-        self.create_subscription(Odometry, topics.REFERENCE, self.on_reference, qos.REFERENCE,
-                                 raw=True)
+        reference = self.create_subscription(Odometry, topics.REFERENCE, self.on_reference,
+                                             qos.REFERENCE, raw=True)
+        self.expected_publishers: Dict[str, Optional[str]] = {reference.topic_name: None}
+        if self.sim_time:
+            self.expected_publishers[topics.CLOCK] = None
         self.changes = Changes(self, config, self.steady, self._reject_change, self._new_state)
         self.cmd_pub = self.create_publisher(TwistStamped if self.stamped else Twist,
                                              topics.CMD_VEL, qos.COMMAND)
@@ -202,11 +228,28 @@ class RobotNode(Node):
         gap = self._clock_gap_s(stamp_ns)
         if abs(gap) * fields.NS_PER_S > self.timeout_ns:
             clock = 'simulated' if self.sim_time else 'wall-clock'
+            advice = self._clock_advice(name, 'the robots and the reference')
             return self._reject(name, Reason.CLOCK, f' ({gap:+.3g} s from the {clock} time '
-                                                    'of this node: start the robots and the '
-                                                    'reference with use_sim_time:=true)')
+                                                    f'of this node: {advice})')
         self.once.end(f'{name}-{Reason.CLOCK.name}', f'{name} messages on this clock again')
         return True
+
+    def _clock_advice(self, name: str, nodes: str) -> str:
+        """
+        Say what to do about stamps from another clock: the graph's answer, else use_sim_time.
+
+        Two publishers of /clock or of the reference are two teams on one domain (looked up
+        here only when the refusal is about to be logged).
+        """
+        if self.once.is_active(f'{name}-{Reason.CLOCK.name}'):
+            return ''
+        doubled = {topic: names for topic in self.expected_publishers
+                   for names in [self.graph.publishers(topic)] if names}
+        if doubled:
+            return ('; '.join(f"{topic} has {len(names)} publishers ({', '.join(names)})"
+                              for topic, names in doubled.items())
+                    + ': two teams on one domain? each needs a ROS_DOMAIN_ID of its own')
+        return f'start {nodes} with use_sim_time:=true'
 
     def _read(self, name: str, reader: Callable[[bytes], Read], data: bytes) -> Optional[Read]:
         """Return ``reader(data)``; None, counted and logged once, if the bytes do not fit it."""
@@ -304,8 +347,9 @@ class RobotNode(Node):
         newest = self.references[-1].frame(self.dim)
         ahead = stamp_ns / fields.NS_PER_S - newest.t
         if abs(ahead) * fields.NS_PER_S > self.timeout_ns:
-            self._reject('reference', Reason.CLOCK, f' ({-ahead:+.3g} s from the state: start '
-                                                    'the reference with use_sim_time:=true)')
+            advice = self._clock_advice('reference', 'the reference')
+            self._reject('reference', Reason.CLOCK, f' ({-ahead:+.3g} s from the state: '
+                                                    f'{advice})')
             return None
         self.once.end(f'reference-{Reason.CLOCK.name}', 'reference on the clock of the states')
         return advance(newest, ahead)
@@ -416,8 +460,41 @@ class RobotNode(Node):
         if self.pose_count == self.answered_count:
             return
         stamp = self.pose.stamp_ns
+        if not self._may_answer(stamp):
+            return
         self._publish_command(self._command(stamp, False), stamp)
         self.answered_count = self.pose_count
+        self.answered_stamp = stamp
+
+    def _may_answer(self, stamp: int) -> bool:
+        """
+        Whether the state stamped ``stamp`` is answered: a new one, within the answer budget.
+
+        A copy of the state answered last is not (it counts as flooding when it comes within
+        COPY_GAP_NS of the previous state); a new state beyond the budget counts as flooding.
+        """
+        now = self._now_ns()
+        if stamp == self.answered_stamp:
+            if now - self.copy_arrived_ns < COPY_GAP_NS:
+                self._flooding(stamp)
+            self.copy_arrived_ns = now
+            self.answered_count = self.pose_count
+            return False
+        self.copy_arrived_ns = now
+        if self.budget.take(self.get_clock().now().nanoseconds):
+            return True
+        if stamp != self.flood_stamp:
+            self._flooding(stamp)
+        return False
+
+    def _flooding(self, stamp: int) -> None:
+        self.flooded += 1
+        self.flood_stamp = stamp
+        period = self.budget.period_ns / fields.NS_PER_S
+        self.once.start('flooding', f'states arrive faster than one per {period:.3g} s (the '
+                                    "plant's or relay's period): answering at most about one "
+                                    'per period, the others are dropped (logged once; '
+                                    'counted in diagnostics)', 'warning')
 
     def _ready(self) -> bool:
         """Start-up: every input heard once and cmd_vel has its subscribers (plant, recorder)."""
@@ -441,11 +518,15 @@ class RobotNode(Node):
         stamp = self.pose.stamp_ns
         if self.neighbours.stamp_ns != stamp:
             return
-        command = self._command(stamp, True)
-        if command is None:
+        if stamp != self.answered_stamp and self._reference_for(stamp, True) is None:
             return
+        if not self._may_answer(stamp):
+            return
+        command = self._command(stamp, True)
+        assert command is not None
         self._publish_command(command, stamp)
         self.answered_count = self.pose_count
+        self.answered_stamp = stamp
 
     def finish(self) -> None:
         """
@@ -475,7 +556,8 @@ class RobotNode(Node):
             values['max |u_hat| component [m/s]'] = float(np.max(np.abs(self.last.u_hat)))
         values['bound c*M1 [m/s]'] = self.law.u_bound
         now = self.pose.stamp_ns if self.pose is not None else 0
-        values.update(announced(team_values(self.config, self.changes.shapes.at(now).vertices)))
+        values.update(announced(team_values(self.config, self.changes.shapes.at(now).vertices),
+                                self))
         if self.last_body_command is not None and self.unicycle:
             values['|v| [m/s]'] = abs(float(self.last_body_command[0]))
             values['|w| [rad/s]'] = abs(float(self.last_body_command[1]))
@@ -484,14 +566,37 @@ class RobotNode(Node):
                 np.max(np.abs(self.last_body_command)))
         values.update({f'rejected {name} messages ({reason.value})': count
                        for (name, reason), count in self.rejected.items()})
-        if self.waiting:
+        values['states not answered (flooding)'] = self.flooded
+        flooding = self.flooded > self.flooded_reported
+        self.flooded_reported = self.flooded
+        shared = self._shared_topics()
+        if shared:
+            values['topics with more than one publisher'] = ' | '.join(
+                f'{topic}: {names}' for topic, names in sorted(shared.items()))
+            level, message = 'error', (f"{', '.join(sorted(shared))}: more than one publisher "
+                                       '(two teams on one domain?)')
+        elif self.waiting:
             level, message = 'warn', 'waiting for its first inputs'
         elif self.once.is_active('stale'):
             level, message = 'warn', 'publishing zero: inputs stale'
+        elif flooding:
+            level, message = 'warn', 'flooding: states beyond the state rate dropped'
         else:
             level, message = 'ok', 'lockstep' if self.lockstep else 'controlling'
         self.diagnostics_pub.publish(diagnostics(f'formation_ros/robot_{self.index + 1}', level,
                                                  message, values))
+
+    def _shared_topics(self) -> Dict[str, str]:
+        """Return {topic: its publishers} of /clock and the reference with several; log once."""
+        shared = self.graph.check(self.expected_publishers, time.monotonic())
+        for topic, names in shared.items():
+            self.once.start(f'publishers-{topic}', f'{topic} has more than one publisher: '
+                                                   f'{names} (two teams on one domain? each '
+                                                   'needs a ROS_DOMAIN_ID of its own)', 'error')
+        for topic in set(self.shared) - set(shared):
+            self.once.end(f'publishers-{topic}', f'{topic} has one publisher again')
+        self.shared = shared
+        return shared
 
 
 def main(args: Optional[List[str]] = None) -> int:

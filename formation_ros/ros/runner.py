@@ -198,6 +198,22 @@ def _exit_request(nodes: Sequence[Node]) -> Optional[int]:
                  if code is not None), None)
 
 
+class _ExitRequests:
+    """The nodes' ``exit_code`` attributes, looked at every SIGNAL_LATENCY s (not per spin)."""
+
+    def __init__(self, nodes: Sequence[Node]) -> None:
+        self.nodes = [node for node in nodes if hasattr(node, 'exit_code')]
+        self._next_check = 0.0
+
+    def due(self) -> Optional[int]:
+        """Return the exit code a node has asked for, None if none (or not looked yet)."""
+        now = time.monotonic()
+        if not self.nodes or now < self._next_check:
+            return None
+        self._next_check = now + SIGNAL_LATENCY
+        return _exit_request(self.nodes)
+
+
 NodeFactory = Callable[[], Union[Node, Sequence[Node]]]
 """Builds the process's node, or its nodes (a fleet of robots): a node class, for one."""
 
@@ -211,11 +227,13 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
     nodes) is moved out of the garbage collector's sight (``gc.freeze``): a profile of the
     lockstep plant found a fifth of its time in full collections walking those objects. The
     spin also ends when the launcher named in the environment is gone (see
-    :class:`LauncherWatch`), and when a node sets its ``exit_code`` attribute (the recorder
-    whose disk is full, :data:`formation_ros.core.exits.RECORDING_FAILED`): the node has said
-    why, in its own line. Returns the exit code: 0; 1 if a node's ``finish()`` failed (the
-    others still finish); 2 for invalid parameters (one line per bad parameter) or a command
-    line rclpy cannot start from; a node's ``exit_code``.
+    :class:`LauncherWatch`), and when a node sets its ``exit_code`` attribute (checked every
+    SIGNAL_LATENCY s): the recorder whose disk is full
+    (:data:`formation_ros.core.exits.RECORDING_FAILED`), a plant that finds another team on
+    its domain (:data:`formation_ros.core.exits.REFUSED`); the node has said why, in its own
+    line. Returns the exit code: 0; 1 if a node's ``finish()`` failed (the others still
+    finish); 2 for invalid parameters (one line per bad parameter) or a command line rclpy
+    cannot start from; a node's ``exit_code``.
     """
     if not _init(args, name):
         return 2
@@ -232,10 +250,11 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
         executor = make_executor()
         for node in nodes:
             executor.add_node(node)
+        requests = _ExitRequests(nodes)
         gc.collect()
         gc.freeze()
         while rclpy.ok() and _StopRequest.signal_name is None:
-            requested = _exit_request(nodes)
+            requested = requests.due()
             if requested is not None:
                 code = requested
                 break

@@ -5,20 +5,28 @@
 One team: announce the values every node must agree on, and name the nodes that differ.
 
 Every formation node adds ``core.team.team_values`` to its ``/diagnostics`` status under keys
-``team: <name>``. The plant and the reference hear every node's status (:class:`TeamCheck`: the
-callback stores, the node's diagnostics timer compares) and name each node whose values differ
-from their own. The shape in force may differ for a moment after a switch (a node takes it a
-few milliseconds later, and announcements are a second apart), so a shape counts as different
-only when it is none of the shapes this node itself had in force in its last
-:data:`RECENT` checks.
+``team: <name>``, and who it is: its host, process id and node name (:func:`announced`; the
+ROS graph names a node but not its host). The plant and the reference hear every node's status
+(:class:`TeamCheck`: the callback stores, the node's diagnostics timer compares) and name each
+node whose values differ from their own. The shape in force may differ for a moment after a
+switch (a node takes it a few milliseconds later, and announcements are a second apart), so a
+shape counts as different only when it is none of the shapes this node itself had in force in
+its last :data:`RECENT` checks.
+
+One team per domain: :class:`PublisherWatch` looks, on the node's timer, for publishers on a
+topic besides the one expected (:func:`formation_ros.core.team.duplicate_due` decides when one
+is reported) and names them, with their host where they announce it.
 """
 
 from collections import deque
-from typing import Dict, List, Mapping
+import os
+import socket
+import time
+from typing import Callable, Dict, List, Mapping, Optional, Sequence, Tuple
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.params import FormationConfig
-from formation_ros.core.team import differences, team_values
+from formation_ros.core.team import differences, duplicate_due, team_values
 from formation_ros.ros import qos, topics
 from formation_ros.ros.once import OnceLog
 import numpy as np
@@ -28,11 +36,34 @@ from rclpy.node import Node
 PREFIX = 'team: '
 TRANSIENT = ('shape in force',)
 RECENT = 3
+HOST, PROCESS, NODE = 'host', 'process', 'node'
+LIVE_FOR = 3.0
+"""A process that announced itself on /diagnostics within this many seconds (three of its
+once-a-second statuses) is taken to be running."""
+Process = Tuple[str, str]
+"""(host name, process id) as a node announces them."""
 
 
-def announced(values: Mapping[str, str]) -> Dict[str, str]:
-    """Return the diagnostics keys of the team values: ``team: num_robots`` and so on."""
-    return {PREFIX + name: text for name, text in values.items()}
+def full_name(namespace: str, name: str) -> str:
+    """Return a node's fully qualified name: ``/plant``, ``/robot_1/robot``."""
+    return namespace.rstrip('/') + '/' + name
+
+
+def identity(node: Optional[Node] = None) -> Dict[str, str]:
+    """Return this process's host name and id, and ``node``'s fully qualified name."""
+    found = {HOST: socket.gethostname(), PROCESS: str(os.getpid())}
+    if node is not None:
+        found[NODE] = node.get_fully_qualified_name()
+    return found
+
+
+def announced(values: Mapping[str, str], node: Optional[Node] = None) -> Dict[str, str]:
+    """
+    Return the diagnostics keys of the team values (``team: num_robots`` ...) and who says so.
+
+    ``host`` and ``process`` (this process), and with ``node`` its name (``node``).
+    """
+    return {**identity(node), **{PREFIX + name: text for name, text in values.items()}}
 
 
 class TeamCheck:
@@ -41,20 +72,49 @@ class TeamCheck:
     def __init__(self, node: Node, own_name: str) -> None:
         """Subscribe ``node`` (whose own status is named ``own_name``) to /diagnostics."""
         self.own_name = own_name
+        own = identity()
+        self.own_process: Process = (own[HOST], own[PROCESS])
         self.heard: Dict[str, Dict[str, str]] = {}
+        self.processes: Dict[str, Dict[Process, float]] = {}
         self.own_recent: deque = deque(maxlen=RECENT)
         node.create_subscription(DiagnosticArray, topics.DIAGNOSTICS, self.store,
                                  qos.DIAGNOSTICS)
 
     def store(self, msg: DiagnosticArray) -> None:
-        """Keep the team values each formation node announced last."""
+        """
+        Keep the team values each formation node announced last, and when each process spoke.
+
+        A status from this very process (this node, or another node of a fleet) is skipped; one
+        with this node's status name from another process (a second plant) is kept.
+        """
         for status in msg.status:
-            if status.name == self.own_name or not status.name.startswith('formation_ros/'):
+            if not status.name.startswith('formation_ros/'):
                 continue
-            values = {kv.key[len(PREFIX):]: kv.value for kv in status.values
-                      if kv.key.startswith(PREFIX)}
+            keys = {kv.key: kv.value for kv in status.values}
+            process = (keys.get(HOST, ''), keys.get(PROCESS, ''))
+            if process == self.own_process or (status.name == self.own_name
+                                               and not keys.get(PROCESS)):
+                continue
+            if keys.get(PROCESS):
+                name = keys.get(NODE) or status.name
+                self.processes.setdefault(name, {})[process] = time.monotonic()
+            values = {key[len(PREFIX):]: value for key, value in keys.items()
+                      if key.startswith(PREFIX)}
             if values:
                 self.heard[status.name] = values
+
+    def running(self, node_name: str, now: float) -> List[Process]:
+        """Return the other processes that announced node ``node_name`` in the last LIVE_FOR s."""
+        return sorted(process for process, when in self.processes.get(node_name, {}).items()
+                      if now - when <= LIVE_FOR)
+
+    def describe(self, node_name: str, now: float) -> str:
+        """Name a node with its host and process, where it announced them; else say so."""
+        found = self.running(node_name, now)
+        if not found:
+            return f'{node_name} (host unknown: it announces none on /diagnostics)'
+        return f'{node_name} on ' + ', '.join(f'host {host} (process {pid})'
+                                              for host, pid in found)
 
     def disagreeing(self, own: Mapping[str, str]) -> Dict[str, Dict[str, str]]:
         """Return {node: {value: 'theirs (here: ours)'}} of the nodes whose last word differs."""
@@ -94,3 +154,65 @@ def team_problems(check: TeamCheck, config: FormationConfig, shape: NDArray[np.f
         if name not in found:
             once.end(f'team-{name}', f'{name} agrees with the team again')
     return lines
+
+
+class PublisherWatch:
+    """
+    Publishers besides the expected one on some topics, looked up in the ROS graph on a timer.
+
+    :meth:`check` costs one ``count_publishers`` per topic (a lookup in the node's graph cache:
+    1.6 ms for the 151 topics of a 50-robot plant on the 2-core machine) and the publishers'
+    names only where there are more than one. A second publisher with another node name is
+    reported at once; one with the expected node's own name may be what is left of a process
+    killed a moment ago (DDS forgets it about 20 s later), so it is reported at once only with
+    evidence that it runs (``alive``), else after ``core.team.DUPLICATE_GRACE`` s.
+    """
+
+    def __init__(self, node: Node, team: Optional[TeamCheck] = None) -> None:
+        """Look up the graph of ``node``; name hosts from what ``team`` heard (if given)."""
+        self.node = node
+        self.team = team
+        self.since: Dict[str, float] = {}
+        self.listed: Dict[str, List[str]] = {}
+
+    def publishers(self, topic: str) -> List[str]:
+        """Return the fully qualified names of the nodes publishing ``topic`` (one per writer)."""
+        if self.node.count_publishers(topic) <= 1:
+            return []
+        return sorted(full_name(info.node_namespace, info.node_name)
+                      for info in self.node.get_publishers_info_by_topic(topic))
+
+    def check(self, expected: Mapping[str, Optional[str]], now: float,
+              alive: Callable[[str, Sequence[str]], bool] = lambda topic, names: False
+              ) -> Dict[str, str]:
+        """
+        Return {topic: the other publishers, named} for each topic of ``expected`` now due.
+
+        expected: {topic: the one node that should publish it (fully qualified), or None for
+        any one node}; alive(topic, names): whether a same-named second publisher is known to
+        run. :attr:`listed` keeps every topic's publishers when there are several, due or not.
+        """
+        due: Dict[str, str] = {}
+        self.listed = {}
+        for topic, own in expected.items():
+            names = self.publishers(topic)
+            if not names:
+                self.since.pop(topic, None)
+                continue
+            self.listed[topic] = names
+            since = self.since.setdefault(topic, now)
+            if duplicate_due(names, own, now - since, alive(topic, names)):
+                due[topic] = self.name_others(names, own, now)
+        return due
+
+    def name_others(self, names: Sequence[str], own: Optional[str], now: float) -> str:
+        """Describe the publishers of a topic other than ``own`` (all of them if it is None)."""
+        others = list(names)
+        if own is not None and own in others:
+            others.remove(own)
+        described = []
+        for name in sorted(set(others)):
+            text = self.team.describe(name, now) if self.team is not None else name
+            count = others.count(name)
+            described.append(text + (f' ({count} publishers)' if count > 1 else ''))
+        return ', '.join(described)

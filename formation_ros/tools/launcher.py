@@ -33,6 +33,7 @@ import time
 from typing import Callable, Mapping, Optional, Sequence, TextIO
 
 from formation_ros.core.exits import RECORDING_FAILED
+from formation_ros.tools.domain import choose_domain
 from formation_ros.tools.supervise import describe_returncode, ExitInfo, ProcessSpec, Supervisor
 from formation_ros.tools.system import (DISCOVERY, DISCOVERY_ENV, discovery_problem,
                                         DOMAIN_ENV, domain_problem, FLEET_REMAP, Formation,
@@ -116,7 +117,9 @@ Options:
                  environment, else localhost
   --domain-id N  ROS 2 domain of the nodes, 0 to 232 (sets ROS_DOMAIN_ID; 0 to 101 is the
                  range that is safe on every Linux machine). Default: ROS_DOMAIN_ID as set
-                 in the environment, else 0
+                 in the environment, else a free domain of the launcher's choosing (one
+                 on which no DDS participant is seen), said in its first line with how to
+                 join it (export ROS_DOMAIN_ID=N)
   --no-plant     a lab: no plant and no /clock. The relay (executable 'relay') reads every
                  robot's measured pose (relay.source_topic, relay.source_names and
                  relay.source_type in PARAMS.yaml) and publishes /robot_<i>/pose and
@@ -641,6 +644,14 @@ def main(argv: Optional[Sequence[str]] = None, make: Optional[Callable[..., 'Lau
             say(exc.args[0])
         return 2
     options = dataclasses.replace(options, cmd_topics=formation.cmd_topics)
+    chosen = ''
+    if options.domain_id is None and not os.environ.get(DOMAIN_ENV):
+        try:
+            domain, chosen = choose_domain(discovery_environment(options, os.environ))
+        except LookupError as exc:
+            say(f'{exc}: set ROS_DOMAIN_ID or --domain-id')
+            return 2
+        options = dataclasses.replace(options, domain_id=domain)
     num_robots = formation.num_robots
     wall_seconds = formation.wall_seconds if options.duration is None else options.duration
     try:
@@ -660,9 +671,12 @@ def main(argv: Optional[Sequence[str]] = None, make: Optional[Callable[..., 'Lau
                  f' in {-(-num_robots // per_process)} fleet processes of up to {per_process}')
     network = discovery_environment(options, os.environ)
     lab = ', no plant (relay, wall-clock time)' if options.no_plant else ''
+    domain = network.get(DOMAIN_ENV) or '0'
+    join = (f' (a free domain of its own: {chosen}; to join it: export ROS_DOMAIN_ID={domain} '
+            'before ros2 topic echo ...)' if chosen else '')
     say(f'{num_robots} robots{processes}{lab} from {options.params} ({install.describe()}), '
-        f"{span}; ROS_DOMAIN_ID {network.get(DOMAIN_ENV) or '0'}, discovery "
-        f'{network[DISCOVERY_ENV].lower()}', sys.stdout)
+        f'{span}; ROS_DOMAIN_ID {domain}{join}, discovery {network[DISCOVERY_ENV].lower()}',
+        sys.stdout)
     return (make or Launch)(options, install, num_robots, wall_seconds).run()
 
 

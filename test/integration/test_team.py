@@ -38,7 +38,8 @@ def test_a_robot_with_another_file_is_named_by_plant_and_reference(
         text = named(status_name)
         assert 'c=1.0' in text and 'c=2.0' in text, text
         assert all(f'formation_ros/robot_{i}' not in text for i in (1, 2, 3)), text
-    assert "following the reference's shape" in processes.log('robot_3')
+    assert probe.spin_until(lambda: "following the reference's shape"
+                            in processes.log('robot_3'), 60), processes.log('robot_3')
     log = processes.log('plant')
     assert log.count('formation_ros/robot_4: law') == 1, log
     assert 'formation_ros/robot_4: law' in processes.log('reference')

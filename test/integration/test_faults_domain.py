@@ -1,0 +1,199 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""Two teams on one domain: refused at the plant's start, named while running, or avoided."""
+
+import os
+import re
+import socket
+
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from formation_ros.ros import messages, qos
+from formation_ros.tools import domain
+from geometry_msgs.msg import PoseStamped, TwistStamped
+from helpers import launch, node, SimClock, SQUARE, stop_when, wait_exit, write_params
+from nav_msgs.msg import Odometry
+import pytest
+from rosgraph_msgs.msg import Clock as ClockMsg
+
+pytestmark = pytest.mark.faults
+START_UP = 90.0
+HOST = socket.gethostname()
+
+
+def statuses_of(probe):
+    """Subscribe ``probe`` to /diagnostics; return {status name: the latest status}."""
+    statuses = {}
+    probe.create_subscription(DiagnosticArray, '/diagnostics', lambda m: statuses.update(
+        {status.name: status for status in m.status}), qos.DIAGNOSTICS)
+    return statuses
+
+
+def value(statuses, name, key):
+    """Return value ``key`` of status ``name`` if that status is an ERROR, else ''."""
+    status = statuses.get(name)
+    if status is None or status.level != DiagnosticStatus.ERROR:
+        return ''
+    return {kv.key: kv.value for kv in status.values}.get(key, '')
+
+
+def error_lines(log):
+    return [line for line in log.splitlines() if '[ERROR]' in line]
+
+
+def test_a_second_plant_refuses_to_start_naming_the_first(processes, install, probe):
+    clock = SimClock(probe)
+    statuses = statuses_of(probe)
+    first = processes.start(node(install, 'plant', SQUARE, '-p', 'plant.wait_for_robots:=false'))
+    assert probe.spin_until(lambda: clock.seconds > 0.5, START_UP), processes.log('plant')
+    second = processes.start(node(install, 'plant', SQUARE, process='plant_2'))
+    info = wait_exit(probe, processes, 'plant_2', START_UP)
+    assert info is not None and info.returncode == 2, processes.log('plant_2')
+    log = processes.log('plant_2')
+    [line] = error_lines(log)
+    assert f'another plant is on ROS_DOMAIN_ID {os.environ["ROS_DOMAIN_ID"]}' in line, line
+    assert f'/plant on host {HOST} (process {first.pid})' in line, line
+    assert 'Traceback' not in log and 'stopped before the first step' not in log, log
+    named = f'another plant runs on this domain: /plant on host {HOST} (process {second.pid})'
+    assert probe.spin_until(lambda: named in processes.log('plant'), 30), processes.log('plant')
+    assert processes.log('plant').count(named) == 1, processes.log('plant')
+    assert processes.running('plant')
+    assert probe.spin_until(lambda: 'the other plant is gone' in processes.log('plant'), 60)
+    assert probe.spin_until(lambda: statuses.get('formation_ros/plant') is not None
+                            and statuses['formation_ros/plant'].level != DiagnosticStatus.ERROR,
+                            30)
+
+
+def test_a_plant_refuses_a_domain_with_another_clock(processes, install, probe):
+    publisher = probe.create_publisher(ClockMsg, '/clock', qos.CLOCK)
+    processes.start(node(install, 'plant', SQUARE))
+
+    def tick():
+        publisher.publish(ClockMsg())
+        return not processes.running('plant')
+
+    assert probe.spin_until(tick, START_UP), processes.log('plant')
+    info = processes.exit_info('plant')
+    assert info is not None and info.returncode == 2, processes.log('plant')
+    [line] = error_lines(processes.log('plant'))
+    assert 'another /clock publisher' in line and '/probe (host unknown' in line, line
+
+
+def test_a_running_plant_names_a_second_publisher_on_pose_and_cmd_vel(processes, install, probe):
+    statuses = statuses_of(probe)
+    processes.start(node(install, 'plant', SQUARE, '-p', 'plant.wait_for_robots:=false'))
+    processes.start(node(install, 'robot', SQUARE, '-r', '__ns:=/robot_1',
+                         '-p', 'use_sim_time:=true', process='robot_1'))
+    clock = SimClock(probe)
+    assert probe.spin_until(lambda: clock.seconds > 0.5, START_UP), processes.log('plant')
+    commands = probe.create_publisher(TwistStamped, '/robot_1/cmd_vel', qos.COMMAND)
+    poses = probe.create_publisher(PoseStamped, '/robot_1/pose', qos.STATE)
+
+    def named():
+        text = value(statuses, 'formation_ros/plant', 'topics with more than one publisher')
+        return '/robot_1/cmd_vel: /probe' in text and '/robot_1/pose: /probe' in text
+
+    assert probe.spin_until(named, 60), (statuses.get('formation_ros/plant'),
+                                         processes.log('plant'))
+    text = value(statuses, 'formation_ros/plant', 'topics with more than one publisher')
+    assert '/robot_1/robot' in text.split('/robot_1/cmd_vel: ')[1], text
+    log = processes.log('plant')
+    assert log.count('/robot_1/pose has more than one publisher: /probe') == 1, log
+    assert log.count('/robot_1/cmd_vel has more than one publisher: /probe') == 1, log
+    assert commands.topic_name == '/robot_1/cmd_vel' and poses.topic_name == '/robot_1/pose'
+
+
+def test_a_robot_names_a_second_reference_publisher(processes, install, probe):
+    statuses = statuses_of(probe)
+    processes.start(node(install, 'reference', SQUARE))
+    processes.start(node(install, 'robot', SQUARE, '-r', '__ns:=/robot_1', process='robot_1'))
+    forged = probe.create_publisher(Odometry, '/formation/reference', qos.REFERENCE)
+
+    def named():
+        forged.publish(messages.reference_odometry(None, probe.get_clock().now().nanoseconds,
+                                                   2))
+        text = value(statuses, 'formation_ros/robot_1', 'topics with more than one publisher')
+        return '/formation/reference: /probe, /reference' in text
+
+    assert probe.spin_until(named, START_UP), (statuses.get('formation_ros/robot_1'),
+                                               processes.log('robot_1'))
+    log = processes.log('robot_1')
+    assert log.count('/formation/reference has more than one publisher') == 1, log
+    assert 'two teams on one domain' in log
+
+
+def test_a_robot_on_two_clocks_names_them_instead_of_advising_use_sim_time(
+        processes, install, probe):
+    processes.start(node(install, 'plant', SQUARE, '-p', 'plant.wait_for_robots:=false'))
+    processes.start(node(install, 'robot', SQUARE, '-r', '__ns:=/robot_1',
+                         '-p', 'use_sim_time:=true', process='robot_1'))
+    clock = SimClock(probe)
+    assert probe.spin_until(lambda: clock.seconds > 0.5, START_UP), processes.log('plant')
+    other = probe.create_publisher(ClockMsg, '/clock', qos.CLOCK)
+    far = ClockMsg()
+    far.clock = messages.ns_to_stamp(1000 * 10 ** 9)
+
+    def refused():
+        other.publish(far)
+        return 'stamps from another clock' in processes.log('robot_1')
+
+    assert probe.spin_until(refused, START_UP), processes.log('robot_1')
+    lines = [line for line in processes.log('robot_1').splitlines()
+             if 'stamps from another clock' in line]
+    for line in lines:
+        assert '/clock has 2 publishers (/plant, /probe)' in line, line
+        assert 'use_sim_time' not in line, line
+    assert probe.spin_until(lambda: '/clock has more than one publisher: /plant, /probe'
+                            in processes.log('robot_1'), 30), processes.log('robot_1')
+
+
+def test_the_launcher_runs_on_a_free_domain_of_its_own(processes, install, probe, tmp_path):
+    """Without ROS_DOMAIN_ID the launcher takes a domain no participant of this host is on."""
+    import rclpy
+    held = next(d for d in domain.candidates(os.getuid()) if not domain.ports_busy(d))
+    holder = rclpy.Context()
+    rclpy.init(context=holder, domain_id=held)
+    holder_node = rclpy.create_node('holder', context=holder)
+    try:
+        assert domain.ports_busy(held)
+        env = dict(processes.env)
+        env.pop('ROS_DOMAIN_ID')
+        params = write_params(tmp_path, 'square_4.yaml', {})
+        launch(processes, install, params, env=env)
+        found = []
+
+        def said():
+            match = re.search(r'ROS_DOMAIN_ID ([0-9]+) \(a free domain of its own: [^;]+; to '
+                              r'join it: export ROS_DOMAIN_ID=([0-9]+) before ros2 topic echo',
+                              processes.log('launcher'))
+            if match and not found:
+                found.append(int(match.group(1)))
+            return bool(found)
+
+        assert probe.spin_until(said, START_UP), processes.log('launcher')
+        first = processes.log('launcher').splitlines()[0]
+        assert f'ROS_DOMAIN_ID {found[0]} (a free domain' in first, first
+        assert found[0] != held and found[0] != int(os.environ['ROS_DOMAIN_ID'])
+        joined = rclpy.Context()
+        rclpy.init(context=joined, domain_id=found[0])
+        listener = rclpy.create_node('listener', context=joined)
+        heard = []
+        listener.create_subscription(ClockMsg, '/clock', heard.append, qos.CLOCK)
+        from rclpy.executors import SingleThreadedExecutor
+        executor = SingleThreadedExecutor(context=joined)
+        executor.add_node(listener)
+
+        def joined_heard():
+            executor.spin_once(timeout_sec=0.05)
+            return len(heard) > 10
+
+        try:
+            info = stop_when(probe, processes, joined_heard)
+        finally:
+            executor.shutdown()
+            listener.destroy_node()
+            rclpy.shutdown(context=joined)
+        assert info.returncode == 0, processes.log('launcher')[-3000:]
+    finally:
+        holder_node.destroy_node()
+        rclpy.shutdown(context=holder)
