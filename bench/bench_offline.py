@@ -187,14 +187,18 @@ def format_row(row: Dict[str, Any]) -> str:
             f"(bound {row['u_bound']:.4g}) |")
 
 
+def _part(split: Dict[str, Any], name: str) -> str:
+    """Return one part's wall time, and its CPU time when measured, as table text."""
+    cpu = split.get('cpu_' + name)
+    return f'{split[name]:.2f}' + ('' if cpu is None else f' ({cpu:.2f})')
+
+
 def format_split(row: Dict[str, Any]) -> str:
     """One Markdown table row of the split run."""
     split = row.get('split', {'error': row.get('error', 'not run')})
     if 'error' in split:
         return f"| {row['robots']} | {split['error']} | | | | | | | | |"
-    parts = ' | '.join(f"{split[name]:.2f}" + (f" ({split['cpu_' + name]:.2f})"
-                                                if 'cpu_' + name in split else '')
-                       for name in SPLIT_PARTS)
+    parts = ' | '.join(_part(split, name) for name in SPLIT_PARTS)
     return (f"| {row['robots']} | {row['sample_dt']:g} | {parts} | {split['wall_s']:.2f} "
             f"({split['cpu_s']:.2f}) | {split['peak_rss_mib']:.0f} |")
 

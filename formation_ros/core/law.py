@@ -233,7 +233,7 @@ def team_command(q: ArrayLike, vertices: ArrayLike, sensing_radii: ArrayLike, la
 
 def _within(terms: NDArray[np.float64], d2: NDArray[np.float64],
             radius_sq: NDArray[np.float64]) -> NDArray[np.float64]:
-    """The rows of terms (K, dim) whose d2 (K,) is below radius_sq (K,), the others zero."""
+    """Keep the rows of terms (K, dim) whose d2 (K,) is below radius_sq (K,), zero the others."""
     inside = d2 < radius_sq
     if np.all(inside):
         return terms  # times 1.0: the same numbers

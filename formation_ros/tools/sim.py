@@ -120,7 +120,7 @@ def sample_count(duration: float, dt: Optional[float], sample_dt: float) -> int:
 
 def default_sample_dt(num_robots: int, duration: float, dt: Optional[float]) -> float:
     """
-    The sample spacing of a run without ``--sample-dt``, s: the rule of :data:`MAX_ROBOT_SAMPLES`.
+    Return the sample spacing of a run without ``--sample-dt``, s (:data:`MAX_ROBOT_SAMPLES`).
 
     :data:`DEFAULT_SAMPLE_DT`, or, when ``num_robots`` times the samples it gives
     (:func:`sample_count`) would exceed :data:`MAX_ROBOT_SAMPLES`, the smallest whole multiple
