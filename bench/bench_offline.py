@@ -176,11 +176,17 @@ def run_case(args: argparse.Namespace, n: int, sample_dt: Optional[float],
     return row
 
 
+def _spacing(row: Dict[str, Any]) -> str:
+    """Return the sample spacing of a row (a formation_sim before the rule does not say it)."""
+    spacing = row['sample_dt'] if row['sample_dt'] is not None else row['sample_dt_given']
+    return 'default' if spacing is None else f'{spacing:g}'
+
+
 def format_row(row: Dict[str, Any]) -> str:
     """One Markdown table row of the whole command."""
     if 'error' in row:
         return f"| {row['robots']} | {row['error']} | | | | | | | |"
-    return (f"| {row['robots']} | {row['sample_dt']:g} ({row['num_samples']}) | "
+    return (f"| {row['robots']} | {_spacing(row)} ({row['num_samples']}) | "
             f"{row['wall_s']:.2f} | {row['cpu_s']:.2f} | {row['peak_rss_mib']:.0f} | "
             f"{row['ms_per_step']:.2f} | {row['realtime_factor']:.1f}x | "
             f"{row['min_pair_distance']:.3g} | {row['max_abs_u_hat_component']:.4g} "
@@ -199,7 +205,7 @@ def format_split(row: Dict[str, Any]) -> str:
     if 'error' in split:
         return f"| {row['robots']} | {split['error']} | | | | | | | | |"
     parts = ' | '.join(_part(split, name) for name in SPLIT_PARTS)
-    return (f"| {row['robots']} | {row['sample_dt']:g} | {parts} | {split['wall_s']:.2f} "
+    return (f"| {row['robots']} | {_spacing(row)} | {parts} | {split['wall_s']:.2f} "
             f"({split['cpu_s']:.2f}) | {split['peak_rss_mib']:.0f} |")
 
 
