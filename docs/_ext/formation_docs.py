@@ -291,12 +291,16 @@ def bench_offline() -> List[str]:
     """Offline rows of offline.json, formatted by bench_offline.py."""
     data = read_json('offline.json')
     row = load('bench/bench_offline.py:format_row')
+    split = load('bench/bench_offline.py:format_split')
     lines = load('bench/bench_offline.py:HEADER').splitlines()
+    lines += [row(entry) for entry in data['rows']]
+    if any('split' in entry for entry in data['rows']):
+        lines += ['', 'Each part in one process, wall (CPU) seconds:', '']
+        lines += load('bench/bench_offline.py:SPLIT_HEADER').splitlines()
+        lines += [split(entry) for entry in data['rows'] if 'split' in entry]
     arguments = data['arguments']
-    return lines + [row(entry) for entry in data['rows']] + [
-        '', machine_line(data, 'offline.json')[:-2] +
-        f"; {arguments['duration']:g} s simulated, dt {arguments['dt']:g}, samples every "
-        f"{arguments['sample_dt']:g} s.*"]
+    return lines + ['', machine_line(data, 'offline.json')[:-2] +
+                    f"; {arguments['duration']:g} s simulated, dt {arguments['dt']:g}.*"]
 
 
 def robustness_limits(data: Mapping[str, Any]) -> List[str]:

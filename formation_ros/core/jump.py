@@ -121,8 +121,11 @@ class PolyJump:
         x = np.asarray(x, dtype=float)
         t = (x - a) / (b - a)
         inside = (t > 0.0) & (t < 1.0)
-        tc = np.where(inside, t, 0.5)
+        every = bool(np.all(inside))
+        tc = t if every else np.where(inside, t, 0.5)
         value = (1.0 - tc) ** self.order * self._inv_beta / ((b - a) * tc * self._sum_s(tc))
+        if every:
+            return np.asarray(value)
         return np.where(inside, value, np.where(t <= 0.0, np.inf, 0.0))
 
 

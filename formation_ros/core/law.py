@@ -111,11 +111,18 @@ def repulsion_terms(q_ij: ArrayLike, law: LawParams) -> NDArray[np.float64]:
     :data:`MAX_REPULSION` along q_ij: the command saturates at c M1 all the same.
     """
     q_ij = np.asarray(q_ij, dtype=float)
-    d2 = np.einsum('kd,kd->k', q_ij, q_ij)
+    return _repulsion_terms(q_ij, np.einsum('kd,kd->k', q_ij, q_ij), law)
+
+
+def _repulsion_terms(q_ij: NDArray[np.float64], d2: NDArray[np.float64],
+                     law: LawParams) -> NDArray[np.float64]:
+    """:func:`repulsion_terms` of q_ij (K, dim) whose squared norms d2 (K,) are known."""
     b = law.repulsion_radius
     with np.errstate(invalid='ignore', over='ignore', divide='ignore'):
         weight = law.jump.ratio(0.5 * d2, 0.0, 0.5 * b * b)
         terms: NDArray[np.float64] = weight[:, None] * q_ij
+    if np.all(d2 != 0.0) and np.all(np.isfinite(terms)):
+        return terms  # every row apart and finite: nothing below would change
     apart = np.any(q_ij != 0.0, axis=1)
     huge = apart & ((d2 == 0.0) | ~np.all(np.isfinite(terms), axis=1))
     if np.any(huge):
@@ -214,14 +221,24 @@ def team_command(q: ArrayLike, vertices: ArrayLike, sensing_radii: ArrayLike, la
     i, j = pairs[:, 0], pairs[:, 1]
     q_hat_ij = q_hat[i] - q_hat[j]
     d2 = np.einsum('kd,kd->k', q_hat_ij, q_hat_ij)
-    terms = repulsion_terms(q_hat_ij, law)
-    heard_by_i = terms * (d2 < radii[i] ** 2)[:, None]
-    heard_by_j = terms * (d2 < radii[j] ** 2)[:, None]
+    terms = _repulsion_terms(q_hat_ij, d2, law)
+    radii_sq = radii ** 2
+    heard_by_i, heard_by_j = (_within(terms, d2, radii_sq[k]) for k in (i, j))
     rep = np.stack([np.bincount(i, heard_by_i[:, axis], n) - np.bincount(j, heard_by_j[:, axis], n)
                     for axis in range(dim)], axis=1)
     omega_hat = omega(q_hat - np.asarray(vertices, dtype=float), rep, law)
     u_hat = bounded_command(omega_hat, law)
     return Command(u=from_frame_velocity(u_hat, q, frame), u_hat=u_hat, omega=omega_hat)
+
+
+def _within(terms: NDArray[np.float64], d2: NDArray[np.float64],
+            radius_sq: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Keep the rows of terms (K, dim) whose d2 (K,) is below radius_sq (K,), zero the others."""
+    inside = d2 < radius_sq
+    if np.all(inside):
+        return terms  # times 1.0: the same numbers
+    within: NDArray[np.float64] = terms * inside[:, None]
+    return within
 
 
 def log_potential(q: ArrayLike, vertices: ArrayLike, law: LawParams,

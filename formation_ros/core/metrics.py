@@ -15,8 +15,6 @@ from formation_ros.core.events import Event, segments
 from formation_ros.core.trajectory import Trajectory
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.spatial import cKDTree
-from scipy.spatial.distance import pdist
 
 SETTLE_TOLERANCE = 0.05
 DIS_ALL_MAX_SAMPLES = 400
@@ -50,6 +48,7 @@ def closest_pair_distance(points: ArrayLike) -> float:
     array = np.asarray(points, dtype=float)
     if len(array) < 2:
         return math.inf
+    from scipy.spatial import cKDTree  # here: importing formation_sim need not load scipy
     dist, _ = cKDTree(array).query(array, k=2)
     return float(np.min(dist[:, 1]))
 
@@ -61,6 +60,7 @@ def dis_min_series(q: ArrayLike) -> NDArray[np.float64]:
 
 def dis_all(points: ArrayLike) -> float:
     """Return dis_all of Section 5, the geometric mean of ||q_ij|| (docs/equations.md, slip 7)."""
+    from scipy.spatial.distance import pdist
     with np.errstate(divide='ignore'):
         return float(np.exp(np.mean(np.log(pdist(np.asarray(points, dtype=float))))))
 

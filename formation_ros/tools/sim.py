@@ -51,6 +51,11 @@ import numpy as np
 RTOL = 1e-8
 ATOL = 1e-10
 DEFAULT_SAMPLE_DT = 0.01
+MAX_ROBOT_SAMPLES = 5_000_000
+"""Without ``--sample-dt`` a run saves at most this many robot-samples (robots x samples): a
+larger team is sampled at the smallest whole multiple of :data:`DEFAULT_SAMPLE_DT` that keeps
+within it (:func:`default_sample_dt`), so 10,000 robots over 20 s are saved every 0.05 s and
+the samples stay well under a gigabyte; smaller runs are sampled as before."""
 MAX_STEPS = 10_000_000
 TRAJECTORY_FILE = 'trajectory.npz'
 METRICS_FILE = 'metrics.json'
@@ -96,6 +101,57 @@ def sample_times(duration: float, sample_dt: float) -> np.ndarray:
     if duration - times[-1] > 1e-9 * max(1.0, duration):
         times = np.append(times, duration)
     return times
+
+
+def sample_count(duration: float, dt: Optional[float], sample_dt: float) -> int:
+    """
+    How many samples a run of ``duration`` s saves at ``sample_dt`` s (the end included).
+
+    dt: the fixed step of a ``--dt`` run (whose samples are every round(sample_dt / dt) steps,
+    at least one), None for RK45 (:func:`sample_times`).
+    """
+    if dt is None:
+        count = int(math.floor(duration / sample_dt + 1e-9))
+        return count + 1 + int(duration - count * sample_dt > 1e-9 * max(1.0, duration))
+    steps = int(round(duration / dt))
+    stride = max(1, int(round(sample_dt / dt)))
+    return -(-steps // stride) + 1
+
+
+def default_sample_dt(num_robots: int, duration: float, dt: Optional[float]) -> float:
+    """
+    Return the sample spacing of a run without ``--sample-dt``, s (:data:`MAX_ROBOT_SAMPLES`).
+
+    :data:`DEFAULT_SAMPLE_DT`, or, when ``num_robots`` times the samples it gives
+    (:func:`sample_count`) would exceed :data:`MAX_ROBOT_SAMPLES`, the smallest whole multiple
+    of it that keeps them within (at most the duration: then only the start and the end).
+    """
+    def fits(multiple: int) -> bool:
+        spacing = multiple * DEFAULT_SAMPLE_DT
+        return (spacing >= duration
+                or num_robots * sample_count(duration, dt, spacing) <= MAX_ROBOT_SAMPLES)
+
+    if fits(1):
+        return DEFAULT_SAMPLE_DT
+    multiple = max(2, int(num_robots * duration / (DEFAULT_SAMPLE_DT * MAX_ROBOT_SAMPLES)) - 1)
+    while not fits(multiple):
+        multiple += 1
+    return min(float(f'{multiple * DEFAULT_SAMPLE_DT:.12g}'), duration)
+
+
+def sampling_metadata(num_robots: int, duration: float, dt: Optional[float],
+                      given: Optional[float]) -> dict:
+    """
+    metrics.json keys that say how the run was sampled.
+
+    ``sample_dt``: the spacing asked for, s (``--sample-dt``, else :func:`default_sample_dt`);
+    ``sampling``: 'given', 'default', or 'default, thinned' when the rule of
+    :data:`MAX_ROBOT_SAMPLES` widened the default; ``max_robot_samples``: that cap.
+    """
+    spacing = default_sample_dt(num_robots, duration, dt) if given is None else given
+    rule = ('given' if given is not None else 'default' if spacing == DEFAULT_SAMPLE_DT
+            else 'default, thinned')
+    return {'sample_dt': spacing, 'sampling': rule, 'max_robot_samples': MAX_ROBOT_SAMPLES}
 
 
 def shapes_of(config: FormationConfig) -> Timeline[Shape]:
@@ -474,7 +530,11 @@ def build_parser() -> argparse.ArgumentParser:
                                                  'adaptive RK45 at rtol 1e-8)')
     parser.add_argument('--sample-dt', type=float,
                         help='spacing of saved samples, s, at most the duration and at most '
-                             f'{MAX_STEPS:,} samples per run (default {DEFAULT_SAMPLE_DT:g})')
+                             f'{MAX_STEPS:,} samples per run (default {DEFAULT_SAMPLE_DT:g}, '
+                             'or for a team that would then save more than '
+                             f'{MAX_ROBOT_SAMPLES:,} robots x samples the smallest multiple '
+                             f'of {DEFAULT_SAMPLE_DT:g} s that keeps within it; metrics.json '
+                             'says which under sample_dt and sampling)')
     parser.add_argument('--no-plots', action='store_true', help='skip the figures')
     parser.add_argument('--quiet', action='store_true', help='print no progress')
     return parser
@@ -580,7 +640,8 @@ def main(argv: Optional[list] = None) -> int:
     if problem:
         print(f'formation_sim: {problem}', file=sys.stderr)
         return 2
-    sample_dt = DEFAULT_SAMPLE_DT if args.sample_dt is None else args.sample_dt
+    sampling = sampling_metadata(config.num_robots, duration, args.dt, args.sample_dt)
+    sample_dt = sampling['sample_dt']
     integrator = 'RK45' if args.dt is None else f'zero-order hold, dt = {args.dt:g} s'
     progress = Progress(duration, quiet=args.quiet)
     events = schedule_events(config)
@@ -592,6 +653,7 @@ def main(argv: Optional[list] = None) -> int:
         trajectory = run.trajectory
         metrics = run_metrics(trajectory, config, integrator, events)
         metrics.update(plant_metrics(run, config))
+    metrics.update(sampling)
     metrics['wall_time'] = progress.elapsed
     trajectory.save(os.path.join(args.out, TRAJECTORY_FILE))
     _copy_params(args.params, args.out)
