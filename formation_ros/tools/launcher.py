@@ -32,9 +32,10 @@ from typing import Callable, Mapping, Optional, Sequence, TextIO
 
 from formation_ros.tools.supervise import describe_returncode, ProcessSpec, Supervisor
 from formation_ros.tools.system import (DISCOVERY, DISCOVERY_ENV, discovery_problem,
-                                        DOMAIN_ENV, domain_problem, FLEET_REMAP, Formation,
-                                        network_variables, NodePlan, plan, PlanError,
-                                        read_formation, recorder_plan, ros_arguments, Run)
+                                        DOMAIN_ENV, domain_problem, ESSENTIAL, FLEET_REMAP,
+                                        Formation, network_variables, NodePlan, plan,
+                                        PlanError, read_formation, RECORDER, recorder_plan,
+                                        ros_arguments, Run, stop_stages, with_variables)
 
 PROG = 'launch_formation.sh'
 PACKAGE = 'formation_ros'
@@ -43,7 +44,6 @@ RECORDER_START_TIMEOUT = 15.0
 POLL = 0.2
 ON_EXIT = ('continue', 'stop', 'respawn')
 MAX_RESTARTS = 5
-ESSENTIAL = ('plant', 'relay', 'reference', 'record')
 LAUNCHER_PID_ENV = 'FORMATION_LAUNCHER_PID'
 LAUNCHER_START_ENV = 'FORMATION_LAUNCHER_START'
 
@@ -254,11 +254,7 @@ def discovery_environment(options: Options, base: Mapping[str, str]) -> dict[str
     ``base`` is kept, and LOCALHOST is set where there is none (so a run on one computer stays
     there; ROS's own default is SUBNET). ``--domain-id`` sets ROS_DOMAIN_ID.
     """
-    env = dict(base)
-    if options.discovery is not None:
-        env.pop('ROS_LOCALHOST_ONLY', None)
-    env.update(network_variables(options.discovery, options.domain_id, base))
-    return env
+    return with_variables(base, network_variables(options.discovery, options.domain_id, base))
 
 
 def check_paths(options: Options) -> Options:
@@ -344,7 +340,7 @@ def node_specs(install: Install, options: Options, num_robots: int,
                env: Mapping[str, str]) -> list[ProcessSpec]:
     """Return the specs of plant (or relay), reference and robots, in the order they start."""
     return [_spec(install, node, options, env) for node in plan(run_of(options, num_robots))
-            if node.name != 'record']
+            if node.name != RECORDER]
 
 
 def recorder_spec(install: Install, options: Options, env: Mapping[str, str]) -> ProcessSpec:
@@ -436,11 +432,7 @@ class Launch:
 
     def stop(self) -> None:
         """Stop robots, reference and plant together, then the recorder."""
-        names = self.supervisor.names()
-        stages = [[name for name in names if name != 'record']]
-        if 'record' in names:
-            stages.append(['record'])
-        self.supervisor.stop_all(stages, STOP_TIMEOUT)
+        self.supervisor.stop_all(stop_stages(self.supervisor.names()), STOP_TIMEOUT)
 
     def _start_and_watch(self) -> None:
         specs = node_specs(self.install, self.options, self.num_robots, self.env)
@@ -449,7 +441,7 @@ class Launch:
         for spec in specs:
             if self.interrupted or not self._start(spec):
                 return
-            if spec.name == 'record' and not self._wait_for_recorder():
+            if spec.name == RECORDER and not self._wait_for_recorder():
                 return
         deadline = time.monotonic() + self.wall_seconds if self.wall_seconds > 0 else None
         while not self.interrupted:
