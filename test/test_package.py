@@ -334,3 +334,14 @@ def test_test_modules_have_distinct_names():
                 names.setdefault(name, []).append(folder)
     shared = {name: folders for name, folders in names.items() if len(folders) > 1}
     assert not shared, f'pytest imports test modules by their basename: {shared}'
+
+
+def test_the_maintainer_is_the_copyright_holder_of_every_file(setup_data):
+    with open(os.path.join(ROOT, 'setup.py'), encoding='utf-8') as stream:
+        holder = stream.readline().split('Copyright 2026 ', 1)[1].strip().rstrip('.')
+    (maintainer,) = package_xml().findall('maintainer')
+    assert maintainer.text == holder == 'The formation_ros authors'
+    assert setup_data['metadata']['maintainer'] == holder
+    email = maintainer.get('email')
+    assert email == setup_data['metadata']['maintainer_email']
+    assert email.endswith('@example.com'), 'a reserved domain (RFC 2606), never a real inbox'

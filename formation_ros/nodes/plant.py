@@ -44,12 +44,13 @@ from formation_ros.core.bodies import make_bodies
 from formation_ros.core.declarations import CommandFrame, Exe
 from formation_ros.core.events import event_records, timeline_events
 from formation_ros.core.frames import desired_positions
-from formation_ros.core.plant import (Commands, CommandStatus, DurationHistogram, NS_PER_S,
+from formation_ros.core.plant import (Commands, CommandStatus, DurationHistogram,
                                       PLANT_STATS_FILE, PlantModel, StepReport)
 from formation_ros.core.team import team_values
 from formation_ros.core.timeline import Mode
 from formation_ros.core.trajectory import (CHUNKS_DIR, ChunkWriter, read_body_chunks,
-                                           read_chunks, Trajectory)
+                                           read_chunks, Trajectory, TRAJECTORY_FILE)
+from formation_ros.core.units import NS_PER_S
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import (CdrError, encode_clock, read_twist, read_twist_stamped,
                                    StateEncoder)
@@ -533,10 +534,10 @@ class PlantNode(Node):
             stream.write('\n')
         trajectory = self.trajectory()
         if trajectory is not None:
-            trajectory.save(os.path.join(output_dir, 'trajectory.npz'))
+            trajectory.save(os.path.join(output_dir, TRAJECTORY_FILE))
             assert self.chunks is not None
             shutil.rmtree(self.chunks.folder, ignore_errors=True)
-        self.get_logger().info(f'plant: wrote trajectory.npz and {PLANT_STATS_FILE} to '
+        self.get_logger().info(f'plant: wrote {TRAJECTORY_FILE} and {PLANT_STATS_FILE} to '
                                f'{output_dir}')
 
 

@@ -15,8 +15,8 @@ plant or relay together, the recorder last) and, with ``--out`` or ``--record``,
 ``formation_report`` writes the metrics and figures. Exit codes: 0 done, 1 a node died or the
 report failed, 2 bad usage or parameters.
 
-The nodes watch the launcher through :data:`LAUNCHER_PID_ENV` and :data:`LAUNCHER_START_ENV`
-(``formation_ros.ros.runner``), so they end on their own when it is killed with SIGKILL.
+The nodes watch the launcher through its process id and start time in their environment
+(``formation_ros.ros.watch``), so they end on their own when it is killed with SIGKILL.
 """
 
 import dataclasses
@@ -30,6 +30,7 @@ import sys
 import time
 from typing import Callable, Mapping, Optional, Sequence, TextIO
 
+from formation_ros.ros.watch import watch_environment
 from formation_ros.tools.supervise import describe_returncode, ProcessSpec, Supervisor
 from formation_ros.tools.system import (DISCOVERY, DISCOVERY_ENV, discovery_problem,
                                         DOMAIN_ENV, domain_problem, ESSENTIAL, FLEET_REMAP,
@@ -44,8 +45,6 @@ RECORDER_START_TIMEOUT = 15.0
 POLL = 0.2
 ON_EXIT = ('continue', 'stop', 'respawn')
 MAX_RESTARTS = 5
-LAUNCHER_PID_ENV = 'FORMATION_LAUNCHER_PID'
-LAUNCHER_START_ENV = 'FORMATION_LAUNCHER_START'
 
 USAGE = """\
 Usage: scripts/launch_formation.sh PARAMS.yaml [--duration S] [--out DIR] [--record DIR]
@@ -355,23 +354,6 @@ def _spec(install: Install, node: NodePlan, options: Options,
                        ros_arguments(node, options.params), env)
 
 
-def watch_environment(pid: int) -> dict[str, str]:
-    """
-    Return the variables with which the nodes watch process ``pid`` and end when it is gone.
-
-    The process id and its start time (clock ticks after boot, field 22 of /proc/PID/stat;
-    left out where there is no /proc): together they name one process, even once the id has
-    been given to another.
-    """
-    env = {LAUNCHER_PID_ENV: str(pid)}
-    try:
-        with open(f'/proc/{pid}/stat', 'rb') as stream:
-            env[LAUNCHER_START_ENV] = stream.read().rsplit(b')', 1)[1].split()[19].decode()
-    except (OSError, IndexError):
-        pass
-    return env
-
-
 class Launch:
     """One run: starts the nodes, watches them and the clock, stops them in order."""
 
@@ -515,11 +497,12 @@ class Launch:
 
     def report(self) -> int:
         """Run formation_report on the bag or the run directory, if any; return the exit code."""
+        from formation_ros.core.trajectory import TRAJECTORY_FILE  # numpy: not for --help
         options = self.options
         if options.record is not None:
             source, target = options.record, options.out or options.record
         elif options.out is not None:
-            if not os.path.isfile(os.path.join(options.out, 'trajectory.npz')):
+            if not os.path.isfile(os.path.join(options.out, TRAJECTORY_FILE)):
                 say(f'the plant wrote no trajectory to {options.out}')
                 return 1
             source, target = options.out, options.out

@@ -13,7 +13,7 @@ import os
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from formation_ros.ros import fields, qos
-from formation_ros.ros.cdr import encode_odometry, encode_pose_stamped
+from formation_ros.ros.cdr import encode_odometry
 from geometry_msgs.msg import PoseArray, PoseStamped
 from helpers import CONFIG, node, write_params
 from lab_standin import Base, Lab, steady_s
@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 from rclpy.clock import Clock, ClockType
 from rclpy.qos import QoSProfile, ReliabilityPolicy
+import wire
 
 START_UP = 90.0
 NS_PER_S = 1_000_000_000
@@ -125,7 +126,7 @@ def test_relay_publishes_every_pose_and_the_brute_force_neighbours_with_one_stam
 
     def measure():
         for i, publisher in enumerate(publishers):
-            publisher.publish(encode_pose_stamped(17, 'map', POSITIONS[i], turned[i]))
+            publisher.publish(wire.pose_stamped_bytes(17, 'map', POSITIONS[i], turned[i]))
         return len(outputs.complete_cycles(range(1, 6))) >= 3
 
     assert probe.spin_until(measure, START_UP), processes.log('relay')
@@ -206,12 +207,12 @@ def test_refused_measurements_are_counted_logged_once_and_never_published(
     probe.create_publisher(Odometry, '/robot_6/measured_pose', RELIABLE)
     near = np.array([0.5, 0.0])
     forged = {
-        1: encode_pose_stamped(3, 'map', (0.0, 0.0)),
-        2: encode_pose_stamped(3, 'world', near),
-        3: encode_pose_stamped(3, 'map', (math.nan, 0.0)),
+        1: wire.pose_stamped_bytes(3, 'map', (0.0, 0.0)),
+        2: wire.pose_stamped_bytes(3, 'world', near),
+        3: wire.pose_stamped_bytes(3, 'map', (math.nan, 0.0)),
         4: encode_odometry(3, 'map', 'base', (0.5, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0),
                            (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)),
-        5: encode_pose_stamped(3, 'map', near, (0.0, 0.0, 0.0, 0.0)),
+        5: wire.pose_stamped_bytes(3, 'map', near, (0.0, 0.0, 0.0, 0.0)),
     }
     sent = []
 
