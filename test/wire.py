@@ -10,30 +10,18 @@ and so an independent reference for the package's readers and writers.
 """
 
 from formation_ros.core.frames import frame_to_pose
-from formation_ros.ros.messages import FORMATION_FRAME, ns_to_stamp, WORLD_FRAME
+from formation_ros.ros.messages import FORMATION_FRAME, stamped, WORLD_FRAME, xyz
 from geometry_msgs.msg import PoseStamped, TwistStamped
 from nav_msgs.msg import Odometry
 import numpy as np
 from rclpy.serialization import serialize_message
 
 
-def _xyz(vector, dim):
-    values = [0.0, 0.0, 0.0]
-    values[:dim] = [float(v) for v in vector[:dim]]
-    return values
-
-
-def _stamped(msg, stamp_ns, frame_id=WORLD_FRAME):
-    msg.header.stamp = ns_to_stamp(stamp_ns)
-    msg.header.frame_id = frame_id
-    return msg
-
-
 def pose_stamped(position, stamp_ns, dim, frame_id=WORLD_FRAME,
                  orientation=(0.0, 0.0, 0.0, 1.0)):
     """Build a PoseStamped at ``position`` ((dim,), m) with a quaternion (x, y, z, w)."""
-    msg = _stamped(PoseStamped(), stamp_ns, frame_id)
-    msg.pose.position.x, msg.pose.position.y, msg.pose.position.z = _xyz(position, dim)
+    msg = stamped(PoseStamped(), stamp_ns, frame_id)
+    msg.pose.position.x, msg.pose.position.y, msg.pose.position.z = xyz(position, dim)
     o = msg.pose.orientation
     o.x, o.y, o.z, o.w = (float(v) for v in orientation)
     return msg
@@ -47,8 +35,8 @@ def pose_stamped_bytes(stamp_ns, frame_id, position, orientation=(0.0, 0.0, 0.0,
 
 def twist_stamped(velocity, stamp_ns, dim):
     """Build a TwistStamped with linear = ``velocity`` ((dim,), m/s), frame 'world'."""
-    msg = _stamped(TwistStamped(), stamp_ns)
-    msg.twist.linear.x, msg.twist.linear.y, msg.twist.linear.z = _xyz(velocity, dim)
+    msg = stamped(TwistStamped(), stamp_ns)
+    msg.twist.linear.x, msg.twist.linear.y, msg.twist.linear.z = xyz(velocity, dim)
     return msg
 
 
@@ -61,7 +49,7 @@ def velocity_of(msg, dim):
 def reference_odometry(frame, stamp_ns, dim):
     """Build the nav_msgs/Odometry of a reference sample (``core.frames.frame_to_pose``)."""
     position, quat, linear, angular = frame_to_pose(frame, dim)
-    msg = _stamped(Odometry(), stamp_ns)
+    msg = stamped(Odometry(), stamp_ns)
     msg.child_frame_id = FORMATION_FRAME
     pose, twist = msg.pose.pose, msg.twist.twist
     pose.position.x, pose.position.y, pose.position.z = (float(v) for v in position)

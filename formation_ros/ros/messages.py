@@ -31,13 +31,15 @@ def ns_to_stamp(ns):
     return Time(sec=int(ns // NS_PER_S), nanosec=int(ns % NS_PER_S))
 
 
-def _xyz(vector, dim):
+def xyz(vector, dim):
+    """Return the first ``dim`` values of ``vector`` as x, y, z floats (0.0 beyond dim)."""
     values = [0.0, 0.0, 0.0]
     values[:dim] = [float(v) for v in vector[:dim]]
     return values
 
 
-def _stamped(msg, stamp_ns, frame_id=WORLD_FRAME):
+def stamped(msg, stamp_ns, frame_id=WORLD_FRAME):
+    """Return ``msg`` with its header at ``stamp_ns`` in ``frame_id`` (set in place)."""
     msg.header.stamp = ns_to_stamp(stamp_ns)
     msg.header.frame_id = frame_id
     return msg
@@ -45,10 +47,10 @@ def _stamped(msg, stamp_ns, frame_id=WORLD_FRAME):
 
 def pose_array(points, stamp_ns, dim, frame_id=WORLD_FRAME):
     """Build a PoseArray of the rows of ``points`` ((K, dim), m), frame ``frame_id``."""
-    msg = _stamped(PoseArray(), stamp_ns, frame_id)
+    msg = stamped(PoseArray(), stamp_ns, frame_id)
     for point in points:
         pose = Pose()
-        pose.position.x, pose.position.y, pose.position.z = _xyz(point, dim)
+        pose.position.x, pose.position.y, pose.position.z = xyz(point, dim)
         pose.orientation.w = 1.0
         msg.poses.append(pose)
     return msg
