@@ -22,7 +22,7 @@ setup(
     install_requires=['setuptools'],
     extras_require={'test': ['pytest']},
     zip_safe=True,
-    maintainer='formation_ros maintainers',
+    maintainer='The formation_ros authors',
     maintainer_email='formation-ros@example.com',
     description='Bounded decentralized formation control for mobile robots with limited sensing.',
     license='Apache-2.0',

@@ -42,6 +42,7 @@ sys.path[:0] = [ROOT, BENCH]
 from bench_core import params_for  # noqa: E402
 from bench_soak import find_run_processes, LAUNCHER, read_rss_kib  # noqa: E402
 from formation_ros.core.params_file import write_params_file  # noqa: E402, I100
+from formation_ros.ros.watch import stat_fields  # noqa: E402
 
 PLANT_RATE = 100.0
 MODES = ('process', 'fleet')
@@ -105,9 +106,8 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
 def cpu_seconds(pid: int) -> Optional[float]:
     """Return the CPU time (user + system) of process ``pid`` so far, s; None if it is gone."""
     try:
-        with open(f'/proc/{pid}/stat', 'rb') as stream:
-            fields = stream.read().rsplit(b')', 1)[1].split()
-    except OSError:
+        fields = stat_fields(pid)
+    except (OSError, ValueError):
         return None
     return (int(fields[11]) + int(fields[12])) / TICKS
 

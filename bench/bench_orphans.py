@@ -47,6 +47,8 @@ sys.path[:0] = [ROOT, BENCH]
 
 from bench_soak import find_run_processes, sort_key, write_json  # noqa: E402
 from formation_ros.core.params_file import load_params_file  # noqa: E402, I100
+from formation_ros.ros.watch import LAUNCHER_PID_ENV, LAUNCHER_START_ENV  # noqa: E402
+from formation_ros.ros.watch import process_start  # noqa: E402
 
 DEFAULT_PARAMS = os.path.join(ROOT, 'config', 'square_4.yaml')
 DEFAULT_RUNS = 10
@@ -59,8 +61,6 @@ POLL = 0.005
 READY_POLL = 0.05
 RUN_DURATION = 3600
 CLOCK_LINE = 'starting the clock'
-LAUNCHER_PID_ENV = 'FORMATION_LAUNCHER_PID'
-LAUNCHER_START_ENV = 'FORMATION_LAUNCHER_START'
 BUSY_LOOP = ['sh', '-c', 'while :; do :; done']
 PR_SET_CHILD_SUBREAPER = 36
 
@@ -140,18 +140,6 @@ def clock_started(text: str) -> bool:
     """Tell whether launcher output ``text`` has the plant's line that its clock started."""
     return any(line.startswith('[plant] ') and CLOCK_LINE in line
                for line in text.splitlines())
-
-
-def process_start(pid: int) -> Optional[int]:
-    """Start time of process ``pid`` (clock ticks after boot); None if gone or a zombie."""
-    try:
-        with open(f'/proc/{pid}/stat', 'rb') as stream:
-            fields = stream.read().rsplit(b')', 1)[1].split()
-    except (OSError, IndexError):
-        return None
-    if fields[0] in (b'Z', b'X'):
-        return None
-    return int(fields[19])
 
 
 def alive(pid: int, start: int) -> bool:

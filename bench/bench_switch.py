@@ -386,7 +386,7 @@ def ros_free_running(prefix: str, folder: str) -> Dict[str, Any]:
 
 def ros_lockstep(prefix: str, folder: str, switch_at: float, duration: float) -> Dict[str, Any]:
     """Section 5 over ROS in lockstep with the switch in the schedule; compared to --dt."""
-    from formation_ros.core.trajectory import Trajectory
+    from formation_ros.core.trajectory import Trajectory, TRAJECTORY_FILE
     from formation_ros.tools.sim import simulate
     os.makedirs(folder)
     raw = section5(switch_at, duration, lockstep=True)
@@ -399,7 +399,7 @@ def ros_lockstep(prefix: str, folder: str, switch_at: float, duration: float) ->
             'Ctrl-C')
         metrics = report(folder, process)
     result = summary(metrics)
-    plant = Trajectory.load(os.path.join(folder, 'out', 'trajectory.npz'))
+    plant = Trajectory.load(os.path.join(folder, 'out', TRAJECTORY_FILE))
     sim = simulate(config, duration=float(plant.t[-1]), dt=DT, sample_dt=DT)
     same = len(sim.t) == len(plant.t)
     result.update({'wall_s': time.monotonic() - started, 'steps': len(plant.t),

@@ -17,8 +17,9 @@ launch::
 
 As with scripts/launch_formation.sh, the nodes stay on this computer
 (ROS_AUTOMATIC_DISCOVERY_RANGE=LOCALHOST) unless the environment sets a range or
-``discovery`` is ``subnet``; ``domain_id`` sets ROS_DOMAIN_ID (0 to 232). The nodes are those
-of the launcher (``formation_ros.tools.system.plan``); ``lab.launch.py`` starts a lab.
+``discovery`` is ``subnet``; ``domain_id`` sets ROS_DOMAIN_ID (0 to 232). The nodes and their
+environment are those of the launcher (``formation_ros.tools.system``); ``lab.launch.py``
+starts a lab.
 
 It runs until Ctrl-C; ``formation_report`` reads the bag or the output directory afterwards.
 """
@@ -32,8 +33,8 @@ from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch.substitutions import LaunchConfiguration
 
 PACKAGE = 'formation_ros'
-ARGUMENTS = ('params_file', 'output_dir', 'robots_per_process',
-             *(name for name, _, _ in SHARED_LAUNCH_ARGUMENTS))
+ARGUMENTS = ('params_file', 'output_dir', 'robots_per_process') + tuple(
+    name for name, _, _ in SHARED_LAUNCH_ARGUMENTS)
 
 
 def formation_nodes(context):

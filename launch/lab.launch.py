@@ -31,8 +31,8 @@ from launch import LaunchDescription
 from launch.actions import DeclareLaunchArgument, OpaqueFunction
 from launch.substitutions import LaunchConfiguration
 
-ARGUMENTS = ('params_file', 'cmd_topic', 'source_topic', 'robots_per_process',
-             *(name for name, _, _ in SHARED_LAUNCH_ARGUMENTS))
+ARGUMENTS = ('params_file', 'cmd_topic', 'source_topic', 'robots_per_process') + tuple(
+    name for name, _, _ in SHARED_LAUNCH_ARGUMENTS)
 
 
 def lab_nodes(context):

@@ -146,6 +146,14 @@ class Shutdown(Recorded):
     """Stands in for launch.actions.Shutdown."""
 
 
+class Node(Recorded):
+    """Stands in for launch_ros.actions.Node."""
+
+
+class UnsetEnvironmentVariable(Recorded):
+    """Stands in for launch.actions.UnsetEnvironmentVariable."""
+
+
 class LaunchConfiguration:
     """Stands in for launch.substitutions.LaunchConfiguration: reads the context's value."""
 
@@ -169,10 +177,11 @@ def load_launch_file(monkeypatch, file_name):
     modules = {
         'launch': {'LaunchDescription': Recorded},
         'launch.actions': {'DeclareLaunchArgument': Recorded, 'OpaqueFunction': Recorded,
-                           'Shutdown': Shutdown},
+                           'Shutdown': Shutdown,
+                           'UnsetEnvironmentVariable': UnsetEnvironmentVariable},
         'launch.substitutions': {'LaunchConfiguration': LaunchConfiguration},
         'launch_ros': {},
-        'launch_ros.actions': {'Node': Recorded},
+        'launch_ros.actions': {'Node': Node},
         'ament_index_python': {},
         'ament_index_python.packages': {
             'get_package_share_directory': {PACKAGE: ROOT}.__getitem__},
@@ -194,6 +203,12 @@ def launched_nodes(launch_file, **arguments):
 
     Arguments not given take their declared defaults; one without a default must be given.
     """
+    return [action for action in launched_actions(launch_file, **arguments)
+            if isinstance(action, Node)]
+
+
+def launched_actions(launch_file, **arguments):
+    """Return every action the launch file's nodes come with (see :func:`launched_nodes`)."""
     description = launch_file.generate_launch_description()
     (actions,) = description.args
     declared = {action.args[0]: action.kwargs['default_value'] for action in actions
@@ -322,3 +337,14 @@ def test_test_modules_have_distinct_names():
                 names.setdefault(name, []).append(folder)
     shared = {name: folders for name, folders in names.items() if len(folders) > 1}
     assert not shared, f'pytest imports test modules by their basename: {shared}'
+
+
+def test_the_maintainer_is_the_copyright_holder_of_every_file(setup_data):
+    with open(os.path.join(ROOT, 'setup.py'), encoding='utf-8') as stream:
+        holder = stream.readline().split('Copyright 2026 ', 1)[1].strip().rstrip('.')
+    (maintainer,) = package_xml().findall('maintainer')
+    assert maintainer.text == holder == 'The formation_ros authors'
+    assert setup_data['metadata']['maintainer'] == holder
+    email = maintainer.get('email')
+    assert email == setup_data['metadata']['maintainer_email']
+    assert email.endswith('@example.com'), 'a reserved domain (RFC 2606), never a real inbox'

@@ -78,11 +78,11 @@ def test_first_death_is_reported_with_its_exit_code(supervisor):
     assert info is not None and info.name == 'crasher'
     assert (info.returncode, info.signal_name, info.stopped) == (3, None, False)
     assert info.reason == 'exit code 3'
-    assert supervisor.first_death == info
+    assert [e for e in supervisor.exits() if not e.stopped] == [info]
     assert supervisor.running('steady')
     stopped = supervisor.stop(['steady'], timeout=10)
     assert [(s.name, s.stopped) for s in stopped] == [('steady', True)]
-    assert supervisor.first_death.name == 'crasher'
+    assert [e.name for e in supervisor.exits() if not e.stopped] == ['crasher']
     assert [e.name for e in supervisor.exits()] == ['crasher', 'steady']
 
 

@@ -173,15 +173,6 @@ def test_lab_launch_file_starts_what_the_launcher_starts(lab_launch_file, named,
     assert [node_view(node) for node in nodes] == launcher_views(named, ['--no-plant', *argv])
 
 
-@pytest.mark.parametrize('argv, arguments', [
-    ((), {}), (('--record', '/tmp/bag', '--out', '/tmp/out'),
-               {'record': '/tmp/bag', 'output_dir': '/tmp/out'}),
-    (('--robots-per-process', '3'), {'robots_per_process': '3'})])
-def test_formation_launch_file_starts_what_the_launcher_starts(launch_file, argv, arguments):
-    nodes = launched_nodes(launch_file, params_file=SQUARE, **arguments)
-    assert [node_view(node) for node in nodes] == launcher_views(SQUARE, list(argv))
-
-
 def test_a_lab_runs_relay_reference_and_robots_on_wall_clock_time(named):
     from formation_ros.core.declarations import BY_NAME as schema, Exe
     views = launcher_views(named, ['--no-plant', '--cmd-topic', '/{name}/cmd_vel',
@@ -321,3 +312,93 @@ def test_a_launch_file_refuses_an_unknown_record_failure_policy(launch_file):
                                          "got 'later'"):
         launched_nodes(launch_file, params_file=SQUARE, record='/tmp/bag',
                        on_record_failure='later')
+
+
+FORMATION_CASES = [
+    ((), {}),
+    (('--record', '/tmp/bag', '--out', '/tmp/out'),
+     {'record': '/tmp/bag', 'output_dir': '/tmp/out'}),
+    (('--robots-per-process', '3'), {'robots_per_process': '3'}),
+    (('--robots-per-process', '3', '--record', '/tmp/bag'),
+     {'robots_per_process': '3', 'record': '/tmp/bag'}),
+    (('--discovery', 'subnet', '--domain-id', '7'), {'discovery': 'subnet', 'domain_id': '7'}),
+]
+NETWORK_CASES = [
+    ((), {}),
+    (('--discovery', 'subnet'), {'discovery': 'subnet'}),
+    (('--discovery', 'localhost', '--domain-id', '7'),
+     {'discovery': 'localhost', 'domain_id': '7'}),
+    (('--domain-id', '0'), {'domain_id': '0'}),
+]
+SHELLS = [{}, {'ROS_AUTOMATIC_DISCOVERY_RANGE': 'SUBNET', 'ROS_DOMAIN_ID': '3'},
+          {'ROS_LOCALHOST_ONLY': '1'}, {'ROS_AUTOMATIC_DISCOVERY_RANGE': ''}]
+NETWORK_NAMES = ('ROS_AUTOMATIC_DISCOVERY_RANGE', 'ROS_DOMAIN_ID', 'ROS_LOCALHOST_ONLY')
+
+
+def launched_environment(actions, base):
+    """Return each node's environment: ``base`` after the actions before it, its own added."""
+    from test_package import Node, UnsetEnvironmentVariable
+    env = dict(base)
+    environments = []
+    for action in actions:
+        if isinstance(action, UnsetEnvironmentVariable):
+            env.pop(action.args[0], None)
+        else:
+            assert isinstance(action, Node), action
+            environments.append(dict(env, **action.kwargs['additional_env']))
+    return environments
+
+
+@pytest.mark.parametrize('argv, arguments', FORMATION_CASES)
+def test_formation_launch_file_starts_what_the_launcher_starts(launch_file, argv, arguments):
+    nodes = launched_nodes(launch_file, params_file=SQUARE, **arguments)
+    assert [node_view(node) for node in nodes] == launcher_views(SQUARE, list(argv))
+
+
+@pytest.mark.parametrize('lab', [False, True])
+@pytest.mark.parametrize('shell', SHELLS)
+@pytest.mark.parametrize('argv, arguments', NETWORK_CASES)
+def test_both_launch_files_give_every_node_the_launchers_environment(
+        launch_file, lab_launch_file, named, monkeypatch, lab, shell, argv, arguments):
+    """The discovery range, domain and ROS_LOCALHOST_ONLY of each node, from one shell."""
+    from formation_ros.tools import launcher
+    from test_package import launched_actions
+    for name in NETWORK_NAMES:
+        monkeypatch.delenv(name, raising=False)
+    for name, value in shell.items():
+        monkeypatch.setenv(name, value)
+    base = dict(os.environ)
+    options = launcher.parse_args([named, *(('--no-plant',) if lab else ()), *argv])
+    expected = launcher.discovery_environment(options, base)
+    actions = launched_actions(lab_launch_file if lab else launch_file, params_file=named,
+                               **arguments)
+    environments = launched_environment(actions, base)
+    assert len(environments) == 6
+    assert all(env == expected for env in environments), (environments[0], expected)
+    if 'discovery' in arguments:
+        assert expected['ROS_AUTOMATIC_DISCOVERY_RANGE'] == arguments['discovery'].upper()
+        assert 'ROS_LOCALHOST_ONLY' not in expected
+    else:
+        assert expected['ROS_AUTOMATIC_DISCOVERY_RANGE'] == (
+            shell.get('ROS_AUTOMATIC_DISCOVERY_RANGE') or 'LOCALHOST')
+    assert expected.get('ROS_DOMAIN_ID') == arguments.get('domain_id',
+                                                          shell.get('ROS_DOMAIN_ID'))
+
+
+def test_the_launcher_stops_what_it_started_in_the_planned_order(named):
+    """Robots, reference and relay (or plant) together, the recorder after them."""
+    from formation_ros.tools.system import ESSENTIAL, plan, Run, stop_stages
+    names = [node.name for node in plan(Run(4, plant=False, record='/tmp/b'))]
+    assert names[0] == 'record'
+    assert stop_stages(names) == [names[1:], ['record']]
+    assert stop_stages(names[1:]) == [names[1:]]
+    assert [name for name in names if name in ESSENTIAL] == ['record', 'relay', 'reference']
+
+
+def test_the_domain_range_is_told_as_the_code_checks_it(launch_file):
+    from formation_ros.tools import launcher
+    from formation_ros.tools.system import domain_problem, MAX_DOMAIN_ID
+    told = f'0 to {MAX_DOMAIN_ID}'
+    assert told in launcher.USAGE and told in launch_file.__doc__
+    assert domain_problem(str(MAX_DOMAIN_ID)) is None
+    assert domain_problem(str(MAX_DOMAIN_ID + 1)) is not None

@@ -125,13 +125,15 @@ class PointBodies:
                               imperfections.actuator_lag, imperfections.max_acceleration)
         return moved, heading, v
 
-    def cap(self, command: Float, rows: NDArray[np.bool_]) -> NDArray[np.bool_]:
-        """Clip (in place) the ``rows`` whose components exceed max_speed; return which."""
+    def cap(self, command: Float, rows: NDArray[np.bool_]) -> Tuple[Float, NDArray[np.bool_]]:
+        """
+        Return ``command`` (N, dim) with its ``rows`` clipped to max_speed, and which were.
+
+        A new array where any row is clipped; ``command`` itself where none is.
+        """
         if self.max_speed <= 0.0:
-            return np.zeros(len(command), dtype=bool)
-        capped: NDArray[np.bool_] = rows & np.any(np.abs(command) > self.max_speed, axis=1)
-        command[capped] = np.clip(command[capped], -self.max_speed, self.max_speed)
-        return capped
+            return command, np.zeros(len(command), dtype=bool)
+        return _clipped(command, rows, self.max_speed)
 
 
 class UnicycleBodies:
@@ -181,11 +183,23 @@ class UnicycleBodies:
         return unicycle_step(q, heading, velocity, command, dt, imperfections.actuator_lag,
                              imperfections.max_acceleration)
 
-    def cap(self, command: Float, rows: NDArray[np.bool_]) -> NDArray[np.bool_]:
-        """Clip (in place) |v| and |w| of the ``rows`` to the actuator caps; return which."""
-        capped: NDArray[np.bool_] = rows & np.any(np.abs(command) > self.limits, axis=1)
-        command[capped] = np.clip(command[capped], -self.limits, self.limits)
-        return capped
+    def cap(self, command: Float, rows: NDArray[np.bool_]) -> Tuple[Float, NDArray[np.bool_]]:
+        """
+        Return ``command`` (N, 2) with |v| and |w| of its ``rows`` clipped to the caps, and which.
+
+        A new array where any row is clipped; ``command`` itself where none is.
+        """
+        return _clipped(command, rows, self.limits)
+
+
+def _clipped(command: Float, rows: NDArray[np.bool_],
+             limits: Union[float, Float]) -> Tuple[Float, NDArray[np.bool_]]:
+    """Return ``command`` with the ``rows`` beyond +-``limits`` clipped, and which were."""
+    capped: NDArray[np.bool_] = rows & np.any(np.abs(command) > limits, axis=1)
+    if np.any(capped):
+        command = np.array(command)
+        command[capped] = np.clip(command[capped], -limits, limits)
+    return command, capped
 
 
 Bodies = Union[PointBodies, UnicycleBodies]

@@ -21,7 +21,9 @@ import math
 import re
 from typing import Any, Dict, FrozenSet, Iterable, Mapping, Optional, Tuple, Type
 
-from formation_ros.core.law import GAIN_MAX, KAPPA_MAX, REPULSION_RANGE
+from formation_ros.core.choice import Choice
+from formation_ros.core.jump import JumpKind
+from formation_ros.core.law import GAIN_MAX, KAPPA_MAX, PsiKind, REPULSION_RANGE
 
 DEFAULT_COLLISION_DISTANCE = 1e-3
 LENGTH_LIMIT = 1e6
@@ -52,32 +54,6 @@ class Exe(enum.Enum):
     REFERENCE = 'reference'
     RECORD = 'record'
     RELAY = 'relay'
-
-
-class Choice(str, enum.Enum):
-    """A string parameter's allowed value: compares, prints and formats as that string."""
-
-    def __str__(self) -> str:
-        """Return the value, e.g. 'arctan'."""
-        return str(self.value)
-
-    def __format__(self, spec: str) -> str:
-        """Format the value, e.g. f'{kind}' gives 'circle'."""
-        return format(str(self.value), spec)
-
-
-class PsiKind(Choice):
-    """Bounded function psi of eq. (14): ``controller.psi``."""
-
-    ARCTAN = 'arctan'
-    TANH = 'tanh'
-
-
-class JumpKind(Choice):
-    """Jump function of Lemma 1: ``jump.kind``."""
-
-    POLY = 'poly'
-    SMOOTH = 'smooth'
 
 
 class BodyKind(Choice):

@@ -38,6 +38,7 @@ from dataclasses import asdict, dataclass
 from typing import Dict, Tuple
 
 from formation_ros.core.unicycle import heading_vectors
+from formation_ros.core.units import NS_PER_S
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -84,7 +85,7 @@ class Imperfections:
 
     def delay_steps(self, step_ns: int) -> int:
         """Return ``state_delay`` in whole steps of ``step_ns`` ns (rounded to the nearest)."""
-        return int(round(self.state_delay * 1e9 / step_ns))
+        return int(round(self.state_delay * NS_PER_S / step_ns))
 
     def as_dict(self) -> Dict[str, float]:
         """Return the four settings by parameter name (for metrics.json, plant_stats.json)."""

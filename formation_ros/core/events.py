@@ -17,8 +17,9 @@ import math
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from formation_ros.core.frames import desired_positions, FrameSample
-from formation_ros.core.timeline import Mode, NS_PER_S, Shape, TeamState, Timeline
+from formation_ros.core.timeline import Mode, Shape, TeamState, Timeline
 from formation_ros.core.trajectory import Trajectory
+from formation_ros.core.units import NS_PER_S
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 

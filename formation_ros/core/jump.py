@@ -25,20 +25,26 @@ dimensionless; ``h'`` and ``h'/h`` are in 1/m**2.
 
 from functools import lru_cache
 import math
-from typing import Optional, Protocol
+from typing import Optional, Protocol, Union
 
+from formation_ros.core.choice import Choice
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-JUMP_KINDS = ('poly', 'smooth')
+
+class JumpKind(Choice):
+    """Jump function of Lemma 1: ``jump.kind``."""
+
+    POLY = 'poly'
+    SMOOTH = 'smooth'
 
 
 class JumpFunction(Protocol):
     """What the control law needs of a jump function: ``h``, ``dh`` and ``ratio`` (eqs. 5, 13)."""
 
     @property
-    def kind(self) -> str:
-        """Return 'poly' or 'smooth' (``jump.kind``)."""
+    def kind(self) -> JumpKind:
+        """Tell which function it is (``jump.kind``)."""
 
     @property
     def order(self) -> Optional[int]:
@@ -62,7 +68,7 @@ def _check_interval(a: float, b: float) -> None:
 class PolyJump:
     """Jump function of Lemma 1 with ``g(y) = y**p`` (docs/equations.md, slip 4)."""
 
-    kind = 'poly'
+    kind = JumpKind.POLY
 
     def __init__(self, order: int) -> None:
         """Build the jump function of order ``order`` (integer p >= 1)."""
@@ -140,7 +146,7 @@ class SmoothJump:
     ``h'/h = 1 / (L K(s))``; for ``s > 1/2`` it uses the symmetry ``h(s) = 1 - h(1 - s)``.
     """
 
-    kind = 'smooth'
+    kind = JumpKind.SMOOTH
     order = None
 
     def __repr__(self) -> str:
@@ -220,10 +226,13 @@ class SmoothJump:
         return np.where(inside, value, np.where(s <= 0.0, np.inf, 0.0))
 
 
-def make_jump(kind: str, order: int = 2) -> JumpFunction:
-    """Return the jump function named by ``jump.kind`` ('poly' or 'smooth') and ``jump.order``."""
-    if kind == 'poly':
-        return PolyJump(order)
-    if kind == 'smooth':
+def make_jump(kind: Union[JumpKind, str], order: int = 2) -> JumpFunction:
+    """Return the jump function of kind ``jump.kind`` and order ``jump.order`` (poly only)."""
+    try:
+        kind = JumpKind(kind)
+    except ValueError:
+        raise ValueError(f'unknown jump kind {kind!r}; expected one of '
+                         f'{[str(member) for member in JumpKind]}') from None
+    if kind is JumpKind.SMOOTH:
         return SmoothJump()
-    raise ValueError(f'unknown jump kind {kind!r}; expected one of {JUMP_KINDS}')
+    return PolyJump(order)

@@ -16,11 +16,12 @@ use it, so they agree to rounding.
 
 from dataclasses import dataclass
 import math
-from typing import Callable, Optional, TYPE_CHECKING
+from typing import Callable, Dict, Optional, Tuple, TYPE_CHECKING, Union
 
+from formation_ros.core.choice import Choice
 from formation_ros.core.frames import (FrameSample, from_frame_velocity, STATIONARY, to_frame,
                                        to_frame_vectors)
-from formation_ros.core.jump import JumpFunction, make_jump
+from formation_ros.core.jump import JumpFunction, JumpKind, make_jump
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -34,10 +35,21 @@ REPULSION_RANGE = (1e-3, 1e4)
 """Where every formula stays within double precision (tested): c and kappa up to 1e6, b from 1 mm
 to 10 km (the smooth jump's integrals underflow below, its scaling above)."""
 RADIUS_MAX = 1e150
-PSI_FUNCTIONS: dict[str, tuple[Callable[[NDArray[np.float64]], NDArray[np.float64]], float]] = {
-    'arctan': (np.arctan, math.pi / 2.0),
-    'tanh': (np.tanh, 1.0),
+
+
+class PsiKind(Choice):
+    """Bounded function psi of eq. (14): ``controller.psi``."""
+
+    ARCTAN = 'arctan'
+    TANH = 'tanh'
+
+
+PsiFunction = Callable[[NDArray[np.float64]], NDArray[np.float64]]
+PSI_FUNCTIONS: Dict[PsiKind, Tuple[PsiFunction, float]] = {
+    PsiKind.ARCTAN: (np.arctan, math.pi / 2.0),
+    PsiKind.TANH: (np.tanh, 1.0),
 }
+"""Each psi with its bound M1 of eq. (15)."""
 
 
 @dataclass(frozen=True)
@@ -46,20 +58,19 @@ class LawParams:
     Constants of the control law.
 
     gain: c of eq. (14), m/s per unit of psi; kappa: kappa of eqs. (8), (13);
-    psi: 'arctan' or 'tanh' (eq. 15); jump: a ``core.jump.JumpFunction`` (Lemma 1);
-    repulsion_radius: b_ij of eq. (11) in m, the same for every pair.
+    psi: :class:`PsiKind` (eq. 15; a string is converted); jump: a ``core.jump.JumpFunction``
+    (Lemma 1); repulsion_radius: b_ij of eq. (11) in m, the same for every pair.
     """
 
     gain: float
     kappa: float
-    psi: str
+    psi: PsiKind
     jump: JumpFunction
     repulsion_radius: float
 
     def __post_init__(self) -> None:
         """Check the constants once, so that the hot path need not."""
-        if self.psi not in PSI_FUNCTIONS:
-            raise ValueError(f'psi must be one of {sorted(PSI_FUNCTIONS)}, got {self.psi!r}')
+        object.__setattr__(self, 'psi', psi_kind(self.psi))
         for name in ('gain', 'kappa', 'repulsion_radius'):
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0.0):
@@ -82,10 +93,20 @@ class LawParams:
         return self.gain * self.psi_bound
 
 
-def make_law(gain: float, kappa: float, psi: str, jump_kind: str, jump_order: int,
+def psi_kind(value: Union[PsiKind, str]) -> PsiKind:
+    """Return the :class:`PsiKind` named ``value``; ValueError naming the kinds if none is."""
+    try:
+        return PsiKind(value)
+    except ValueError:
+        raise ValueError(f'psi must be one of {[str(kind) for kind in PsiKind]}, got '
+                         f'{value!r}') from None
+
+
+def make_law(gain: float, kappa: float, psi: Union[PsiKind, str],
+             jump_kind: Union[JumpKind, str], jump_order: int,
              repulsion_radius: float) -> LawParams:
     """Build :class:`LawParams` from the parameter values of the YAML file."""
-    return LawParams(float(gain), float(kappa), psi, make_jump(jump_kind, jump_order),
+    return LawParams(float(gain), float(kappa), psi_kind(psi), make_jump(jump_kind, jump_order),
                      float(repulsion_radius))
 
 

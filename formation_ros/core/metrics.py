@@ -13,6 +13,7 @@ from typing import Any, List, Mapping, Optional, Sequence
 
 from formation_ros.core.events import Event, segments
 from formation_ros.core.trajectory import Trajectory
+from formation_ros.core.unicycle import command_bounds
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -128,7 +129,7 @@ def body_metrics(q_body: ArrayLike, body_command: ArrayLike, u_bound: float,
     below twice the radius).
     """
     commands = np.asarray(body_command, dtype=float)
-    v_bound = math.sqrt(2.0) * u_bound
+    v_bound, omega_bound = command_bounds(u_bound, hand_distance)
     return {
         'body_kind': 'unicycle',
         'hand_distance': float(hand_distance),
@@ -137,7 +138,7 @@ def body_metrics(q_body: ArrayLike, body_command: ArrayLike, u_bound: float,
         'max_abs_v': float(np.max(np.abs(commands[..., 0]))),
         'max_abs_omega': float(np.max(np.abs(commands[..., 1]))),
         'v_bound': v_bound,
-        'omega_bound': v_bound / hand_distance,
+        'omega_bound': omega_bound,
     }
 
 

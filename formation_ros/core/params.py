@@ -21,17 +21,19 @@ from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 from formation_ros.core.bodies import BodySettings, POINT_BODY, random_headings
 from formation_ros.core.declarations import (BodyKind, BY_NAME, check_values, CommandFrame,
-                                             CommandType, DEFAULT_WORLD_FRAME, Exe, JumpKind,
-                                             ParamError, PoseType, PsiKind, range_problem,
+                                             CommandType, DEFAULT_WORLD_FRAME, Exe,
+                                             ParamError, PoseType, range_problem,
                                              ReferenceKind, SHAPE_NAME, shape_vertices_name,
                                              SourceType, type_problem)
 from formation_ros.core.dynamics import IDEAL, Imperfections
 from formation_ros.core.frames import desired_positions, from_frame_velocity
-from formation_ros.core.law import LawParams, make_law, PSI_FUNCTIONS
+from formation_ros.core.jump import JumpKind
+from formation_ros.core.law import LawParams, make_law, PSI_FUNCTIONS, PsiKind
 from formation_ros.core.params_file import load_params_file, PathText
-from formation_ros.core.plant import NS_PER_S, start_positions, StartSpec
-from formation_ros.core.reference import Reference
-from formation_ros.core.unicycle import hand_points
+from formation_ros.core.plant import start_positions, StartSpec
+from formation_ros.core.reference import dimension_problem, PERIODIC, Reference
+from formation_ros.core.unicycle import command_bounds, hand_points
+from formation_ros.core.units import NS_PER_S
 import numpy as np
 from numpy.typing import NDArray
 
@@ -220,7 +222,7 @@ class FormationConfig:
 
     def law(self) -> LawParams:
         """Return the control law constants (``core.law.LawParams``)."""
-        return make_law(self.gain, self.kappa, self.psi.value, self.jump_kind.value,
+        return make_law(self.gain, self.kappa, self.psi, self.jump_kind,
                         self.jump_order, self.repulsion_radius)
 
     def reference(self) -> Reference:
@@ -350,12 +352,12 @@ def _geometry(values: Mapping[str, Any], radii: NDArray[np.float64],
 
 def _reference_problems(values: Mapping[str, Any], dim: int, problems: Problems) -> None:
     kind = ReferenceKind(values['reference.kind'])
-    if kind is ReferenceKind.HELIX and dim != 3:
-        problems.append(('reference.kind', 'helix needs dim 3'))
+    problem = dimension_problem(kind, dim)
+    if problem:
+        problems.append(('reference.kind', problem))
     if kind is ReferenceKind.LINE and values.get('reference.velocity') is None:
         problems.append(('reference.velocity', f'is required for a line (dim = {dim} values)'))
-    moving = (ReferenceKind.CIRCLE, ReferenceKind.FIGURE_EIGHT, ReferenceKind.HELIX)
-    if kind in moving and values['reference.speed'] <= 0.0:
+    if kind in PERIODIC and values['reference.speed'] <= 0.0:
         problems.append(('reference.speed', f'must be > 0 for a {kind.value}'))
 
 
@@ -392,20 +394,19 @@ def _body(values: Mapping[str, Any], dim: int, problems: Problems) -> BodySettin
     if l_value is None:
         problems.append(('body.hand_distance', 'is required for body.kind unicycle (l > 0, m)'))
         return BodySettings(kind=kind, hand_distance=1.0)
-    psi_bound = PSI_FUNCTIONS[values['controller.psi']][1]
-    gain = values['controller.gain']
-    v_bound = math.sqrt(2.0) * gain * psi_bound
+    psi_bound = PSI_FUNCTIONS[PsiKind(values['controller.psi'])][1]
+    v_bound, w_bound = command_bounds(values['controller.gain'] * psi_bound, l_value)
+    v_per_gain = command_bounds(psi_bound, l_value)[0]
     max_linear, max_angular = values.get('body.max_linear'), values.get('body.max_angular')
     if max_linear is not None and v_bound > max_linear:
         problems.append(('body.max_linear', f'the law bound sqrt(2) c M1 = {v_bound:.4g} m/s '
                                             f'exceeds body.max_linear = {max_linear:g} m/s: '
                                             'controller.gain <= '
-                                            f'{_down(max_linear / (math.sqrt(2.0) * psi_bound)):g}'
-                                            ' would fit'))
-    if max_angular is not None and v_bound / l_value > max_angular:
-        fit_gain = _down(max_angular * l_value / (math.sqrt(2.0) * psi_bound))
+                                            f'{_down(max_linear / v_per_gain):g} would fit'))
+    if max_angular is not None and w_bound > max_angular:
+        fit_gain = _down(max_angular * l_value / v_per_gain)
         problems.append(('body.max_angular', 'the law bound sqrt(2) c M1 / l = '
-                                             f'{v_bound / l_value:.4g} rad/s exceeds '
+                                             f'{w_bound:.4g} rad/s exceeds '
                                              f'body.max_angular = {max_angular:g} rad/s: '
                                              f'controller.gain <= {fit_gain:g} or '
                                              'body.hand_distance >= '

@@ -60,13 +60,13 @@ from formation_ros.core.frames import from_frame_velocity, to_frame_velocity
 from formation_ros.core.law import LawParams
 from formation_ros.core.reference import Reference
 from formation_ros.core.sensing import neighbour_lists, sensed_pairs, sensor_radii
+from formation_ros.core.units import NS_PER_S
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 if TYPE_CHECKING:
     from scipy.spatial import cKDTree
 
-NS_PER_S = 1_000_000_000
 BOUND_TOLERANCE_FIXED = 1e-9
 BOUND_TOLERANCE_MOVING = 1e-3
 MAX_STATES_KEPT = 512
@@ -145,6 +145,11 @@ class Admission:
         counted: NDArray[np.bool_] = ((self.status == CommandStatus.APPLIED)
                                       | (self.status == CommandStatus.SATURATED))
         return counted
+
+
+Saturation = Tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.bool_],
+                   NDArray[np.float64]]
+"""(commands, velocities, saturated, largest |u_hat|) of ``PlantModel._saturate``."""
 
 
 @dataclass(frozen=True)
@@ -479,35 +484,42 @@ class PlantModel:
         counted = status == CommandStatus.APPLIED
         u = (commands.u.copy() if np.all(counted)
              else np.where(counted[:, None], commands.u, 0.0))
-        largest = np.zeros(self.num_robots)
         if np.any(counted):
-            velocity = self._saturate(u, commands.stamp_ns, counted, status, largest)
+            u, velocity, saturated, largest = self._saturate(u, commands.stamp_ns, counted)
+            status[saturated] = CommandStatus.SATURATED
         else:
+            largest = np.zeros(self.num_robots)
             velocity = self.body.world_velocity(u, self.heading)
         return Admission(u=u, status=status, largest_u_hat=largest, velocity=velocity)
 
     def _saturate(self, command: NDArray[np.float64], stamps: NDArray[np.int64],
-                  counted: NDArray[np.bool_], status: NDArray[np.int8],
-                  largest: NDArray[np.float64]) -> NDArray[np.float64]:
+                  counted: NDArray[np.bool_]) -> Saturation:
         """
-        Clip the counted commands (in place) to the law's bound and to the actuator caps.
+        Return the counted commands clipped to the law's bound and to the actuator caps.
 
         The bound applies to the velocity a command gives the control point (the command itself
         for points; R(th) (v, l w) at the heading of the answered state for unicycles). Returns
-        those velocities after clipping, (N, dim) (``command`` itself for points).
+        (commands, velocities, saturated, largest): the commands after clipping and the
+        velocities they give the control points, (N, dim) each; which were clipped (N,); each
+        counted robot's largest |u_hat| component before clipping (N,, 0 for the others).
+        ``command`` is not changed.
         """
         body = self.body
         heading = self._answered_headings(stamps, counted) if body.has_heading else self.heading
         u = body.world_velocity(command, heading)
-        over = self._clip_to_law(u, stamps, counted, largest)
-        if u is not command and np.any(over):
+        same = u is command
+        u, over, largest = self._clip_to_law(u, stamps, counted)
+        if same:
+            command = u
+        elif np.any(over):
+            command = np.array(command)
             command[over] = body.body_command(u[over], heading[over])
-        capped = body.cap(command, counted)
-        if u is not command and np.any(capped):
+        command, capped = body.cap(command, counted)
+        if same:
+            u = command
+        elif np.any(capped):
             u[capped] = body.world_velocity(command[capped], heading[capped])
-        over |= capped
-        status[over] = CommandStatus.SATURATED
-        return u
+        return command, u, over | capped, largest
 
     def _answered_headings(self, stamps: NDArray[np.int64],
                            counted: NDArray[np.bool_]) -> NDArray[np.float64]:
@@ -519,16 +531,23 @@ class PlantModel:
         return heading
 
     def _clip_to_law(self, u: NDArray[np.float64], stamps: NDArray[np.int64],
-                     counted: NDArray[np.bool_],
-                     largest: NDArray[np.float64]) -> NDArray[np.bool_]:
-        """Clip (in place) control-point velocities whose u_hat exceeds c M1; return which."""
+                     counted: NDArray[np.bool_]
+                     ) -> Tuple[NDArray[np.float64], NDArray[np.bool_], NDArray[np.float64]]:
+        """
+        Return the control-point velocities ``u`` (N, dim) with u_hat clipped to c M1 (a copy).
+
+        Also which were clipped (N,) and the largest |u_hat| component of each counted robot
+        (N,, 0 for the others).
+        """
         bound = self.law.u_bound
         limit = bound + self.bound_tolerance
+        largest = np.zeros(self.num_robots)
+        clipped = np.array(u)
         if self.reference.is_stationary:
             largest[counted] = _row_max(np.abs(u[counted]) if not np.all(counted) else np.abs(u))
             over = counted & (largest > limit)
             if np.any(over):
-                u[over] = np.clip(u[over], -bound, bound)
+                clipped[over] = np.clip(u[over], -bound, bound)
         else:
             over = np.zeros(self.num_robots, dtype=bool)
             for stamp in np.unique(stamps[counted]):
@@ -540,10 +559,10 @@ class PlantModel:
                 clip = largest[rows] > limit
                 if np.any(clip):
                     index = np.flatnonzero(rows)[clip]
-                    u[index] = from_frame_velocity(np.clip(u_hat[clip], -bound, bound),
-                                                   state[clip], frame)
+                    clipped[index] = from_frame_velocity(np.clip(u_hat[clip], -bound, bound),
+                                                         state[clip], frame)
                     over[index] = True
-        return over
+        return clipped, over, largest
 
     def _state_key(self, stamp_ns: int) -> int:
         """Return the time of the kept state a command stamped ``stamp_ns`` answers."""

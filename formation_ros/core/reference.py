@@ -21,14 +21,16 @@ Kinds (the ``reference.*`` parameters):
 """
 
 import math
-from typing import Optional, Tuple
+from typing import Optional, Tuple, Union
 
+from formation_ros.core.declarations import ReferenceKind
 from formation_ros.core.frames import (frame_2d, frame_frenet_3d, frame_planar_3d, FrameSample,
                                        stationary_frame)
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-REFERENCE_KINDS = ('fixed', 'line', 'circle', 'figure_eight', 'helix')
+PERIODIC = (ReferenceKind.CIRCLE, ReferenceKind.FIGURE_EIGHT, ReferenceKind.HELIX)
+"""The kinds that go round a closed path at a path speed (``reference.speed`` > 0)."""
 Z_AXIS = np.array([0.0, 0.0, 1.0])
 Derivatives = tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64],
                     NDArray[np.float64]]
@@ -51,6 +53,13 @@ def _gerono_loop_length() -> float:
 GERONO_LOOP_LENGTH = _gerono_loop_length()
 
 
+def dimension_problem(kind: ReferenceKind, dim: int) -> Optional[str]:
+    """Return why a reference of ``kind`` cannot run in ``dim`` dimensions (None: it can)."""
+    if kind is ReferenceKind.HELIX and dim != 3:
+        return 'helix needs dim 3'
+    return None
+
+
 class Reference:
     """
     A moving desired formation centre q_od(t) with its frame J(t).
@@ -59,22 +68,26 @@ class Reference:
     (q, q', q'', q''') as (dim,) arrays (m, m/s, m/s**2, m/s**3).
     """
 
-    def __init__(self, kind: str, dim: int, origin: Optional[ArrayLike] = None,
-                 velocity: Optional[ArrayLike] = None, radius: float = 1.0, speed: float = 0.0,
-                 pitch: float = 0.0, phase: float = 0.0) -> None:
+    def __init__(self, kind: Union[ReferenceKind, str], dim: int,
+                 origin: Optional[ArrayLike] = None, velocity: Optional[ArrayLike] = None,
+                 radius: float = 1.0, speed: float = 0.0, pitch: float = 0.0,
+                 phase: float = 0.0) -> None:
         """
         Build a reference (values already validated by ``core.params``).
 
         phase: angle a of the circle, figure eight and helix at t = 0, rad (0: their start
         above); a = rate t + phase.
         """
-        if kind not in REFERENCE_KINDS:
-            raise ValueError(f'unknown reference kind {kind!r}; expected one of {REFERENCE_KINDS}')
+        try:
+            self.kind = ReferenceKind(kind)
+        except ValueError:
+            raise ValueError(f'unknown reference kind {kind!r}; expected one of '
+                             f'{[str(member) for member in ReferenceKind]}') from None
         if dim not in (2, 3):
             raise ValueError(f'dim must be 2 or 3, got {dim!r}')
-        if kind == 'helix' and dim != 3:
-            raise ValueError('a helix reference needs dim 3')
-        self.kind = kind
+        problem = dimension_problem(self.kind, dim)
+        if problem:
+            raise ValueError(f'a {problem}')
         self.dim = dim
         self.origin = np.zeros(dim) if origin is None else np.array(origin, dtype=float)
         self.velocity = np.zeros(dim) if velocity is None else np.array(velocity, dtype=float)
@@ -85,11 +98,11 @@ class Reference:
         self.rate = self._angular_rate()
 
     def _angular_rate(self) -> float:
-        if self.kind == 'circle':
+        if self.kind is ReferenceKind.CIRCLE:
             return self.speed / self.radius
-        if self.kind == 'figure_eight':
+        if self.kind is ReferenceKind.FIGURE_EIGHT:
             return 2.0 * math.pi * self.speed / (self.radius * GERONO_LOOP_LENGTH)
-        if self.kind == 'helix':
+        if self.kind is ReferenceKind.HELIX:
             rise = self.pitch / (2.0 * math.pi)
             return self.speed / math.hypot(self.radius, rise)
         return 0.0
@@ -102,7 +115,7 @@ class Reference:
         ``q_od`` at ``t`` is where it is now (a = rate t + phase is kept at t); the speed, and so
         qdot_od and J's rate, change at once. Raises ValueError for the other kinds.
         """
-        if self.kind not in ('circle', 'figure_eight', 'helix'):
+        if self.kind not in PERIODIC:
             raise ValueError(f'a {self.kind} reference has no path speed')
         angle = self.rate * t + self.phase
         faster = Reference(self.kind, self.dim, self.origin, self.velocity, self.radius, speed,
@@ -118,7 +131,8 @@ class Reference:
     @property
     def is_stationary(self) -> bool:
         """Tell whether q_od never moves (fixed, or a line with zero velocity)."""
-        return self.kind == 'fixed' or (self.kind == 'line' and not np.any(self.velocity))
+        return self.kind is ReferenceKind.FIXED or (self.kind is ReferenceKind.LINE
+                                                    and not np.any(self.velocity))
 
     def rate_limits(self) -> Tuple[float, float]:
         """
@@ -127,7 +141,7 @@ class Reference:
         Exact for the fixed, line, circle and helix kinds (constant rates); the figure eight's
         are the largest over RATE_SAMPLES points of one loop (relative error below 1e-4).
         """
-        if self.kind in ('fixed', 'line'):
+        if self.kind not in PERIODIC:
             return float(np.linalg.norm(self.velocity)), 0.0
         if self.rate == 0.0:
             return 0.0, 0.0
@@ -144,14 +158,14 @@ class Reference:
         """Return (q_od, q_od', q_od'', q_od''') at time t, each (dim,)."""
         dim = self.dim
         zero = np.zeros(dim)
-        if self.kind == 'fixed':
+        if self.kind is ReferenceKind.FIXED:
             return self.origin.copy(), zero, zero.copy(), zero.copy()
-        if self.kind == 'line':
+        if self.kind is ReferenceKind.LINE:
             return self.origin + self.velocity * t, self.velocity.copy(), zero, zero.copy()
         r, w = self.radius, self.rate
         a = w * t + self.phase
         ca, sa = math.cos(a), math.sin(a)
-        if self.kind == 'figure_eight':
+        if self.kind is ReferenceKind.FIGURE_EIGHT:
             c2, s2 = math.cos(2.0 * a), math.sin(2.0 * a)
             planar = (np.array([sa, 0.5 * s2]), np.array([w * ca, w * c2]),
                       np.array([-w * w * sa, -2.0 * w * w * s2]),
@@ -161,7 +175,7 @@ class Reference:
             planar = (np.array([ca, sa]), np.array([-w * sa, w * ca]),
                       np.array([-w * w * ca, -w * w * sa]),
                       np.array([w ** 3 * sa, -w ** 3 * ca]))
-            c = self.pitch / (2.0 * math.pi) if self.kind == 'helix' else 0.0
+            c = self.pitch / (2.0 * math.pi) if self.kind is ReferenceKind.HELIX else 0.0
             rise = (c * a, c * w, 0.0, 0.0)
         out = []
         for order in range(4):
@@ -174,12 +188,12 @@ class Reference:
 
     def sample(self, t: float) -> FrameSample:
         """Return the :class:`FrameSample` (q_od, qdot_od, J, Jdot) at time t in s."""
-        if self.kind == 'fixed':
+        if self.kind is ReferenceKind.FIXED:
             return stationary_frame(self.dim, self.origin, t)
         q, q1, q2, q3 = self.derivatives(t)
         if self.dim == 2:
             jmat, jdot = frame_2d(q1, q2)
-        elif self.kind == 'helix':
+        elif self.kind is ReferenceKind.HELIX:
             jmat, jdot = frame_frenet_3d(q1, q2, q3)
         else:
             jmat, jdot = frame_planar_3d(q1, q2, self._plane_normal(q1))
@@ -187,7 +201,7 @@ class Reference:
 
     def _plane_normal(self, qdot: NDArray[np.float64]) -> NDArray[np.float64]:
         """Return the plane normal of the planar 3D frame: +z, or +y for a line along z."""
-        if self.kind == 'line':
+        if self.kind is ReferenceKind.LINE:
             speed = float(np.linalg.norm(qdot))
             if speed > 0.0 and np.linalg.norm(np.cross(Z_AXIS, qdot / speed)) < 1e-6:
                 return np.array([0.0, 1.0, 0.0])

@@ -17,11 +17,11 @@ from typing import Dict, Generic, List, Mapping, Sequence, Tuple, TypeVar
 
 from formation_ros.core.frames import FrameSample
 from formation_ros.core.reference import Reference
+from formation_ros.core.units import NS_PER_S
 import numpy as np
 from numpy.typing import NDArray
 
 Value = TypeVar('Value')
-NS_PER_S = 1_000_000_000
 MAX_CHANGES = 256
 """Changes kept; the oldest are dropped (a state never answers one that old)."""
 

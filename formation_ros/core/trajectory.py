@@ -11,6 +11,8 @@ from formation_ros.core.frames import desired_positions, FrameSample, to_frame_v
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+TRAJECTORY_FILE = 'trajectory.npz'
+"""The file name of a run's trajectory in its output directory (:meth:`Trajectory.save`)."""
 ARRAYS = ('t', 'q', 'u', 'u_hat', 'q_desired', 'q_od')
 BODY_ARRAYS = ('heading', 'q_body', 'body_command')
 """Arrays of a unicycle run, beside :data:`ARRAYS` (which then describe the hand points)."""

@@ -49,11 +49,6 @@ def hand_points(q: ArrayLike, heading: ArrayLike, hand_distance: float) -> Float
     return np.asarray(q, dtype=float) + hand_distance * heading_vectors(heading)
 
 
-def axle_positions(p: ArrayLike, heading: ArrayLike, hand_distance: float) -> Float:
-    """Axle positions q = p - l (cos th, sin th), the inverse of (U2): (..., 2) in m."""
-    return np.asarray(p, dtype=float) - hand_distance * heading_vectors(heading)
-
-
 def unicycle_commands(u: ArrayLike, heading: ArrayLike, hand_distance: float) -> Float:
     """
     Return (v, w) that move the hand point with world velocity u (U4): (..., 2).
@@ -114,12 +109,6 @@ def command_bounds(u_bound: float, hand_distance: float) -> Tuple[float, float]:
     """Bounds (U5) of |v| (m/s) and |w| (rad/s) for commands with every |u^k| <= u_bound."""
     v_bound = math.sqrt(2.0) * u_bound
     return v_bound, v_bound / hand_distance
-
-
-def wrap_angle(angle: ArrayLike) -> Float:
-    """Angles wrapped into [-pi, pi), same shape."""
-    return np.asarray((np.asarray(angle, dtype=float) + math.pi) % (2.0 * math.pi) - math.pi,
-                      dtype=float)
 
 
 def quaternions_from_headings(heading: ArrayLike) -> Float:

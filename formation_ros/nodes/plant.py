@@ -57,12 +57,14 @@ from formation_ros.core.declarations import CommandFrame, Exe
 from formation_ros.core.events import event_records, timeline_events
 from formation_ros.core.exits import REFUSED
 from formation_ros.core.frames import desired_positions
-from formation_ros.core.plant import (Commands, CommandStatus, DurationHistogram, NS_PER_S,
+from formation_ros.core.plant import (Commands, CommandStatus, DurationHistogram,
                                       PLANT_STATS_FILE, PlantModel, StepReport)
 from formation_ros.core.team import team_values
 from formation_ros.core.timeline import Mode
 from formation_ros.core.trajectory import (CHUNKS_DIR, ChunkWriter, read_body_chunks,
-                                           read_chunks, save_atomically, Trajectory)
+                                           read_chunks, save_atomically, Trajectory,
+                                           TRAJECTORY_FILE)
+from formation_ros.core.units import NS_PER_S
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import (CdrError, encode_clock, read_twist, read_twist_stamped,
                                    StateEncoder)
@@ -673,7 +675,7 @@ class PlantNode(Node):
         try:
             save_atomically(where, lambda stream: stream.write(text))
             trajectory = self.trajectory()
-            where = os.path.join(output_dir, 'trajectory.npz')
+            where = os.path.join(output_dir, TRAJECTORY_FILE)
             if trajectory is not None:
                 trajectory.save(where)
         except OSError as exc:
@@ -682,7 +684,7 @@ class PlantNode(Node):
         if trajectory is not None:
             assert self.chunks is not None
             shutil.rmtree(self.chunks.folder, ignore_errors=True)
-        self.get_logger().info(f'plant: wrote trajectory.npz and {PLANT_STATS_FILE} to '
+        self.get_logger().info(f'plant: wrote {TRAJECTORY_FILE} and {PLANT_STATS_FILE} to '
                                f'{output_dir}')
 
 

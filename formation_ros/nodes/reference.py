@@ -48,9 +48,11 @@ from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.declarations import Exe, ParamError, ReferenceKind
 from formation_ros.core.frames import frame_to_pose
 from formation_ros.core.params import check_shape, tracking_problem
+from formation_ros.core.reference import PERIODIC
 from formation_ros.core.team import team_values
 from formation_ros.core.timeline import Mode, Shape, TeamState, Timeline
-from formation_ros.ros import fields, messages, qos, topics
+from formation_ros.core.units import NS_PER_S
+from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import encode_odometry
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.once import OnceLog
@@ -70,7 +72,6 @@ from std_srvs.srv import Trigger
 REFERENCE_STATUS = 'formation_ros/reference'
 RUNTIME = ('formation.vertices', 'formation.name', 'reference.origin', 'reference.speed')
 """The parameters that can be set while the node runs."""
-PERIODIC = (ReferenceKind.CIRCLE, ReferenceKind.FIGURE_EIGHT, ReferenceKind.HELIX)
 Change = Callable[[int], None]
 
 
@@ -120,7 +121,7 @@ class ReferenceNode(Node):
                 post_callback=lambda jump: self.clock_moved.arm())
         self._publish_shape(0, self.shape)
         for time_s, name in config.schedule:
-            since = self.epoch_ns + int(round(time_s * fields.NS_PER_S))
+            since = self.epoch_ns + int(round(time_s * NS_PER_S))
             self.shapes.add(since, Shape(name, config.shapes[name]))
             self._publish_shape(since, self.shapes.at(since))
         self._publish_status(0, self.state)
@@ -151,7 +152,7 @@ class ReferenceNode(Node):
     def _publish(self, stamp: int) -> None:
         self.last_stamp = stamp
         reference = self.states.at(stamp).reference(self.base)
-        frame = reference.sample((stamp - self.epoch_ns) / fields.NS_PER_S)
+        frame = reference.sample((stamp - self.epoch_ns) / NS_PER_S)
         self.pub.publish(encode_odometry(stamp, self.world_frame, messages.FORMATION_FRAME,
                                          *frame_to_pose(frame, self.dim)))
         self.published += 1
@@ -170,7 +171,7 @@ class ReferenceNode(Node):
         return self.get_clock().now().nanoseconds
 
     def _reference_time(self, stamp_ns: int) -> float:
-        return (stamp_ns - self.epoch_ns) / fields.NS_PER_S
+        return (stamp_ns - self.epoch_ns) / NS_PER_S
 
     def on_set_parameters(self, parameters: List[Parameter]) -> SetParametersResult:
         """
@@ -219,7 +220,7 @@ class ReferenceNode(Node):
                                  f"{', '.join(RUNTIME)} can)")])
 
     def _origin_change(self, value: Any) -> Change:
-        if self.base.kind != ReferenceKind.FIXED.value:
+        if self.base.kind is not ReferenceKind.FIXED:
             raise ParamError([('reference.origin', f'moves only a fixed reference; this one is '
                                                    f'a {self.base.kind} (change its speed)')])
         origin = value if isinstance(value, list) else []
@@ -235,7 +236,7 @@ class ReferenceNode(Node):
         return move
 
     def _speed_change(self, value: Any) -> Change:
-        if ReferenceKind(self.base.kind) not in PERIODIC:
+        if self.base.kind not in PERIODIC:
             raise ParamError([('reference.speed', f'applies to circle, figure_eight and helix; '
                                                   f'this reference is a {self.base.kind}')])
         if not (isinstance(value, float) and math.isfinite(value) and value > 0.0):

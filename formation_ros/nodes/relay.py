@@ -70,6 +70,7 @@ from formation_ros.core.frames import valid_quaternions
 from formation_ros.core.sensing import sensed_pairs, sensor_radii
 from formation_ros.core.team import team_values
 from formation_ros.core.unicycle import headings_from_quaternions
+from formation_ros.core.units import NS_PER_S
 from formation_ros.ros import qos, topics
 from formation_ros.ros.cdr import (CdrError, PoseData, read_odometry, read_pose_stamped,
                                    StateEncoder)
@@ -85,7 +86,6 @@ from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from scipy.spatial import cKDTree
 
-NS_PER_S = 1_000_000_000
 NEVER = -1
 UNSTAMPED = 0
 MESSAGE_TYPES = {SourceType.POSE: PoseStamped, SourceType.ODOMETRY: Odometry}
@@ -192,11 +192,7 @@ class RelayNode(Node):
 
     def on_odometry(self, index: int, data: bytes) -> None:
         """Store robot ``index``'s measured pose, read from a serialized nav_msgs/Odometry."""
-        def pose_of(raw: bytes) -> PoseData:
-            odometry = read_odometry(raw, exact=True)
-            return PoseData(odometry.stamp_ns, odometry.frame_id, odometry.position,
-                            odometry.orientation)
-        self._read(index, data, pose_of)
+        self._read(index, data, lambda raw: read_odometry(raw, exact=True).pose)
 
     def _read(self, index: int, data: bytes, reader: Callable[[bytes], PoseData]) -> None:
         """Store what ``reader`` makes of the bytes; refuse (count, log once) what it cannot."""

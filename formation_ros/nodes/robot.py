@@ -59,7 +59,8 @@ from formation_ros.core.team import team_values
 from formation_ros.core.timeline import Mode, TeamState
 from formation_ros.core.unicycle import (hand_points, headings_from_quaternions,
                                          unicycle_commands)
-from formation_ros.ros import fields, messages, qos, topics
+from formation_ros.core.units import NS_PER_S
+from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import (CdrError, encode_twist, encode_twist_stamped, OdometryData,
                                    PoseArrayData, PoseData, read_odometry, read_pose_array,
                                    read_pose_stamped, TooManyPoses)
@@ -121,7 +122,7 @@ class RobotNode(Node):
         self.sensing_radius = float(config.sensing_radii[self.index])
         self.law = config.law()
         self.lockstep = config.lockstep
-        self.timeout_ns = int(settings.input_timeout * fields.NS_PER_S)
+        self.timeout_ns = int(settings.input_timeout * NS_PER_S)
         self.num_robots = config.num_robots
         self.speed_limit, self.turn_limit = config.reference().rate_limits()
         self.unicycle = config.body.is_unicycle
@@ -148,7 +149,7 @@ class RobotNode(Node):
         self.waiting = True
         self.wait_subscribers = settings.wait_for_subscribers
         period = settings.plant_period if self.sim_time else settings.relay_period
-        self.budget = AnswerBudget(max(1, int(round(period * fields.NS_PER_S))))
+        self.budget = AnswerBudget(max(1, int(round(period * NS_PER_S))))
         self.answered_stamp: Optional[int] = None
         self.flooded = 0
         self.flooded_reported = 0
@@ -211,7 +212,7 @@ class RobotNode(Node):
         now = self.get_clock().now().nanoseconds
         if self.sim_time and now == 0:
             return 0.0
-        return (stamp_ns - now) / fields.NS_PER_S
+        return (stamp_ns - now) / NS_PER_S
 
     def _check(self, name: str, frame_id: str, stamp_ns: int, finite: bool,
                oriented: bool = True) -> bool:
@@ -226,7 +227,7 @@ class RobotNode(Node):
                                                           + ('a unicycle' if self.unicycle
                                                              else 'command.frame body') + ')')
         gap = self._clock_gap_s(stamp_ns)
-        if abs(gap) * fields.NS_PER_S > self.timeout_ns:
+        if abs(gap) * NS_PER_S > self.timeout_ns:
             clock = 'simulated' if self.sim_time else 'wall-clock'
             advice = self._clock_advice(name, 'the robots and the reference')
             return self._reject(name, Reason.CLOCK, f' ({gap:+.3g} s from the {clock} time '
@@ -271,8 +272,7 @@ class RobotNode(Node):
         """Store the latest own pose, read from a serialized nav_msgs/Odometry."""
         odometry = self._read('pose', read_odometry, data)
         if odometry is not None:
-            self._store_pose(PoseData(odometry.stamp_ns, odometry.frame_id, odometry.position,
-                                      odometry.orientation))
+            self._store_pose(odometry.pose)
 
     def _store_pose(self, pose: PoseData) -> None:
         oriented = not self.needs_orientation or bool(valid_quaternions(pose.orientation))
@@ -345,8 +345,8 @@ class RobotNode(Node):
         if exact or not self.references:
             return None
         newest = self.references[-1].frame(self.dim)
-        ahead = stamp_ns / fields.NS_PER_S - newest.t
-        if abs(ahead) * fields.NS_PER_S > self.timeout_ns:
+        ahead = stamp_ns / NS_PER_S - newest.t
+        if abs(ahead) * NS_PER_S > self.timeout_ns:
             advice = self._clock_advice('reference', 'the reference')
             self._reject('reference', Reason.CLOCK, f' ({-ahead:+.3g} s from the state: '
                                                     f'{advice})')
@@ -454,7 +454,7 @@ class RobotNode(Node):
         if stale:
             self._publish_command(None, self.pose.stamp_ns)
             self.once.start('stale', f"no new {', '.join(stale)} for "
-                                     f'{self.timeout_ns / 1e9:g} s: publishing zero')
+                                     f'{self.timeout_ns / NS_PER_S:g} s: publishing zero')
             return
         self.once.end('stale', 'inputs fresh again: controlling')
         if self.pose_count == self.answered_count:
@@ -490,7 +490,7 @@ class RobotNode(Node):
     def _flooding(self, stamp: int) -> None:
         self.flooded += 1
         self.flood_stamp = stamp
-        period = self.budget.period_ns / fields.NS_PER_S
+        period = self.budget.period_ns / NS_PER_S
         self.once.start('flooding', f'states arrive faster than one per {period:.3g} s (the '
                                     "plant's or relay's period): answering at most about one "
                                     'per period, the others are dropped (logged once; '
@@ -544,7 +544,7 @@ class RobotNode(Node):
         """Publish this robot's status: input ages, neighbours in range, command size."""
         now = self._now_ns()
         values = {f'{name} message age [s]': ('never' if self.received_ns[name] is None
-                                              else (now - self.received_ns[name]) / 1e9)
+                                              else (now - self.received_ns[name]) / NS_PER_S)
                   for name in INPUTS}
         if self.neighbours is not None and self.pose is not None:
             gaps = np.linalg.norm(self._neighbour_points() - self._own_position(), axis=1)

@@ -6,11 +6,11 @@ The formation messages as CDR bytes: read into numpy and written from numpy, wit
 
 rclpy turns every message it receives into Python objects and every message it publishes back
 into C structures, field by field: a PoseArray costs one ``Pose``, ``Point`` and ``Quaternion``
-per element, an Odometry two 36-element covariance arrays. In a team of robots that was most of
-the CPU time of every process (profiles in the README). Subscriptions with ``raw=True`` hand over
-the serialized bytes, and ``Publisher.publish`` takes bytes, so the hot topics (``pose``,
-``neighbors``, ``cmd_vel``, ``/formation/reference``, ``/clock``) go through this module: the
-same messages on the wire, read and written with a few ``struct`` and numpy calls.
+per element, an Odometry two 36-element covariance arrays, on every message of every robot.
+Subscriptions with ``raw=True`` hand over the serialized bytes, and ``Publisher.publish`` takes
+bytes, so the hot topics (``pose``, ``neighbors``, ``cmd_vel``, ``/formation/reference``,
+``/clock``) go through this module: the same messages on the wire, read and written with a few
+``struct`` and numpy calls.
 
 The layout (XCDR1, as every ROS 2 rmw writes it): a 4-byte encapsulation header (``00 01`` for
 little endian, ``00 00`` for big endian, then two option bytes); then the fields in order, each
@@ -28,6 +28,7 @@ from typing import List, Optional, Sequence, Tuple
 
 from formation_ros.core.frames import frame_from_pose, FrameSample
 from formation_ros.core.unicycle import quaternions_from_headings
+from formation_ros.core.units import NS_PER_S
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -35,8 +36,9 @@ HEADER = 4
 LITTLE = b'\x00\x01\x00\x00'
 POSE_DOUBLES = 7
 COVARIANCE_DOUBLES = 36
-NS_PER_S = 1_000_000_000
 ENDIANS = {b'\x00\x01': '<', b'\x00\x00': '>'}
+LITTLE_DOUBLE = np.dtype('<f8')
+"""A float64 as the writers write it, whatever the machine's byte order."""
 IDENTITY = (0.0, 0.0, 0.0, 1.0)
 FINAL_PADDING = 3
 """Bytes a writer may leave after a message's last field (its payload padded to 4)."""
@@ -112,6 +114,11 @@ class OdometryData:
         values = self.position + self.orientation + self.linear + self.angular
         return (all(map(math.isfinite, values))
                 and sum(v * v for v in self.orientation) > 0.0)
+
+    @property
+    def pose(self) -> PoseData:
+        """Return its pose with the stamp and frame (what a robot and the relay read of it)."""
+        return PoseData(self.stamp_ns, self.frame_id, self.position, self.orientation)
 
     def frame(self, dim: int) -> FrameSample:
         """Return the formation frame this sample carries (``core.frames.frame_from_pose``)."""
@@ -272,13 +279,6 @@ def _xyz(vector: ArrayLike) -> List[float]:
     return values
 
 
-def encode_pose_stamped(stamp_ns: int, frame_id: str, position: ArrayLike,
-                        orientation: Sequence[float] = IDENTITY) -> bytes:
-    """Return a serialized PoseStamped: ``position`` ((dim,) m, z = 0 in 2D) and a quaternion."""
-    return _with_doubles(encode_header(stamp_ns, frame_id),
-                         _xyz(position) + [float(v) for v in orientation])
-
-
 def encode_twist_stamped(stamp_ns: int, frame_id: str, linear: ArrayLike,
                          angular: ArrayLike = (0.0, 0.0, 0.0)) -> bytes:
     """Return a serialized TwistStamped: ``linear`` ((dim,) m/s) and ``angular`` (rad/s)."""
@@ -320,8 +320,9 @@ class StateEncoder:
     """
     The plant's state messages of all robots at once: poses and range-sensor readings as bytes.
 
-    Every robot's pose is 7 float64 (x, y, z, quaternion: identity, the heading of a unicycle,
-    or an orientation given) in one (N, 7) array; a PoseStamped is a fixed prefix and that row,
+    Every robot's pose is 7 little-endian float64 (x, y, z, quaternion: identity, the heading
+    of a unicycle, or an orientation given) in one (N, 7) array, whatever the byte order of
+    the arrays given; a PoseStamped is a fixed prefix and that row,
     a PoseArray a prefix with its count and the rows of the robots it lists, taken with one
     numpy index for all arrays together. Used by the plant node and the relay node alike.
     """
@@ -330,7 +331,7 @@ class StateEncoder:
         """Prepare the messages of ``num_robots`` robots in ``dim`` (2 or 3) dimensions."""
         self.dim = dim
         self.frame_id = frame_id
-        self.rows = np.zeros((num_robots, POSE_DOUBLES))
+        self.rows = np.zeros((num_robots, POSE_DOUBLES), dtype=LITTLE_DOUBLE)
         self.rows[:, 6] = 1.0
 
     def encode(self, q: NDArray[np.float64], observer: NDArray[np.intp],

@@ -15,7 +15,7 @@ from collections import deque
 from typing import Any, Callable, List
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros.core.declarations import ParamError
+from formation_ros.core.declarations import ParamError, ReferenceKind
 from formation_ros.core.params import check_shape, FormationConfig
 from formation_ros.core.timeline import (Mode, named_shape, ReferenceTimeline, Shape, TeamState,
                                          Timeline)
@@ -99,7 +99,7 @@ class Changes:
             self.reject('status', f'bytes that are not a team status ({exc})')
             return None
         if state.speed < 0.0 or (state.speed == 0.0 and not self.reference.base.is_stationary
-                                 and self.reference.base.kind != 'line'):
+                                 and self.reference.base.kind is not ReferenceKind.LINE):
             self.reject('status', f'a path speed this reference cannot have ({state.speed!r} '
                                   'm/s)')
             return None

@@ -9,12 +9,9 @@ so they serve rclpy's messages in the nodes and the messages that ``rosbags`` de
 a bag alike.
 """
 
-import math
-
 from formation_ros.core.frames import frame_from_pose
+from formation_ros.core.units import NS_PER_S
 import numpy as np
-
-NS_PER_S = 1_000_000_000
 
 
 def stamp_to_ns(stamp):
@@ -34,12 +31,6 @@ def points_of(msg, dim):
     return points.reshape(-1, 3)[:, :dim]
 
 
-def velocity_of(msg, dim):
-    """Return the linear velocity of a TwistStamped as (dim,)."""
-    v = msg.twist.linear
-    return np.array([v.x, v.y, v.z][:dim])
-
-
 def frame_of(msg, dim):
     """Return the FrameSample carried by a reference Odometry message."""
     pose, twist = msg.pose.pose, msg.twist.twist
@@ -49,13 +40,3 @@ def frame_of(msg, dim):
         [pose.position.x, pose.position.y, pose.position.z], [o.x, o.y, o.z, o.w],
         [twist.linear.x, twist.linear.y, twist.linear.z],
         [twist.angular.x, twist.angular.y, twist.angular.z], dim)
-
-
-def odometry_is_finite(msg):
-    """Tell whether every number of a reference message is finite and its quaternion non-zero."""
-    pose, twist = msg.pose.pose, msg.twist.twist
-    o = pose.orientation
-    values = [pose.position.x, pose.position.y, pose.position.z, o.x, o.y, o.z, o.w,
-              twist.linear.x, twist.linear.y, twist.linear.z,
-              twist.angular.x, twist.angular.y, twist.angular.z]
-    return all(map(math.isfinite, values)) and (o.x ** 2 + o.y ** 2 + o.z ** 2 + o.w ** 2) > 0

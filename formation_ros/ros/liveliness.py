@@ -48,7 +48,3 @@ class PeerLiveliness:
         if self.alive > 0:
             return 'alive'
         return 'lost' if self.lost else 'unknown'
-
-    def seconds_since_change(self, now_ns: int) -> Optional[float]:
-        """Return the seconds since the last change (steady clock), None before any."""
-        return None if self.changed_ns is None else (now_ns - self.changed_ns) / 1e9

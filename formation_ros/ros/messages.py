@@ -4,19 +4,17 @@
 """
 Build ROS messages from the numpy arrays of the core (reading them is ``fields``).
 
-The nodes write their hot topics as bytes (``cdr``); these typed messages are what tools and
-tests publish, and what the byte writers are tested against.
+The nodes write their hot topics as bytes (``cdr``); the typed messages they publish besides
+(a shape's PoseArray, diagnostics, the team's status) are built here.
 """
 
 import math
 
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
-from formation_ros.core.frames import frame_to_pose
 from formation_ros.core.timeline import Mode, TeamState
-from formation_ros.ros.fields import NS_PER_S
-from geometry_msgs.msg import Pose, PoseArray, PoseStamped, TwistStamped
-from nav_msgs.msg import Odometry
+from formation_ros.core.units import NS_PER_S
+from geometry_msgs.msg import Pose, PoseArray
 
 WORLD_FRAME = 'world'
 FORMATION_FRAME = 'formation'
@@ -33,55 +31,28 @@ def ns_to_stamp(ns):
     return Time(sec=int(ns // NS_PER_S), nanosec=int(ns % NS_PER_S))
 
 
-def _xyz(vector, dim):
+def xyz(vector, dim):
+    """Return the first ``dim`` values of ``vector`` as x, y, z floats (0.0 beyond dim)."""
     values = [0.0, 0.0, 0.0]
     values[:dim] = [float(v) for v in vector[:dim]]
     return values
 
 
-def _stamped(msg, stamp_ns, frame_id=WORLD_FRAME):
+def stamped(msg, stamp_ns, frame_id=WORLD_FRAME):
+    """Return ``msg`` with its header at ``stamp_ns`` in ``frame_id`` (set in place)."""
     msg.header.stamp = ns_to_stamp(stamp_ns)
     msg.header.frame_id = frame_id
     return msg
 
 
-def pose_stamped(position, stamp_ns, dim):
-    """Build a PoseStamped at ``position`` ((dim,), m), identity orientation, frame 'world'."""
-    msg = _stamped(PoseStamped(), stamp_ns)
-    msg.pose.position.x, msg.pose.position.y, msg.pose.position.z = _xyz(position, dim)
-    msg.pose.orientation.w = 1.0
-    return msg
-
-
 def pose_array(points, stamp_ns, dim, frame_id=WORLD_FRAME):
     """Build a PoseArray of the rows of ``points`` ((K, dim), m), frame ``frame_id``."""
-    msg = _stamped(PoseArray(), stamp_ns, frame_id)
+    msg = stamped(PoseArray(), stamp_ns, frame_id)
     for point in points:
         pose = Pose()
-        pose.position.x, pose.position.y, pose.position.z = _xyz(point, dim)
+        pose.position.x, pose.position.y, pose.position.z = xyz(point, dim)
         pose.orientation.w = 1.0
         msg.poses.append(pose)
-    return msg
-
-
-def twist_stamped(velocity, stamp_ns, dim):
-    """Build a TwistStamped with linear = ``velocity`` ((dim,), m/s), frame 'world'."""
-    msg = _stamped(TwistStamped(), stamp_ns)
-    msg.twist.linear.x, msg.twist.linear.y, msg.twist.linear.z = _xyz(velocity, dim)
-    return msg
-
-
-def reference_odometry(frame, stamp_ns, dim):
-    """Build the nav_msgs/Odometry of a reference sample (``core.frames.frame_to_pose``)."""
-    position, quat, linear, angular = frame_to_pose(frame, dim)
-    msg = _stamped(Odometry(), stamp_ns)
-    msg.child_frame_id = FORMATION_FRAME
-    pose, twist = msg.pose.pose, msg.twist.twist
-    pose.position.x, pose.position.y, pose.position.z = (float(v) for v in position)
-    (pose.orientation.x, pose.orientation.y, pose.orientation.z,
-     pose.orientation.w) = (float(v) for v in quat)
-    twist.linear.x, twist.linear.y, twist.linear.z = (float(v) for v in linear)
-    twist.angular.x, twist.angular.y, twist.angular.z = (float(v) for v in angular)
     return msg
 
 

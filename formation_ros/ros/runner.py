@@ -11,8 +11,8 @@ wakes at least every :data:`SIGNAL_LATENCY` s even when no timer fires (a sim-ti
 while ROS is still up, the node is destroyed and rclpy shut down.
 
 A node started by the launcher also watches the launcher (:class:`LauncherWatch`): the launcher
-puts its process id and start time into the environment (:data:`LAUNCHER_PID_ENV`,
-:data:`LAUNCHER_START_ENV`), and when that process is gone, even killed with SIGKILL, the spin
+puts its process id and start time into the environment (``formation_ros.ros.watch``, its
+variables), and when that process is gone, even killed with SIGKILL, the spin
 loop ends the node as on SIGTERM and the process ends at once after (:func:`_exit_now`). This
 works whatever started the node on the launcher's
 behalf (``ros2 run`` puts a process of its own in between). A node started by hand, without
@@ -30,6 +30,7 @@ import time
 from typing import Any, Callable, List, Mapping, Optional, Sequence, Union
 
 from formation_ros.core.declarations import ParamError
+from formation_ros.ros.watch import LAUNCHER_PID_ENV, LAUNCHER_START_ENV, process_start
 import rclpy
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
@@ -37,9 +38,6 @@ from rclpy.signals import SignalHandlerOptions
 import yaml
 
 SIGNAL_LATENCY = 0.1
-LAUNCHER_PID_ENV = 'FORMATION_LAUNCHER_PID'
-LAUNCHER_START_ENV = 'FORMATION_LAUNCHER_START'
-"""Process id and start time (clock ticks after boot, /proc/<pid>/stat) of the launcher."""
 
 
 def make_executor() -> Executor:
@@ -61,34 +59,6 @@ class _StopRequest:
     @classmethod
     def handler(cls, signum: int, frame: Any) -> None:
         cls.signal_name = signal.Signals(signum).name
-
-
-def process_start(pid: int) -> Optional[int]:
-    """
-    Return the start time of process ``pid`` in clock ticks after boot; None if it is gone.
-
-    A zombie (ended, not yet reaped by its parent) counts as gone. Where there is no /proc,
-    return 0 for any process that exists.
-    """
-    try:
-        with open(f'/proc/{pid}/stat', 'rb') as stream:
-            fields = stream.read().rsplit(b')', 1)[1].split()
-    except FileNotFoundError:
-        if os.path.isdir('/proc/self'):
-            return None
-        try:
-            os.kill(pid, 0)
-        except ProcessLookupError:
-            return None
-        except PermissionError:
-            pass
-        return 0
-    except (OSError, IndexError):
-        return None
-    # fields[0] is field 3 of proc_pid_stat(5), the state; field 22 is the start time.
-    if fields[0] in (b'Z', b'X'):
-        return None
-    return int(fields[19])
 
 
 class LauncherWatch:

@@ -32,9 +32,10 @@ from formation_ros.core.params import check_shape, FormationConfig, ParamError
 from formation_ros.core.timeline import Mode, named_shape, Shape, TeamState, Timeline
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.core.unicycle import hand_points, hand_velocity, headings_from_quaternions
+from formation_ros.core.units import NS_PER_S
 from formation_ros.ros import topics as names
 from formation_ros.ros.bag_writer import BagError, BagWriter, PARAMS_FILE, TYPESTORE
-from formation_ros.ros.fields import frame_of, NS_PER_S, points_of, position_of, stamp_to_ns
+from formation_ros.ros.fields import frame_of, points_of, position_of, stamp_to_ns
 from formation_ros.ros.messages import team_state_of
 from mcap.data_stream import ReadDataStream
 from mcap.opcode import Opcode

@@ -53,6 +53,7 @@ from formation_ros.tools import launcher
 from formation_ros.tools.launcher import Install, Launch, main as launcher_main, Options
 from formation_ros.tools.launcher import parse_args, say, UsageError
 from formation_ros.tools.supervise import ProcessSpec, Supervisor
+from formation_ros.tools.system import network_variables, with_variables
 
 PROG = 'hosts.sh'
 PREFIX = 'frh'
@@ -63,8 +64,7 @@ DEVICE = 'eth0'
 NETWORK = '10.77.0'
 LOSS_TABLE = 'frh_loss'
 LOSS_HOOKS = ('ingress', 'egress')
-TRANSPORT_ENV = {'FASTDDS_BUILTIN_TRANSPORTS': 'UDPv4',
-                 'ROS_AUTOMATIC_DISCOVERY_RANGE': 'SUBNET'}
+TRANSPORT_ENV = {'FASTDDS_BUILTIN_TRANSPORTS': 'UDPv4'}
 COMMAND_TIMEOUT = 30.0
 KILL_WAIT = 5.0
 MAX_HOSTS = 200
@@ -205,8 +205,8 @@ class Hosts:
     @staticmethod
     def environment(base: Mapping[str, str]) -> dict[str, str]:
         """Return ``base`` with discovery across the subnet and Fast DDS on UDP only."""
-        env = dict(base, **TRANSPORT_ENV)
-        env.pop('ROS_LOCALHOST_ONLY', None)
+        env = with_variables(base, network_variables('subnet', None, base))
+        env.update(TRANSPORT_ENV)
         return env
 
     def create(self) -> None:

@@ -17,8 +17,8 @@ plant or relay together, the recorder last) and, with ``--out`` or ``--record``,
 Exit codes: 0 done, 1 a node died or the report failed, 2 bad usage or parameters,
 :data:`RECORDING_FAILED` (74) the recording stopped early.
 
-The nodes watch the launcher through :data:`LAUNCHER_PID_ENV` and :data:`LAUNCHER_START_ENV`
-(``formation_ros.ros.runner``), so they end on their own when it is killed with SIGKILL.
+The nodes watch the launcher through its process id and start time in their environment
+(``formation_ros.ros.watch``), so they end on their own when it is killed with SIGKILL.
 """
 
 import dataclasses
@@ -33,13 +33,15 @@ import time
 from typing import Callable, Mapping, Optional, Sequence, TextIO
 
 from formation_ros.core.exits import RECORDING_FAILED
+from formation_ros.ros.watch import watch_environment
 from formation_ros.tools.domain import choose_domain
 from formation_ros.tools.supervise import describe_returncode, ExitInfo, ProcessSpec, Supervisor
 from formation_ros.tools.system import (DISCOVERY, DISCOVERY_ENV, discovery_problem,
-                                        DOMAIN_ENV, domain_problem, FLEET_REMAP, Formation,
-                                        network_variables, NodePlan, ON_RECORD_FAILURE, plan,
-                                        PlanError, read_formation, recorder_plan,
-                                        ros_arguments, Run)
+                                        DOMAIN_ENV, domain_problem, ESSENTIAL, FLEET_REMAP,
+                                        Formation, network_variables, NodePlan,
+                                        ON_RECORD_FAILURE, plan, PlanError, read_formation,
+                                        RECORDER, recorder_plan, ros_arguments, Run,
+                                        stop_stages, with_variables)
 
 PROG = 'launch_formation.sh'
 PACKAGE = 'formation_ros'
@@ -48,9 +50,6 @@ RECORDER_START_TIMEOUT = 15.0
 POLL = 0.2
 ON_EXIT = ('continue', 'stop', 'respawn')
 MAX_RESTARTS = 5
-ESSENTIAL = ('plant', 'relay', 'reference', 'record')
-LAUNCHER_PID_ENV = 'FORMATION_LAUNCHER_PID'
-LAUNCHER_START_ENV = 'FORMATION_LAUNCHER_START'
 
 USAGE = """\
 Usage: scripts/launch_formation.sh PARAMS.yaml [--duration S] [--out DIR] [--record DIR]
@@ -280,11 +279,7 @@ def discovery_environment(options: Options, base: Mapping[str, str]) -> dict[str
     ``base`` is kept, and LOCALHOST is set where there is none (so a run on one computer stays
     there; ROS's own default is SUBNET). ``--domain-id`` sets ROS_DOMAIN_ID.
     """
-    env = dict(base)
-    if options.discovery is not None:
-        env.pop('ROS_LOCALHOST_ONLY', None)
-    env.update(network_variables(options.discovery, options.domain_id, base))
-    return env
+    return with_variables(base, network_variables(options.discovery, options.domain_id, base))
 
 
 def check_paths(options: Options) -> Options:
@@ -370,7 +365,7 @@ def node_specs(install: Install, options: Options, num_robots: int,
                env: Mapping[str, str]) -> list[ProcessSpec]:
     """Return the specs of plant (or relay), reference and robots, in the order they start."""
     return [_spec(install, node, options, env) for node in plan(run_of(options, num_robots))
-            if node.name != 'record']
+            if node.name != RECORDER]
 
 
 def recorder_spec(install: Install, options: Options, env: Mapping[str, str]) -> ProcessSpec:
@@ -383,23 +378,6 @@ def _spec(install: Install, node: NodePlan, options: Options,
           env: Mapping[str, str]) -> ProcessSpec:
     return ProcessSpec(node.name, install.command(node.executable) +
                        ros_arguments(node, options.params), env)
-
-
-def watch_environment(pid: int) -> dict[str, str]:
-    """
-    Return the variables with which the nodes watch process ``pid`` and end when it is gone.
-
-    The process id and its start time (clock ticks after boot, field 22 of /proc/PID/stat;
-    left out where there is no /proc): together they name one process, even once the id has
-    been given to another.
-    """
-    env = {LAUNCHER_PID_ENV: str(pid)}
-    try:
-        with open(f'/proc/{pid}/stat', 'rb') as stream:
-            env[LAUNCHER_START_ENV] = stream.read().rsplit(b')', 1)[1].split()[19].decode()
-    except (OSError, IndexError):
-        pass
-    return env
 
 
 class Launch:
@@ -471,11 +449,7 @@ class Launch:
 
     def stop(self) -> None:
         """Stop robots, reference and plant together, then the recorder."""
-        names = self.supervisor.names()
-        stages = [[name for name in names if name != 'record']]
-        if 'record' in names:
-            stages.append(['record'])
-        self.supervisor.stop_all(stages, STOP_TIMEOUT)
+        self.supervisor.stop_all(stop_stages(self.supervisor.names()), STOP_TIMEOUT)
 
     def _start_and_watch(self) -> None:
         specs = node_specs(self.install, self.options, self.num_robots, self.env)
@@ -484,7 +458,7 @@ class Launch:
         for spec in specs:
             if self.interrupted or not self._start(spec):
                 return
-            if spec.name == 'record' and not self._wait_for_recorder():
+            if spec.name == RECORDER and not self._wait_for_recorder():
                 return
         deadline = time.monotonic() + self.wall_seconds if self.wall_seconds > 0 else None
         while not self.interrupted:
@@ -583,13 +557,14 @@ class Launch:
 
     def report(self) -> int:
         """Run formation_report on the bag or the run directory, if any; return the exit code."""
+        from formation_ros.core.trajectory import TRAJECTORY_FILE  # numpy: not for --help
         options = self.options
         if options.record is not None:
             source, target = options.record, options.out or options.record
         elif options.out is not None:
             from formation_ros.core.trajectory import CHUNKS_DIR
             if not any(os.path.exists(os.path.join(options.out, name))
-                       for name in ('trajectory.npz', CHUNKS_DIR)):
+                       for name in (TRAJECTORY_FILE, CHUNKS_DIR)):
                 say(f'the plant wrote no trajectory to {options.out}')
                 return 1
             source, target = options.out, options.out

@@ -39,7 +39,8 @@ from formation_ros.core.frames import FrameSample
 from formation_ros.core.params import FormationConfig, load_config, validate
 from formation_ros.core.params_file import parse_params_text
 from formation_ros.core.plant import PLANT_STATS_FILE
-from formation_ros.core.trajectory import CHUNKS_DIR, read_body_chunks, read_chunks, Trajectory
+from formation_ros.core.trajectory import (CHUNKS_DIR, read_body_chunks, read_chunks, Trajectory,
+                                           TRAJECTORY_FILE)
 from formation_ros.ros import topics as names
 from formation_ros.ros.bag_writer import BagError, PARAMS_FILE
 from formation_ros.tools.animate import (AnimationError, DEFAULT_DPI, DEFAULT_FPS, describe,
@@ -138,7 +139,7 @@ def load_run(path: str, notes: Optional[List[str]] = None) -> Loaded:
     except OSError as exc:
         raise ReportError(f'{path}: cannot list it: {exc.strerror}') from None
     params = os.path.join(path, 'params.yaml')
-    arrays = os.path.join(path, 'trajectory.npz')
+    arrays = os.path.join(path, TRAJECTORY_FILE)
     chunks = os.path.join(path, CHUNKS_DIR)
     if not os.path.exists(arrays) and os.path.isdir(chunks) and os.path.exists(params):
         return _load_chunks(path, params, chunks, notes)

@@ -41,11 +41,12 @@ from formation_ros.core.metrics import body_metrics, compute_metrics, segment_me
 from formation_ros.core.params import (FormationConfig, load_config,
                                        validate_for_every_executable)
 from formation_ros.core.params_file import load_params_file
-from formation_ros.core.plant import Commands, NS_PER_S, PlantCounts, PlantModel
-from formation_ros.core.safety import guaranteed_min_distance
+from formation_ros.core.plant import Commands, PlantCounts, PlantModel
+from formation_ros.core.safety import body_clearance, guaranteed_min_distance
 from formation_ros.core.timeline import Mode, scheduled_shapes, Shape, TeamState, Timeline
-from formation_ros.core.trajectory import Trajectory
+from formation_ros.core.trajectory import Trajectory, TRAJECTORY_FILE
 from formation_ros.core.unicycle import hand_points, unicycle_commands, unicycle_rates
+from formation_ros.core.units import NS_PER_S
 import numpy as np
 
 RTOL = 1e-8
@@ -57,7 +58,6 @@ larger team is sampled at the smallest whole multiple of :data:`DEFAULT_SAMPLE_D
 within it (:func:`default_sample_dt`), so 10,000 robots over 20 s are saved every 0.05 s and
 the samples stay well under a gigabyte; smaller runs are sampled as before."""
 MAX_STEPS = 10_000_000
-TRAJECTORY_FILE = 'trajectory.npz'
 METRICS_FILE = 'metrics.json'
 PARAMS_COPY = 'params.yaml'
 
@@ -494,7 +494,7 @@ def format_summary(metrics: dict, out_dir: Optional[str] = None) -> str:
             f'2 x body.radius = {touching:.4g} m)',
             '  guaranteed by the potential from this start (docs/equations.md, U6): hand '
             f'points >= {guaranteed:.4g} m apart, so bodies >= '
-            f"{guaranteed - 2.0 * metrics['hand_distance']:.4g} m",
+            f"{body_clearance(guaranteed, metrics['hand_distance']):.4g} m",
             f"  max |v|: {metrics['max_abs_v']:.4g} m/s (sqrt(2) c M1 = "
             f"{metrics['v_bound']:.4g} m/s{_limit(metrics, 'max_linear', 'm/s')}), "
             f"max |w|: {metrics['max_abs_omega']:.4g} rad/s (sqrt(2) c M1 / l = "

@@ -251,12 +251,6 @@ class Supervisor:
         except queue.Empty:
             return None
 
-    @property
-    def first_death(self) -> Optional[ExitInfo]:
-        """Return the first process that ended without being asked to (None: none has)."""
-        with self._state_lock:
-            return next((info for info in self._ended if not info.stopped), None)
-
     def exits(self) -> list[ExitInfo]:
         """Return every exit so far, in the order the processes ended."""
         with self._state_lock:

@@ -12,7 +12,9 @@ executable, namespace, own arguments, parameter overrides (on top of the one par
 and remappings. ``formation_ros.tools.launcher`` turns them into command lines
 (:func:`ros_arguments`), ``launch/formation.launch.py`` and ``launch/lab.launch.py`` into
 ``launch_ros`` nodes (:func:`launch_nodes`), so that the two ways to start a run cannot drift
-apart. The discovery settings of the nodes (:func:`network_variables`) are also shared.
+apart. The discovery settings of the nodes (:func:`network_variables`), which processes end the
+run (:data:`ESSENTIAL`) and the order of stopping (:func:`stop_stages`) are also shared; a
+launch file ends on any node's exit and ``ros2 launch`` signals every node at once.
 
 Only the standard library and ``formation_ros.ros.topics`` (the topic names, no ROS) are
 imported at the top (the launcher's ``--help`` needs no more); the parameter code and
@@ -22,14 +24,12 @@ imported at the top (the launcher's ``--help`` needs no more); the parameter cod
 import dataclasses
 import os
 import re
-from typing import Any, List, Mapping, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
 
 from formation_ros.core.exits import RECORDING_FAILED
 from formation_ros.ros.topics import CMD_VEL, robot_namespace, robot_topic
 
 PACKAGE = 'formation_ros'
-RECORDER = 'record'
-"""The recorder's executable (and process name)."""
 SHARED_LAUNCH_ARGUMENTS = (
     ('discovery', '', "'localhost' or 'subnet' (empty: the environment's "
                       'ROS_AUTOMATIC_DISCOVERY_RANGE, else localhost)'),
@@ -44,12 +44,16 @@ ON_RECORD_FAILURE = ('continue', 'stop')
 DISCOVERY = ('localhost', 'subnet')
 DISCOVERY_ENV = 'ROS_AUTOMATIC_DISCOVERY_RANGE'
 DOMAIN_ENV = 'ROS_DOMAIN_ID'
+LOCALHOST_ONLY_ENV = 'ROS_LOCALHOST_ONLY'
 MAX_DOMAIN_ID = 232
 TOPIC_NAME = re.compile(r'(/[A-Za-z_][A-Za-z0-9_]*)+')
 """An absolute ROS 2 topic name: tokens of letters, digits and '_', none starting with a digit."""
 FLEET_REMAP = ('cannot be used with more than one robot per process: the ROS arguments of a '
                "fleet apply to all of its robots (each named 'robot'), so their cmd_vel "
                'cannot be remapped one by one')
+RECORDER = 'record'
+ESSENTIAL = ('plant', 'relay', 'reference', RECORDER)
+"""The processes whose end ends a run; the launcher's ``--on-exit`` says what a robot's does."""
 
 
 class PlanError(ValueError):
@@ -161,6 +165,19 @@ def recorder_plan(record: str, cmd_topics: Sequence[str] = ()) -> NodePlan:
                     remappings=remaps)
 
 
+def stop_stages(names: Sequence[str]) -> List[List[str]]:
+    """
+    Return the processes ``names`` in the order to stop them: groups stopped together.
+
+    Every node but the recorder first, then the recorder, so that it still hears their last
+    messages.
+    """
+    stages = [[name for name in names if name != RECORDER]]
+    if RECORDER in names:
+        stages.append([RECORDER])
+    return stages
+
+
 def ros_value(value: Any) -> str:
     """Return ``value`` as ``-p name:=value`` writes it (``true``/``false`` for booleans)."""
     if isinstance(value, bool):
@@ -215,19 +232,22 @@ def launch_file_nodes(arguments: Mapping[str, str], plant: bool = True) -> List[
     return launch_nodes(plan(run), params_file, env, on_record_failure)
 
 
-def launch_nodes(nodes: Sequence[NodePlan], params_file: str, env: Mapping[str, str],
+def launch_nodes(nodes: Sequence[NodePlan], params_file: str, env: Mapping[str, Optional[str]],
                  on_record_failure: str = ON_RECORD_FAILURE[0]) -> List[Any]:
     """
-    Return ``launch_ros`` nodes for ``nodes``: what the launch files start.
+    Return the ``launch`` actions that start ``nodes``: what the launch files start.
 
-    Each with the parameters file and its overrides, a relative namespace (so that a
+    Each node with the parameters file and its overrides, a relative namespace (so that a
     ``PushRosNamespace`` around the launch file still applies), its remappings, ``env`` added
     to its environment, and a Shutdown when it exits: the first node to end ends the launch.
     The recorder's exit with RECORDING_FAILED ends it only with ``on_record_failure`` 'stop'.
+    The variables that ``env`` maps to None are unset first (UnsetEnvironmentVariable).
     """
-    from launch.actions import Shutdown
+    from launch.actions import Shutdown, UnsetEnvironmentVariable
     from launch_ros.actions import Node
-    launched = []
+    launched: List[Any] = [UnsetEnvironmentVariable(name)
+                           for name, value in env.items() if value is None]
+    added = {name: value for name, value in env.items() if value is not None}
     for node in nodes:
         on_exit: Any = Shutdown(reason=f'{node.executable} exited')
         if node.executable == RECORDER and on_record_failure == 'continue':
@@ -239,7 +259,7 @@ def launch_nodes(nodes: Sequence[NodePlan], params_file: str, env: Mapping[str, 
             package=PACKAGE, executable=node.executable,
             namespace=None if node.namespace is None else node.namespace.lstrip('/'),
             arguments=list(node.arguments) or None, parameters=parameters,
-            remappings=list(node.remappings) or None, additional_env=dict(env),
+            remappings=list(node.remappings) or None, additional_env=dict(added),
             output='screen', on_exit=on_exit))
     return launched
 
@@ -276,25 +296,36 @@ def domain_problem(domain_id: str) -> Optional[str]:
 
 
 def network_variables(discovery: Optional[str], domain_id: Optional[int],
-                      base: Mapping[str, str]) -> dict:
+                      base: Mapping[str, str]) -> Dict[str, Optional[str]]:
     """
-    Return the variables to set in the nodes' environment for a discovery range and domain.
+    Return the variables to set (None: to unset) in the nodes' environment ``base``.
 
-    ``discovery`` sets ROS_AUTOMATIC_DISCOVERY_RANGE (LOCALHOST or SUBNET); without it a range
-    already in ``base`` is kept, and LOCALHOST is set where there is none (so that a run on one
+    ``discovery`` sets ROS_AUTOMATIC_DISCOVERY_RANGE (LOCALHOST or SUBNET) and unsets the
+    deprecated ROS_LOCALHOST_ONLY, which rcl would honour over it; without it a range already
+    in ``base`` is kept, and LOCALHOST is set where there is none (so that a run on one
     computer stays there; ROS's own default is SUBNET). ``domain_id`` sets ROS_DOMAIN_ID.
     Raises PlanError for a range other than :data:`DISCOVERY`.
     """
-    env = {}
+    env: Dict[str, Optional[str]] = {}
     if discovery:
         problem = discovery_problem(discovery)
         if problem:
             raise PlanError(f'discovery {problem}')
         env[DISCOVERY_ENV] = discovery.upper()
+        if LOCALHOST_ONLY_ENV in base:
+            env[LOCALHOST_ONLY_ENV] = None
     elif not base.get(DISCOVERY_ENV):
         env[DISCOVERY_ENV] = 'LOCALHOST'
     if domain_id is not None:
         env[DOMAIN_ENV] = str(domain_id)
+    return env
+
+
+def with_variables(base: Mapping[str, str], variables: Mapping[str, Optional[str]]
+                   ) -> Dict[str, str]:
+    """Return ``base`` with ``variables`` set, those mapped to None removed."""
+    env = {name: value for name, value in base.items() if variables.get(name, '') is not None}
+    env.update({name: value for name, value in variables.items() if value is not None})
     return env
 
 

@@ -208,3 +208,32 @@ def test_kept_pairs_are_the_hand_points_and_bodies_still_collide_on_their_own():
     commands.store_all([[-0.05, 0.0], [-0.05, 0.0], [0.0, 0.0]], 0)
     report = plant.advance(commands)
     assert [c[:2] for c in report.collisions] == [(0, 1)]
+
+
+@pytest.mark.parametrize('bodies', [
+    PointBodies(0.3), UnicycleBodies(L, max_linear=0.2, max_angular=1.0)])
+def test_caps_return_a_clipped_copy_and_leave_the_commands_alone(bodies):
+    command = np.array([[0.1, 0.1], [0.5, -0.1], [-0.05, -3.0]])
+    before = command.copy()
+    rows = np.array([True, True, False])
+    capped, which = bodies.cap(command, rows)
+    assert np.array_equal(command, before)
+    assert which.tolist() == [False, True, False]
+    limits = np.array([0.3, 0.3]) if isinstance(bodies, PointBodies) else np.array([0.2, 1.0])
+    assert np.array_equal(capped[1], np.clip(before[1], -limits, limits))
+    assert np.array_equal(capped[[0, 2]], before[[0, 2]])
+    untouched, none = bodies.cap(command, np.zeros(3, dtype=bool))
+    assert untouched is command and not np.any(none)
+
+
+def test_admission_leaves_the_stored_commands_alone():
+    plant = unicycle_model([[0.0, 0.0], [3.0, 0.0]], [0.0, 0.5])
+    plant.advance(Commands.empty(2, 2))
+    commands = Commands.empty(2, 2)
+    commands.store(0, [1e9, -1e9], plant.t_ns)
+    commands.store(1, [0.01, 0.02], plant.t_ns)
+    stored = commands.u.copy()
+    admission = plant.admit(commands)
+    assert np.array_equal(commands.u, stored)
+    assert admission.status.tolist() == [CommandStatus.SATURATED, CommandStatus.APPLIED]
+    assert admission.u[1].tolist() == [0.01, 0.02]

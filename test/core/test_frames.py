@@ -4,6 +4,7 @@
 """Moving references and the formation frame J (core/reference.py, core/frames.py)."""
 
 import math
+import os
 
 from formation_ros.core.frames import (advance, desired_positions, frame_from_pose,
                                        frame_to_pose, from_frame_velocity,
@@ -12,6 +13,8 @@ from formation_ros.core.frames import (advance, desired_positions, frame_from_po
 from formation_ros.core.reference import GERONO_LOOP_LENGTH, Reference
 import numpy as np
 import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 CASES = [
     ('fixed', 2), ('fixed', 3), ('line', 2), ('line', 3), ('circle', 2), ('circle', 3),
@@ -121,10 +124,33 @@ def test_desired_positions_invert_eq_20():
 
 
 def test_bad_reference_rejected():
-    with pytest.raises(ValueError, match='helix'):
+    with pytest.raises(ValueError, match='^a helix needs dim 3$'):
         Reference('helix', 2)
     with pytest.raises(ValueError, match='unknown reference kind'):
         Reference('spiral', 2)
+
+
+def test_reference_kinds_are_one_enum_and_the_file_check_says_what_the_reference_says():
+    from formation_ros.core.declarations import BY_NAME, ParamError, ReferenceKind
+    from formation_ros.core.params import validate
+    from formation_ros.core.params_file import load_params_file
+    from formation_ros.core.reference import PERIODIC
+    assert set(BY_NAME['reference.kind'].choices) == {kind.value for kind in ReferenceKind}
+    assert Reference('circle', 2, speed=1.0).kind is ReferenceKind.CIRCLE
+    assert Reference(ReferenceKind.HELIX, 3, speed=1.0).kind is ReferenceKind.HELIX
+    assert set(PERIODIC) == {ReferenceKind.CIRCLE, ReferenceKind.FIGURE_EIGHT,
+                             ReferenceKind.HELIX}
+    for kind in ReferenceKind:
+        moves = Reference(kind, 3, velocity=[1.0, 0.0, 0.0], speed=1.0)
+        assert moves.rate > 0.0 if kind in PERIODIC else moves.rate == 0.0
+    values = load_params_file(os.path.join(ROOT, 'config', 'circle_2d.yaml'))
+    values['reference.kind'] = 'helix'
+    with pytest.raises(ParamError) as refused:
+        validate(values)
+    with pytest.raises(ValueError) as built:
+        Reference('helix', 2)
+    assert "'reference.kind': helix needs dim 3" in str(refused.value)
+    assert str(built.value) == 'a helix needs dim 3'
 
 
 def axis_angle_matrix(axis, angle):

@@ -142,3 +142,13 @@ def test_bad_arguments_rejected():
         PolyJump(2).h(np.array([0.1]), 0.5, 0.5)
     with pytest.raises(ValueError, match='unknown jump kind'):
         make_jump('cubic', 2)
+
+
+def test_jump_kinds_are_one_enum_and_make_jump_dispatches_on_it():
+    from formation_ros.core.declarations import BY_NAME
+    from formation_ros.core.jump import JumpKind, make_jump, PolyJump, SmoothJump
+    assert set(BY_NAME['jump.kind'].choices) == {kind.value for kind in JumpKind}
+    for kind, cls in ((JumpKind.POLY, PolyJump), (JumpKind.SMOOTH, SmoothJump)):
+        assert isinstance(make_jump(kind), cls) and isinstance(make_jump(kind.value), cls)
+        assert make_jump(kind).kind is kind
+    assert make_jump('poly', 3).order == 3

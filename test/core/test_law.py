@@ -172,3 +172,19 @@ def test_team_command_with_the_callers_tree_is_the_same_command():
     alone = team_command(q, vertices, radii, law)
     shared = team_command(q, vertices, radii, law, tree=cKDTree(q))
     assert np.array_equal(alone.u, shared.u) and np.array_equal(alone.omega, shared.omega)
+
+
+def test_every_psi_kind_has_its_function_and_bound_and_strings_name_them():
+    from formation_ros.core.declarations import BY_NAME
+    from formation_ros.core.law import psi, PSI_FUNCTIONS, PsiKind
+    assert set(PSI_FUNCTIONS) == set(PsiKind)
+    assert set(BY_NAME['controller.psi'].choices) == {kind.value for kind in PsiKind}
+    omega = np.array([-1e6, -0.7, 0.0, 0.3, 1e6])
+    for kind, (function, bound) in PSI_FUNCTIONS.items():
+        law = make_law(2.0, 1.0, kind.value, 'poly', 2, 1.0)
+        assert law.psi is kind and law.psi_bound == bound
+        assert np.array_equal(psi(omega, law), function(omega))
+        assert np.max(np.abs(function(omega))) <= bound
+    assert make_law(2.0, 1.0, PsiKind.TANH, 'poly', 2, 1.0).psi is PsiKind.TANH
+    assert (PSI_FUNCTIONS[PsiKind.ARCTAN][1], PSI_FUNCTIONS[PsiKind.TANH][1]) == (math.pi / 2,
+                                                                                  1.0)

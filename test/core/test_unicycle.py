@@ -5,10 +5,9 @@
 
 import math
 
-from formation_ros.core.unicycle import (axle_positions, command_bounds, hand_points,
-                                         hand_velocity, headings_from_quaternions,
-                                         quaternions_from_headings, unicycle_commands,
-                                         unicycle_rates, wrap_angle, zoh_step)
+from formation_ros.core.unicycle import (command_bounds, hand_points, hand_velocity,
+                                         headings_from_quaternions, quaternions_from_headings,
+                                         unicycle_commands, unicycle_rates, zoh_step)
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -73,7 +72,8 @@ def test_maps_invert_each_other():
     q = RNG.normal(size=(50, 2))
     th = RNG.uniform(-10.0, 10.0, 50)
     u = RNG.normal(size=(50, 2))
-    assert np.max(np.abs(axle_positions(hand_points(q, th, L), th, L) - q)) < 1e-15
+    axles = hand_points(q, th, L) - L * np.stack([np.cos(th), np.sin(th)], axis=-1)
+    assert np.max(np.abs(axles - q)) < 1e-15
     assert np.max(np.abs(hand_velocity(unicycle_commands(u, th, L), th, L) - u)) < 1e-14
     command = unicycle_commands(u, th, L)
     assert np.max(np.abs(unicycle_commands(hand_velocity(command, th, L), th, L)
@@ -96,7 +96,6 @@ def test_per_robot_and_vectorised_forms_agree():
     rates_q, rates_th = unicycle_rates(th, command)
     for i in range(n):
         assert np.array_equal(hand_points(q[i], th[i], L), hand_points(q, th, L)[i])
-        assert np.array_equal(axle_positions(q[i], th[i], L), axle_positions(q, th, L)[i])
         assert np.array_equal(unicycle_commands(u[i], th[i], L), command[i])
         assert np.array_equal(hand_velocity(command[i], th[i], L),
                               hand_velocity(command, th, L)[i])
@@ -127,23 +126,12 @@ def test_inputs_are_not_modified():
     command = RNG.normal(size=(5, 2))
     copies = [a.copy() for a in (q, th, command)]
     hand_points(q, th, L)
-    axle_positions(q, th, L)
     unicycle_commands(command, th, L)
     hand_velocity(command, th, L)
     unicycle_rates(th, command)
     zoh_step(q, th, command, 0.1)
-    wrap_angle(th)
     for before, after in zip(copies, (q, th, command)):
         assert np.array_equal(before, after)
-
-
-def test_wrap_angle():
-    wrapped = wrap_angle([0.0, math.pi, -math.pi, 3 * math.pi + 0.1, -7.0])
-    assert np.all((wrapped >= -math.pi) & (wrapped < math.pi))
-    assert np.allclose(np.cos(wrapped), np.cos([0.0, math.pi, -math.pi, 3 * math.pi + 0.1,
-                                                -7.0]))
-    assert np.allclose(np.sin(wrapped), np.sin([0.0, math.pi, -math.pi, 3 * math.pi + 0.1,
-                                                -7.0]))
 
 
 def test_quaternions_and_headings_round_trip_and_match_scipy():

@@ -28,11 +28,11 @@ import enum
 import math
 from typing import Dict, List, Optional, Sequence, Set, Tuple
 
-from formation_ros.ros.cdr import encode_pose_stamped
 from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
 import numpy as np
 from rclpy.clock import Clock, ClockType
 from rclpy.qos import qos_profile_sensor_data, QoSProfile, ReliabilityPolicy
+import wire
 
 SUBSTEP = 0.002
 NS_PER_S = 1_000_000_000
@@ -197,7 +197,7 @@ class Lab:
                 continue
             position = self.q[i] + (self.rng.normal(0.0, self.noise, 2) if self.noise else 0.0)
             half = 0.5 * float(self.heading[i])
-            publisher.publish(encode_pose_stamped(
+            publisher.publish(wire.pose_stamped_bytes(
                 WALL.now().nanoseconds, self.frame, position,
                 (0.0, 0.0, math.sin(half), math.cos(half))))
             self.measured[i] = (now, (float(position[0]), float(position[1])))

@@ -15,6 +15,7 @@ from helpers import launch, node, SimClock, SQUARE, stop_when, wait_exit, write_
 from nav_msgs.msg import Odometry
 import pytest
 from rosgraph_msgs.msg import Clock as ClockMsg
+import wire
 
 pytestmark = pytest.mark.faults
 START_UP = 90.0
@@ -110,7 +111,7 @@ def test_a_robot_names_a_second_reference_publisher(processes, install, probe):
     forged = probe.create_publisher(Odometry, '/formation/reference', qos.REFERENCE)
 
     def named():
-        forged.publish(messages.reference_odometry(None, probe.get_clock().now().nanoseconds,
+        forged.publish(wire.reference_odometry(None, probe.get_clock().now().nanoseconds,
                                                    2))
         text = value(statuses, 'formation_ros/robot_1', 'topics with more than one publisher')
         return '/formation/reference: /probe, /reference' in text

@@ -6,12 +6,13 @@
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.answers import BURST, RATE_MARGIN
 from formation_ros.core.params import load_config
-from formation_ros.ros import fields, messages, qos
+from formation_ros.ros import fields, qos
 from geometry_msgs.msg import PoseStamped, TwistStamped
 from helpers import node, SQUARE
 import pytest
 from rclpy.qos import QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock as ClockMsg
+import wire
 
 pytestmark = pytest.mark.faults
 START_UP = 90.0
@@ -56,7 +57,7 @@ def test_a_pose_flood_is_not_passed_on_to_cmd_vel(processes, install, probe):
         for _ in range(FLOOD_PER_TICK):
             k = counts['forged'] % FLOOD_PER_STATE
             offset = 0 if k % 2 else 1000 * (k + 1)
-            forger.publish(messages.pose_stamped(start + 0.01 * k, latest['clock_ns'] + offset,
+            forger.publish(wire.pose_stamped(start + 0.01 * k, latest['clock_ns'] + offset,
                                                  2))
             counts['forged'] += 1
 

@@ -11,12 +11,13 @@ import subprocess
 from formation_ros.core.law import robot_command
 from formation_ros.core.params import load_config
 from formation_ros.core.trajectory import Trajectory
-from formation_ros.ros import fields, messages, qos
+from formation_ros.ros import messages, qos
 from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
 from helpers import exe, node, SimClock, SQUARE, wait_exit, watch_commands
 from nav_msgs.msg import Odometry
 import numpy as np
 import pytest
+import wire
 
 pytestmark = pytest.mark.faults
 START_UP = 90.0
@@ -62,8 +63,8 @@ def test_forged_commands_are_refused_or_saturated(processes, install, probe, tmp
 
     def send():
         now = max(0, int(clock.seconds * 1e9))
-        future.publish(messages.twist_stamped(np.array([0.5, 0.0]), 2_000_000_000 * 10 ** 9, 2))
-        huge.publish(messages.twist_stamped(np.array([1e9, -1e9]), now, 2))
+        future.publish(wire.twist_stamped(np.array([0.5, 0.0]), 2_000_000_000 * 10 ** 9, 2))
+        huge.publish(wire.twist_stamped(np.array([1e9, -1e9]), now, 2))
         garbage.publish(b'\x00\x01\x00\x00' + bytes(range(9)))
         return clock.seconds >= 3.0
 
@@ -102,14 +103,14 @@ def test_robot_ignores_forged_poses_and_floods(processes, install, probe):
     def publish():
         ticks.append(len(ticks))
         stamp = probe.get_clock().now().nanoseconds
-        forged_pose = messages.pose_stamped(np.array([5.0, 5.0]), stamp, 2)
+        forged_pose = wire.pose_stamped(np.array([5.0, 5.0]), stamp, 2)
         forged_pose.header.frame_id = 'robot_1/base_link'
-        fast = messages.reference_odometry(None, stamp, 2)
+        fast = wire.reference_odometry(None, stamp, 2)
         fast.twist.twist.linear.x = 1e9
         flood.header.stamp = messages.ns_to_stamp(stamp)
-        good = ((messages.pose_stamped(np.array([0.2, -0.1]), stamp, 2), pose_pub),
+        good = ((wire.pose_stamped(np.array([0.2, -0.1]), stamp, 2), pose_pub),
                 (messages.pose_array(np.array([[0.6, 0.2]]), stamp, 2), neighbours_pub),
-                (messages.reference_odometry(None, stamp, 2), reference_pub))
+                (wire.reference_odometry(None, stamp, 2), reference_pub))
         forged = ((forged_pose, pose_pub), (flood, neighbours_pub), (fast, reference_pub),
                   (b'\x00\x01\x00\x00\x07', pose_pub))
         for message, publisher in (forged if len(ticks) % 3 == 0 else good):
@@ -122,7 +123,7 @@ def test_robot_ignores_forged_poses_and_floods(processes, install, probe):
         return bool(logged_at) and len(heard) > logged_at[0] + 20
 
     assert probe.spin_until(publish, START_UP), processes.log('robot_1')
-    answers = [u for u in (fields.velocity_of(m, 2) for m in heard[logged_at[0]:]) if np.any(u)]
+    answers = [u for u in (wire.velocity_of(m, 2) for m in heard[logged_at[0]:]) if np.any(u)]
     assert answers, 'the robot only published zero (its watchdog) after the forged messages'
     expected = robot_command(np.array([0.2, -0.1]), config.vertices[0], np.array([[0.6, 0.2]]),
                              config.sensing_radii[0], config.law()).u

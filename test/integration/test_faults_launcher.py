@@ -19,7 +19,8 @@ import time
 from formation_ros.core.declarations import Exe
 from formation_ros.core.params import load_config
 from formation_ros.core.trajectory import Trajectory
-from formation_ros.ros.runner import LauncherWatch, process_start
+from formation_ros.ros.runner import LauncherWatch
+from formation_ros.ros.watch import process_start
 from helpers import (exe, launch, project_processes, SimClock, SQUARE, START_UP, stop_when,
                      wait_exit, watch_commands)
 import numpy as np

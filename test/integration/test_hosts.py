@@ -23,11 +23,11 @@ import time
 
 from formation_ros.core.declarations import Exe
 from formation_ros.core.params import load_config
+from formation_ros.ros.watch import watch_environment
 from formation_ros.tools import hosts as hosts_module
 from formation_ros.tools.bag import read_messages
 from formation_ros.tools.hosts import host_names, Hosts, HostsError, spread
 from formation_ros.tools.launcher import Install, node_specs, Options, recorder_spec
-from formation_ros.tools.launcher import watch_environment
 from formation_ros.tools.report import load_bag, write_report
 from formation_ros.tools.supervise import ProcessSpec, Supervisor
 from helpers import project_processes, SQUARE, START_UP, write_params

@@ -17,12 +17,13 @@ import time
 from formation_ros.core.frames import desired_positions
 from formation_ros.core.params import load_config
 from formation_ros.core.params_file import load_params_file
-from formation_ros.ros import fields, messages, qos
+from formation_ros.ros import qos
 from formation_ros.tools.bag import read_messages
 from geometry_msgs.msg import PoseStamped, TwistStamped
 from helpers import launch, project_processes, START_UP, stop_when, write_params
 import numpy as np
 from rclpy.qos import qos_profile_sensor_data
+import wire
 
 MOCAP_PERIOD = 0.02
 NAMES = ['tb1', 'tb2', 'tb3', 'tb4']
@@ -57,7 +58,7 @@ class Lab:
 
     def on_command(self, k, msg):
         """Keep base k's latest command (a base driver takes the newest)."""
-        self.u[k] = fields.velocity_of(msg, self.dim)
+        self.u[k] = wire.velocity_of(msg, self.dim)
         self.heard[k] += 1
         self.largest = max(self.largest, float(np.max(np.abs(self.u[k]))))
 
@@ -68,7 +69,7 @@ class Lab:
         self.last = now
         stamp = self.clock.now().nanoseconds
         for k, publisher in enumerate(self.mocap):
-            msg = messages.pose_stamped(self.q[k], stamp, self.dim)
+            msg = wire.pose_stamped(self.q[k], stamp, self.dim)
             msg.header.frame_id = self.frame
             publisher.publish(msg)
 

@@ -14,6 +14,7 @@ from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
 from helpers import node, SQUARE
 from nav_msgs.msg import Odometry
 import numpy as np
+import wire
 
 STAMP_NS = 123_450_000_000
 
@@ -29,22 +30,22 @@ def test_robot_publishes_the_core_command_and_survives_bad_poses(processes, inst
     reference_pub = probe.create_publisher(Odometry, '/formation/reference', qos.REFERENCE)
     heard = []
     probe.create_subscription(TwistStamped, '/robot_1/cmd_vel', heard.append, qos.COMMAND)
-    bad = messages.pose_stamped(np.array([math.nan, 0.0]), STAMP_NS + 1, 2)
+    bad = wire.pose_stamped(np.array([math.nan, 0.0]), STAMP_NS + 1, 2)
 
     def publish(pose):
         pose_pub.publish(pose)
         neighbours_pub.publish(messages.pose_array(neighbours, STAMP_NS, 2))
-        reference_pub.publish(messages.reference_odometry(None, STAMP_NS, 2))
+        reference_pub.publish(wire.reference_odometry(None, STAMP_NS, 2))
 
     def answered():
-        publish(messages.pose_stamped(own, STAMP_NS, 2))
+        publish(wire.pose_stamped(own, STAMP_NS, 2))
         return any(fields.stamp_to_ns(m.header.stamp) == STAMP_NS for m in heard)
 
     assert probe.spin_until(answered, 60), processes.log('robot_1')
     expected = robot_command(own, config.vertices[0], neighbours, config.sensing_radii[0],
                              config.law()).u
     command = [m for m in heard if fields.stamp_to_ns(m.header.stamp) == STAMP_NS][-1]
-    assert np.max(np.abs(fields.velocity_of(command, 2) - expected)) < 1e-12
+    assert np.max(np.abs(wire.velocity_of(command, 2) - expected)) < 1e-12
     assert np.any(expected != robot_command(own, config.vertices[0], neighbours[1:2],
                                             config.sensing_radii[0], config.law()).u)
     count = len(heard)
@@ -71,7 +72,7 @@ def test_plant_treats_a_non_finite_command_as_zero(processes, install, probe, tm
 
     def send():
         stamp = clock[-1] if clock else 0
-        command_pub.publish(messages.twist_stamped(np.array([math.nan, 1.0]), stamp, 2))
+        command_pub.publish(wire.twist_stamped(np.array([math.nan, 1.0]), stamp, 2))
         return len(clock) > 60
 
     assert probe.spin_until(send, 60), processes.log('plant')

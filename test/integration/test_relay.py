@@ -14,7 +14,7 @@ import os
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from formation_ros.ros import fields, qos
-from formation_ros.ros.cdr import encode_odometry, encode_pose_stamped
+from formation_ros.ros.cdr import encode_odometry
 from geometry_msgs.msg import PoseArray, PoseStamped
 from helpers import CONFIG, node, write_params
 from lab_standin import Base, Lab, steady_s
@@ -23,6 +23,7 @@ import numpy as np
 import pytest
 from rclpy.clock import Clock, ClockType
 from rclpy.qos import QoSProfile, ReliabilityPolicy
+import wire
 
 START_UP = 90.0
 NS_PER_S = 1_000_000_000
@@ -128,7 +129,7 @@ def test_relay_publishes_every_pose_and_the_brute_force_neighbours_with_one_stam
     def measure():
         stamp = next(stamps)
         for i, publisher in enumerate(publishers):
-            publisher.publish(encode_pose_stamped(stamp, 'map', POSITIONS[i], turned[i]))
+            publisher.publish(wire.pose_stamped_bytes(stamp, 'map', POSITIONS[i], turned[i]))
         return len(outputs.complete_cycles(range(1, 6))) >= 3
 
     assert probe.spin_until(measure, START_UP), processes.log('relay')
@@ -211,17 +212,17 @@ def test_refused_measurements_are_counted_logged_once_and_never_published(
     probe.create_publisher(Odometry, '/robot_6/measured_pose', RELIABLE)
     near = np.array([0.5, 0.0])
     forged = {
-        1: encode_pose_stamped(3, 'map', (0.0, 0.0)),
-        2: encode_pose_stamped(3, 'world', near),
-        3: encode_pose_stamped(3, 'map', (math.nan, 0.0)),
+        1: wire.pose_stamped_bytes(3, 'map', (0.0, 0.0)),
+        2: wire.pose_stamped_bytes(3, 'world', near),
+        3: wire.pose_stamped_bytes(3, 'map', (math.nan, 0.0)),
         4: encode_odometry(3, 'map', 'base', (0.5, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0),
                            (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)),
-        5: encode_pose_stamped(3, 'map', near, (0.0, 0.0, 0.0, 0.0)),
+        5: wire.pose_stamped_bytes(3, 'map', near, (0.0, 0.0, 0.0, 0.0)),
     }
     sent = []
 
     def counted():
-        forged[1] = encode_pose_stamped(3 + len(sent), 'map', (0.0, 0.0))
+        forged[1] = wire.pose_stamped_bytes(3 + len(sent), 'map', (0.0, 0.0))
         for i, publisher in pubs.items():
             publisher.publish(forged[i])
         sent.append(1)
@@ -276,7 +277,7 @@ def test_a_frozen_source_goes_stale_an_unstamped_one_is_taken_a_restarted_one_re
         tick = next(ticks)
         stamps = {1: 1000 * NS_PER_S + tick * 1_000_000 - back['by'], 2: 500 * NS_PER_S, 3: 0}
         for i, publisher in publishers.items():
-            publisher.publish(encode_pose_stamped(stamps[i], 'map', POSITIONS[i - 1]))
+            publisher.publish(wire.pose_stamped_bytes(stamps[i], 'map', POSITIONS[i - 1]))
         values = outputs.values()
         return (values.get('stale robots') == '2' and int(values.get(key, 0)) > 10
                 and len(outputs.poses[1]) > 20 and len(outputs.poses[3]) > 20)

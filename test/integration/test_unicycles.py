@@ -18,6 +18,7 @@ from helpers import launch, node, SimClock, stop_when, write_params
 from nav_msgs.msg import Odometry
 import numpy as np
 import pytest
+import wire
 
 ROBOTS = 4
 FOUR = {'num_robots': ROBOTS, 'formation.vertices': [0.6, 0.6, -0.6, 0.6, -0.6, -0.6, 0.6, -0.6],
@@ -153,7 +154,7 @@ def test_unicycle_robot_takes_odometry_and_answers_in_its_body_frame(processes, 
     def answered():
         odometry_pub.publish(odometry)
         neighbours_pub.publish(array)
-        reference_pub.publish(messages.reference_odometry(None, STAMP_NS, 2))
+        reference_pub.publish(wire.reference_odometry(None, STAMP_NS, 2))
         return any(fields.stamp_to_ns(m.header.stamp) == STAMP_NS for m in heard)
 
     assert probe.spin_until(answered, 60), processes.log('robot_1')

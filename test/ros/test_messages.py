@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 from rclpy.serialization import deserialize_message
 from scipy.spatial import cKDTree
+import wire
 
 
 @pytest.mark.parametrize('dim', [2, 3])
@@ -26,7 +27,7 @@ def test_encoded_states_equal_messages_built_alone_at_every_step(dim):
         poses, arrays = encoder.encode(q, observer, seen, stamp)
         assert len(poses) == len(arrays) == n
         for i in range(n):
-            assert deserialize_message(poses[i], PoseStamped) == messages.pose_stamped(
+            assert deserialize_message(poses[i], PoseStamped) == wire.pose_stamped(
                 q[i], stamp, dim)
             mine = seen[observer == i]
             array = deserialize_message(arrays[i], PoseArray)
@@ -43,3 +44,30 @@ def test_encode_leaves_its_inputs_alone_and_lists_nobody_unseen():
     assert np.array_equal(seen, before[2])
     assert [len(deserialize_message(a, PoseArray).poses) for a in arrays] == [1, 1, 0]
     assert all(isinstance(p, bytes) for p in poses + arrays)
+
+
+@pytest.mark.parametrize('dim', [2, 3])
+def test_states_are_written_little_endian_from_big_endian_arrays_too(dim):
+    """The bytes are the values as '<f8', whatever the byte order of the arrays given."""
+    rng = np.random.default_rng(10 + dim)
+    n = 5
+    q = rng.uniform(-2.0, 2.0, (n, dim))
+    quaternions = rng.normal(size=(n, 4))
+    quaternions /= np.linalg.norm(quaternions, axis=1)[:, None]
+    observer, seen = sensed_pairs(q, np.full(n, 10.0), cKDTree(q))
+    native = StateEncoder(n, dim, 'map').encode(q, observer, seen, 9, orientations=quaternions)
+    big_q, big_quaternions = q.astype('>f8'), quaternions.astype('>f8')
+    assert big_q.tobytes() != q.tobytes()
+    swapped = StateEncoder(n, dim, 'map').encode(big_q, observer, seen, 9,
+                                                 orientations=big_quaternions)
+    assert swapped == native
+    headings = rng.uniform(-3.0, 3.0, n)
+    assert (StateEncoder(n, dim, 'map').encode(big_q, observer, seen, 9,
+                                               headings=headings.astype('>f8'))
+            == StateEncoder(n, dim, 'map').encode(q, observer, seen, 9, headings=headings))
+    poses, arrays = swapped
+    for i in range(n):
+        row = np.frombuffer(poses[i][-8 * 7:], dtype='<f8')
+        assert np.array_equal(row[:dim], q[i]) and np.array_equal(row[3:], quaternions[i])
+        message = deserialize_message(arrays[i], PoseArray)
+        assert np.array_equal(fields.points_of(message, dim), q[seen[observer == i]])

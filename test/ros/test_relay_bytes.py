@@ -4,17 +4,17 @@
 """What the relay reads and writes as bytes: exact readers, forwarded orientations."""
 
 from formation_ros.core.sensing import sensed_pairs
-from formation_ros.ros import messages
-from formation_ros.ros.cdr import (CdrError, encode_odometry, encode_pose_stamped,
-                                   read_odometry, read_pose_stamped, StateEncoder)
+from formation_ros.ros.cdr import (CdrError, encode_odometry, read_odometry, read_pose_stamped,
+                                   StateEncoder)
 from geometry_msgs.msg import PoseArray, PoseStamped
 import numpy as np
 import pytest
 from rclpy.serialization import deserialize_message, serialize_message
+import wire
 
 ODOMETRY = encode_odometry(5, 'map', 'tb1', (1.0, 2.0, 0.0), (0.0, 0.0, 0.0, 1.0),
                            (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
-POSE = encode_pose_stamped(5, 'map', (1.0, 2.0), (0.0, 0.0, 0.0, 1.0))
+POSE = wire.pose_stamped_bytes(5, 'map', (1.0, 2.0), (0.0, 0.0, 0.0, 1.0))
 
 
 def test_an_odometry_read_as_a_pose_is_refused_only_when_exact():
@@ -27,7 +27,7 @@ def test_an_odometry_read_as_a_pose_is_refused_only_when_exact():
 
 @pytest.mark.parametrize('padding', [0, 1, 3])
 def test_exact_readers_take_whole_messages_and_a_final_padding(padding):
-    pose = serialize_message(messages.pose_stamped(np.array([0.5, -1.5]), 7, 2))
+    pose = serialize_message(wire.pose_stamped(np.array([0.5, -1.5]), 7, 2))
     assert read_pose_stamped(pose + b'\x00' * padding, exact=True).position == (0.5, -1.5, 0.0)
     assert read_odometry(ODOMETRY + b'\x00' * padding, exact=True).position == (1.0, 2.0, 0.0)
     with pytest.raises(CdrError):
