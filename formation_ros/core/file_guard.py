@@ -280,6 +280,9 @@ def check_params_text(text: str, source: str,
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         at = None if mark is None else mark.line + 1
+        if 'nesting depth' in str(exc.problem):
+            raise ParamsFileError(source, f'nested more than {limits.max_depth} levels deep',
+                                  at) from None
         raise ParamsFileError(source, 'cannot read it as YAML: ' + yaml_problem(exc), at) \
             from None
     except yaml.YAMLError as exc:
