@@ -53,9 +53,11 @@ def with_vertices(values):
 
 
 def laughs():
-    """Nine levels of ten aliases each (10^9 strings) under a key the package does not know."""
-    lines = ['    lol:', '      l0: &l0 [' + ', '.join(['lol'] * 10) + ']']
-    lines += [f'      l{k}: &l{k} [' + ', '.join([f'*l{k - 1}'] * 10) + ']' for k in range(1, 9)]
+    """Nine levels of ten aliased mappings (10^9 names) under a key the package does not know."""
+    keys = 'abcdefghij'
+    lines = ['    lol:', '      l0: &l0 {' + ', '.join(f'{key}: lol' for key in keys) + '}']
+    lines += [f'      l{k}: &l{k} {{' + ', '.join(f'{key}: *l{k - 1}' for key in keys) + '}'
+              for k in range(1, 9)]
     return square_text() + '\n'.join(lines) + '\n'
 
 
