@@ -336,6 +336,9 @@ _PROBLEMS = (
     ('found duplicate anchor', 'YAML anchors are not allowed'),
     ('while scanning a directive', "a '%' directive line"),
     ('found incompatible YAML document', "a '%YAML' directive of another YAML version"),
+    ('could not determine a constructor', "an unknown '!' tag"),
+    ('found unhashable key', 'a list or a mapping as a key'),
+    ('timestamp', 'a date or time that is not one'),
 )
 
 

@@ -24,7 +24,7 @@ from typing import Any, Dict, Mapping, Union
 
 from formation_ros.core.declarations import ParamError
 from formation_ros.core.file_guard import (check_params_text, ParamsFileError,
-                                           read_params_file_text)
+                                           read_params_file_text, yaml_problem)
 import yaml
 
 PathText = Union[str, 'os.PathLike[str]']
@@ -104,9 +104,13 @@ def parse_params_text(text: str, source: str) -> Dict[str, Any]:
     check_params_text(text, source)
     try:
         document = yaml.load(text, Loader=_Loader)
-    except (yaml.YAMLError, ValueError, RecursionError) as exc:
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, 'problem_mark', None)
+        raise ParamsFileError(source, f'cannot read it as YAML: {yaml_problem(exc)}',
+                              None if mark is None else mark.line + 1) from None
+    except (ValueError, RecursionError) as exc:
         reason = ' '.join(str(exc).split()) or type(exc).__name__
-        raise ParamError([(source, f'cannot read it as YAML: {reason[:300]}')]) from None
+        raise ParamsFileError(source, f'cannot read it as YAML: {reason[:300]}') from None
     section = document.get('/**') if isinstance(document, dict) else None
     if not isinstance(section, dict) or not isinstance(section.get('ros__parameters'), dict):
         raise ParamsFileError(source, NOT_PARAMETERS)

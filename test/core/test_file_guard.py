@@ -205,3 +205,10 @@ def test_the_loader_refuses_what_the_guard_refuses():
     with pytest.raises(ParamsFileError) as caught:
         parse_params_text('- a list\n', 'robots.yaml')
     assert "'/**:'" in caught.value.summary
+
+
+def test_what_only_the_full_parse_finds_is_one_line_in_our_words_too():
+    with pytest.raises(ParamsFileError) as caught:
+        parse_params_text(HEADER + '    a: !!python/object:os.system 1\n', 'robots.yaml')
+    assert caught.value.summary == ("robots.yaml line 3: cannot read it as YAML: an unknown '!' "
+                                    'tag (column 8)')
