@@ -112,8 +112,8 @@ def test_num_robots_in_a_node_section_sets_the_limit_too():
     text = ('plant:\n  ros__parameters:\n    num_robots: 5\n    dim: 2\n'
             '    formation:\n      vertices: ' + flow_list(10) + '\n')
     assert check_params_text(text, 'robots.yaml', limits).num_robots == 5
-    assert 'has more than 10 values' in refused(text.replace(flow_list(10), flow_list(11)),
-                                                  limits).summary
+    longer = text.replace(flow_list(10), flow_list(11))
+    assert 'has more than 10 values' in refused(longer, limits).summary
 
 
 @pytest.mark.parametrize('text,line,word', [

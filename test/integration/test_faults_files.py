@@ -45,7 +45,7 @@ def square_text():
 
 
 def with_vertices(values):
-    """The square's file with ``formation.vertices`` replaced by ``values`` (YAML text)."""
+    """Return the square's file with ``formation.vertices`` replaced by ``values`` (YAML)."""
     text = square_text()
     start = text.index('      vertices: ')
     end = text.index('\n', start)
@@ -111,7 +111,7 @@ def refuses(program, text, tmp_path, install, env, problem, line=None):
 
 @pytest.mark.parametrize('program', PROGRAMS)
 def test_a_file_that_expands_is_refused_at_its_first_anchor(program, install, ros_env,
-                                                             tmp_path):
+                                                            tmp_path):
     text = laughs()
     refuses(program, text, tmp_path, install, ros_env, 'YAML anchors are not allowed (&l0)',
             numbered(text, '&l0'))
