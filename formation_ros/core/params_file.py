@@ -23,9 +23,13 @@ import re
 from typing import Any, Dict, Mapping, Union
 
 from formation_ros.core.declarations import ParamError
+from formation_ros.core.file_guard import (check_params_text, ParamsFileError,
+                                           read_params_file_text, yaml_problem)
 import yaml
 
 PathText = Union[str, 'os.PathLike[str]']
+NOT_PARAMETERS = ("expected a ROS 2 parameters file with a top-level '/**:' section holding "
+                  "'ros__parameters:'")
 
 _FLOAT_PATTERN = re.compile(
     r'^(?:[-+]?[0-9][0-9_]*\.[0-9_]*(?:[eE][-+]?[0-9]+)?'
@@ -83,30 +87,33 @@ def load_params_file(path: PathText) -> Dict[str, Any]:
     """
     Read a ROS 2 parameters YAML file and return the flat ``/**`` parameters.
 
-    Raises ParamError (naming the file) when the file is missing or unreadable, is empty or not
-    YAML, or has no ``/**: ros__parameters:`` section.
+    The file is checked before it is parsed in full (:mod:`formation_ros.core.file_guard`:
+    size, anchors, depth, array lengths). Raises ParamError (naming the file; a
+    ParamsFileError for the file as a whole) when the file is missing or unreadable, too
+    large, is empty or not YAML, or has no ``/**: ros__parameters:`` section.
     """
-    try:
-        with open(path, encoding='utf-8') as stream:
-            text = stream.read()
-    except FileNotFoundError:
-        raise ParamError([(str(path), 'file not found')]) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ParamError([(str(path), f'cannot read it: {exc}')]) from None
-    return parse_params_text(text, str(path))
+    return parse_params_text(read_params_file_text(path), str(path))
 
 
 def parse_params_text(text: str, source: str) -> Dict[str, Any]:
-    """Parse ROS 2 parameters YAML text (``source`` names it in errors); return flat values."""
+    """
+    Parse ROS 2 parameters YAML text (``source`` names it in errors); return flat values.
+
+    The text passes :func:`formation_ros.core.file_guard.check_params_text` first.
+    """
+    check_params_text(text, source)
     try:
         document = yaml.load(text, Loader=_Loader)
-    except (yaml.YAMLError, ValueError, RecursionError) as exc:
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, 'problem_mark', None)
+        raise ParamsFileError(source, f'cannot read it as YAML: {yaml_problem(exc)}',
+                              None if mark is None else mark.line + 1) from None
+    except (ValueError, RecursionError) as exc:
         reason = ' '.join(str(exc).split()) or type(exc).__name__
-        raise ParamError([(source, f'cannot read it as YAML: {reason[:300]}')]) from None
+        raise ParamsFileError(source, f'cannot read it as YAML: {reason[:300]}') from None
     section = document.get('/**') if isinstance(document, dict) else None
     if not isinstance(section, dict) or not isinstance(section.get('ros__parameters'), dict):
-        raise ParamError([(source, "expected a ROS 2 parameters file with a top-level '/**:' "
-                                   "section holding 'ros__parameters:'")])
+        raise ParamsFileError(source, NOT_PARAMETERS)
     try:
         return flatten(section['ros__parameters'])
     except RecursionError:

@@ -30,12 +30,13 @@ import time
 from typing import Any, Callable, List, Mapping, Optional, Sequence, Union
 
 from formation_ros.core.declarations import ParamError
+from formation_ros.core.file_guard import (check_params_text, ParamsFileError,
+                                           read_params_file_text)
 from formation_ros.ros.watch import LAUNCHER_PID_ENV, LAUNCHER_START_ENV, process_start
 import rclpy
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
-import yaml
 
 SIGNAL_LATENCY = 0.1
 
@@ -104,22 +105,23 @@ def _params_files(args: List[str]) -> List[str]:
 
 
 def params_file_problem(path: str) -> Optional[str]:
-    """Return what keeps ``path`` from being a parameters file (missing, empty, not YAML)."""
+    """
+    Return, as one line naming ``path``, what keeps it from being a parameters file; or None.
+
+    The file is checked by :mod:`formation_ros.core.file_guard` (size, anchors, depth, array
+    lengths, YAML syntax in this package's words), never parsed in full, and must hold a
+    mapping: rcl parses it only after this, so that none of rcl's or libyaml's own messages
+    reach the user for a file the guard refuses.
+    """
     try:
-        with open(path, encoding='utf-8') as stream:
-            text = stream.read()
-    except FileNotFoundError:
-        return 'not found'
-    except (OSError, UnicodeDecodeError) as exc:
-        return f'cannot be read ({exc})'
-    if not text.strip():
-        return 'is empty'
-    try:
-        document = yaml.safe_load(text)
-    except (yaml.YAMLError, ValueError, RecursionError) as exc:
-        return 'is not YAML: ' + ' '.join(str(exc).split())[:200]
-    if not isinstance(document, dict):
-        return 'is not a ROS 2 parameters file (no mapping of node names to ros__parameters)'
+        shape = check_params_text(read_params_file_text(path), path)
+    except ParamsFileError as exc:
+        return exc.summary
+    if shape.root is None:
+        return f'{path}: is empty'
+    if shape.root != 'mapping':
+        return (f'{path}: is not a ROS 2 parameters file (no mapping of node names to '
+                'ros__parameters)')
     return None
 
 
@@ -128,7 +130,7 @@ def _init(args: Optional[List[str]], name: str) -> bool:
     for path in _params_files(sys.argv if args is None else args):
         problem = params_file_problem(path)
         if problem:
-            print(f'{name}: parameters file {path} {problem}', file=sys.stderr)
+            print(f'{name}: parameters file {problem}', file=sys.stderr)
             return False
     try:
         rclpy.init(args=args, signal_handler_options=SignalHandlerOptions.NO)

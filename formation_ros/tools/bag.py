@@ -27,6 +27,7 @@ from typing import Any, Dict, List, Optional, Tuple
 
 from formation_ros.core.declarations import CommandFrame
 from formation_ros.core.events import timeline_events
+from formation_ros.core.file_guard import read_params_file_text
 from formation_ros.core.frames import advance, FrameSample, from_body_frame
 from formation_ros.core.params import check_shape, FormationConfig, ParamError
 from formation_ros.core.timeline import Mode, named_shape, Shape, TeamState, Timeline
@@ -418,13 +419,17 @@ def repair_bag(path: str) -> str:
 
 
 def bag_params_text(path: str, recorded: Recorded) -> Optional[str]:
-    """Return the parameters YAML stored with a bag (topic, else params.yaml), or None."""
+    """
+    Return the parameters YAML stored with a bag (topic, else params.yaml), or None.
+
+    params.yaml is read within the limits of :mod:`formation_ros.core.file_guard` (raises
+    its ParamsFileError).
+    """
     if recorded.get(names.PARAMS):
         return recorded[names.PARAMS][-1][1].data
     file_path = os.path.join(path, PARAMS_FILE)
     if os.path.isfile(file_path):
-        with open(file_path, encoding='utf-8') as stream:
-            return stream.read()
+        return read_params_file_text(file_path)
     return None
 
 

@@ -157,11 +157,14 @@ def read_parameters(options: 'Options') -> Formation:
     """
     # Imported here so that --help and usage errors need nothing but the standard library.
     from formation_ros.core.declarations import ParamError
+    from formation_ros.core.file_guard import ParamsFileError
     try:
         return read_formation(options.params, plant=not options.no_plant,
                               cmd_topic=options.cmd_topic, source_topic=options.source_topic,
                               robots_per_process=options.robots_per_process,
                               cmd_option='--cmd-topic', source_option='--source-topic')
+    except ParamsFileError as exc:
+        raise UsageError(f'parameters file {exc.summary}') from None
     except ParamError as exc:
         raise UsageError(f'invalid parameters in {options.params}:\n{exc}') from None
     except PlanError as exc:

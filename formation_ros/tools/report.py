@@ -35,6 +35,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from formation_ros.core.declarations import ParamError
 from formation_ros.core.events import Event, events_from_records
+from formation_ros.core.file_guard import ParamsFileError
 from formation_ros.core.frames import FrameSample
 from formation_ros.core.params import FormationConfig, load_config, validate
 from formation_ros.core.params_file import parse_params_text
@@ -62,6 +63,11 @@ def _one_line(text: str) -> str:
     return '; '.join(line.strip() for line in str(text).splitlines() if line.strip())
 
 
+def _param_problem(exc: ParamError) -> str:
+    """Return one line for invalid parameters: a refused file's own line, else every problem."""
+    return exc.summary if isinstance(exc, ParamsFileError) else _one_line(str(exc))
+
+
 def load_bag(path: str, notes: Optional[List[str]] = None) -> Loaded:
     """
     Return (Trajectory, FormationConfig, extra metrics) of a recorded bag (or MCAP file).
@@ -73,7 +79,10 @@ def load_bag(path: str, notes: Optional[List[str]] = None) -> Loaded:
     except BagError as exc:
         raise ReportError(f'cannot read the bag: {exc}') from None
     folder = path if os.path.isdir(path) else os.path.dirname(path)
-    text = bag_params_text(folder, recorded)
+    try:
+        text = bag_params_text(folder, recorded)
+    except ParamsFileError as exc:
+        raise ReportError(exc.summary) from None
     if text is None:
         raise ReportError(f'{path}: the bag has no parameters (no {names.PARAMS} message and '
                           'no '
@@ -83,6 +92,8 @@ def load_bag(path: str, notes: Optional[List[str]] = None) -> Loaded:
     try:
         config = validate(parse_params_text(text, f'{path} parameters'))
         trajectory, info = trajectory_from_topics(recorded, config)
+    except ParamsFileError as exc:
+        raise ReportError(exc.summary) from None
     except (ParamError, BagError) as exc:
         raise ReportError(f'{path}: {_one_line(str(exc))}') from None
     extra: Dict[str, Any] = {'source': 'rosbag2', 'integrator': 'recorded run (rosbag2)',
@@ -106,7 +117,7 @@ def _load_chunks(path: str, params: str, chunks: str, notes: Optional[List[str]]
         config = load_config(params)
         t, q, u = read_chunks(chunks)
     except ParamError as exc:
-        raise ReportError(_one_line(str(exc))) from None
+        raise ReportError(_param_problem(exc)) from None
     except ValueError as exc:
         raise ReportError(_one_line(str(exc))) from None
     if q.shape[1:] != (config.num_robots, config.dim):
@@ -152,7 +163,7 @@ def load_run(path: str, notes: Optional[List[str]] = None) -> Loaded:
     try:
         config = load_config(params)
     except ParamError as exc:
-        raise ReportError(_one_line(str(exc))) from None
+        raise ReportError(_param_problem(exc)) from None
     try:
         trajectory = Trajectory.load(arrays)
     # trajectory.npz from the disk: numpy and zipfile raise many kinds of error on a bad file.

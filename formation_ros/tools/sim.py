@@ -35,6 +35,7 @@ from formation_ros.core.bodies import make_bodies
 from formation_ros.core.declarations import (CommandFrame, DEFAULT_COLLISION_DISTANCE, Exe,
                                              ParamError)
 from formation_ros.core.events import Event, EventKind, timeline_events, with_shapes
+from formation_ros.core.file_guard import ParamsFileError
 from formation_ros.core.frames import desired_positions, FrameSample
 from formation_ros.core.law import team_command
 from formation_ros.core.metrics import body_metrics, compute_metrics, segment_metrics
@@ -626,6 +627,9 @@ def main(argv: Optional[list] = None) -> int:
             config = validate_for_every_executable(load_params_file(args.params))[Exe.SIM]
         else:
             config = load_config(args.params)
+    except ParamsFileError as exc:
+        print(f'formation_sim: {exc.summary}', file=sys.stderr)
+        return 2
     except ParamError as exc:
         print(f'formation_sim: invalid parameters in {args.params}:\n{exc}', file=sys.stderr)
         return 2

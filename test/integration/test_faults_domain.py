@@ -111,8 +111,7 @@ def test_a_robot_names_a_second_reference_publisher(processes, install, probe):
     forged = probe.create_publisher(Odometry, '/formation/reference', qos.REFERENCE)
 
     def named():
-        forged.publish(wire.reference_odometry(None, probe.get_clock().now().nanoseconds,
-                                                   2))
+        forged.publish(wire.reference_odometry(None, probe.get_clock().now().nanoseconds, 2))
         text = value(statuses, 'formation_ros/robot_1', 'topics with more than one publisher')
         return '/formation/reference: /probe, /reference' in text
 

@@ -57,8 +57,7 @@ def test_a_pose_flood_is_not_passed_on_to_cmd_vel(processes, install, probe):
         for _ in range(FLOOD_PER_TICK):
             k = counts['forged'] % FLOOD_PER_STATE
             offset = 0 if k % 2 else 1000 * (k + 1)
-            forger.publish(wire.pose_stamped(start + 0.01 * k, latest['clock_ns'] + offset,
-                                                 2))
+            forger.publish(wire.pose_stamped(start + 0.01 * k, latest['clock_ns'] + offset, 2))
             counts['forged'] += 1
 
     probe.create_timer(period * FLOOD_PER_TICK / FLOOD_PER_STATE, forge)
