@@ -110,17 +110,19 @@ def parameter_problems(declarations: Sequence[Any]) -> List[str]:
             for p in declarations if not str(p.description or '').strip()]
 
 
+def named(param: Any, name: str) -> bool:
+    """Whether ``name`` gives ``param``: its name, or a prefix ending in a dot (``plant.``)."""
+    return param.name == name or (name.endswith('.') and param.name.startswith(name))
+
+
 def select_parameters(declarations: Sequence[Any], names: Sequence[str]) -> List[Any]:
     """Return the declarations ``names`` gives: ``plant.`` every plant.*, ``dim`` that one."""
     if not names:
         return list(declarations)
-    unknown = [n for n in names if not any(p.name == n or (n.endswith('.') and
-                                                            p.name.startswith(n))
-                                           for p in declarations)]
+    unknown = [n for n in names if not any(named(p, n) for p in declarations)]
     if unknown:
         raise DocsError(f"no parameter named or starting with '{unknown[0]}'")
-    return [p for p in declarations
-            if any(p.name == n or (n.endswith('.') and p.name.startswith(n)) for n in names)]
+    return [p for p in declarations if any(named(p, n) for n in names)]
 
 
 def unlisted_parameters(declarations: Sequence[Any], listed: Iterable[str]) -> List[str]:
@@ -331,8 +333,8 @@ def robustness_limits(data: Mapping[str, Any]) -> List[str]:
     for sweep, per_config in limits.items():
         entry = sweeps[sweep]
         values = [row['value'] for row in entry['rows'] if row['config'] == configs[0]]
-        cells = [f"{sweep} ({code(entry['parameter'])}, {entry['unit']}; swept "
-                 f'{values[0]} to {values[-1]})']
+        cells = [f"{sweep} ({code(entry['parameter'])}, {entry['unit']}; the ideal "
+                 f'{values[0]}, then {values[1]} to {values[-1]})']
         for config in configs:
             found = per_config[config]
             broke = [row for row in entry['rows'] if row['config'] == config
