@@ -7,7 +7,7 @@ The formation messages as CDR bytes: read into numpy and written from numpy, wit
 rclpy turns every message it receives into Python objects and every message it publishes back
 into C structures, field by field: a PoseArray costs one ``Pose``, ``Point`` and ``Quaternion``
 per element, an Odometry two 36-element covariance arrays. In a team of robots that was most of
-the CPU time of every process (profiles in docs/benchmarks.md). Subscriptions with ``raw=True`` hand over
+the CPU time of every process (docs/benchmarks.md). Subscriptions with ``raw=True`` hand over
 the serialized bytes, and ``Publisher.publish`` takes bytes, so the hot topics (``pose``,
 ``neighbors``, ``cmd_vel``, ``/formation/reference``, ``/clock``) go through this module: the
 same messages on the wire, read and written with a few ``struct`` and numpy calls.
