@@ -95,7 +95,7 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
             parser.error(f'--figure: no such file: {unreadable[0]}')
     elif not os.access(os.path.join(args.prefix, 'lib', 'formation_ros', 'plant'), os.X_OK):
         parser.error(f"no formation_ros install at --prefix '{args.prefix}' (build one with "
-                     'colcon, see README)')
+                     'colcon, see docs/ros_interface.md)')
     args.prefix = os.path.abspath(args.prefix)
     if args.out is None:
         stamp = datetime.datetime.now().strftime('%Y%m%d-%H%M%S')

@@ -124,7 +124,7 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
         args.json = os.path.join(args.out, 'orphans.json')
     if not os.access(os.path.join(args.prefix, 'lib', 'formation_ros', 'plant'), os.X_OK):
         parser.error(f"no formation_ros install at --prefix '{args.prefix}' (build one with "
-                     'colcon, see README)')
+                     'colcon, see docs/ros_interface.md)')
     args.prefix = os.path.abspath(args.prefix)
     args.params = os.path.abspath(args.params)
     return args

@@ -31,4 +31,5 @@ suppress_warnings = []
 
 html_theme = 'sphinx_rtd_theme'
 html_title = 'formation_ros'
-html_static_path = []
+html_static_path = ['_static']
+html_css_files = ['formation.css']

@@ -95,6 +95,23 @@ def test_a_parameter_without_a_description_fails_the_build(tmp_path, monkeypatch
     assert "parameter 'controller.gain' has no description" in warnings, warnings
 
 
+def test_a_parameter_in_no_table_fails_the_build(tmp_path):
+    page = ('# Reference\n\n```{formation-parameters} plant.\n```\n\n'
+            '```{formation-parameters} relay.\n```\n')
+    source = write_pages(tmp_path / 'src', index=INDEX, reference=page)
+    status, warnings = sphinx_build(source, tmp_path / 'out')
+    assert status != 0
+    assert "parameter 'controller.gain' is in no parameter table" in warnings, warnings
+    assert "'plant.rate' is in no" not in warnings and "'relay.rate' is in no" not in warnings
+
+
+def test_a_parameter_group_is_its_prefix_or_its_name():
+    chosen = formation_docs.select_parameters(declarations.DECLARATIONS, ['dim', 'jump.'])
+    assert [p.name for p in chosen] == ['dim', 'jump.kind', 'jump.order']
+    with pytest.raises(formation_docs.DocsError, match='nothing.'):
+        formation_docs.select_parameters(declarations.DECLARATIONS, ['nothing.'])
+
+
 @pytest.mark.parametrize('page, says', [
     ('# Reference\n\nSee [the lab](lab.md).\n', 'lab'),
     ('# Reference\n\nSee [the lab](#no-such-heading).\n', 'no-such-heading'),

@@ -6,9 +6,10 @@ Sphinx extension: the reference parts of the docs, generated from the package's 
 
 Directives (each writes MyST Markdown that the page then parses):
 
-* ``formation-parameters``: every parameter of ``core/declarations.py`` (name, type, default,
-  range, who reads it, meaning). A parameter without a description is a build warning (an
-  error with ``-W``).
+* ``formation-parameters [NAMES]``: the parameters of ``core/declarations.py`` (name, type,
+  default, range, who reads it, meaning): those NAMES gives (``plant.`` a prefix, ``dim`` one
+  name), or all of them. A parameter without a description, or one that no table of the docs
+  lists, is a build warning (an error with ``-W``).
 * ``formation-topics``: every topic of ``ros/topics.py`` with its type and the QoS profile of
   ``ros/qos.py``. The directive's body gives one line ``NAME: what it carries`` per topic; a
   topic without a line, or a line naming no topic, is a warning.
@@ -107,6 +108,28 @@ def parameter_problems(declarations: Sequence[Any]) -> List[str]:
     """Return what keeps the reference from being complete: names without a description."""
     return [f"parameter '{p.name}' has no description in core/declarations.py"
             for p in declarations if not str(p.description or '').strip()]
+
+
+def named(param: Any, name: str) -> bool:
+    """Whether ``name`` gives ``param``: its name, or a prefix ending in a dot (``plant.``)."""
+    return param.name == name or (name.endswith('.') and param.name.startswith(name))
+
+
+def select_parameters(declarations: Sequence[Any], names: Sequence[str]) -> List[Any]:
+    """Return the declarations ``names`` gives: ``plant.`` every plant.*, ``dim`` that one."""
+    if not names:
+        return list(declarations)
+    unknown = [n for n in names if not any(named(p, n) for p in declarations)]
+    if unknown:
+        raise DocsError(f"no parameter named or starting with '{unknown[0]}'")
+    return [p for p in declarations if any(named(p, n) for n in names)]
+
+
+def unlisted_parameters(declarations: Sequence[Any], listed: Iterable[str]) -> List[str]:
+    """Return the problems of a docs build whose tables leave parameters out."""
+    shown = set(listed)
+    return [f"parameter '{p.name}' is in no parameter table of the docs"
+            for p in declarations if p.name not in shown]
 
 
 def parameter_markdown(declarations: Sequence[Any]) -> List[str]:
@@ -314,8 +337,8 @@ def robustness_limits(data: Mapping[str, Any]) -> List[str]:
     for sweep, per_config in limits.items():
         entry = sweeps[sweep]
         values = [row['value'] for row in entry['rows'] if row['config'] == configs[0]]
-        cells = [f"{sweep} ({code(entry['parameter'])}, {entry['unit']}; swept "
-                 f'{values[0]} to {values[-1]})']
+        cells = [f"{sweep} ({code(entry['parameter'])}, {entry['unit']}; the ideal "
+                 f'{values[0]}, then {values[1]} to {values[-1]})']
         for config in configs:
             found = per_config[config]
             broke = [row for row in entry['rows'] if row['config'] == config
@@ -375,6 +398,8 @@ class Generated(Directive):
     final_argument_whitespace = False
     reads: Tuple[str, ...] = ()
     """Files (relative to the repository) the output depends on: a change rebuilds the page."""
+    kind = 'table'
+    """The HTML class ``formation-<kind>`` of the generated part (docs/_static/formation.css)."""
 
     def markdown(self) -> Tuple[List[str], List[str]]:
         """Return the Markdown lines and the problems found."""
@@ -396,28 +421,58 @@ class Generated(Directive):
             env.note_dependency(os.path.join(ROOT, path))
         for problem in problems:
             LOG.warning(problem, location=(env.docname, line), type='formation_docs')
-        container = nodes.container(classes=['formation-generated'])
+        container = nodes.container(classes=['formation-generated', f'formation-{self.kind}'])
         self.state.nested_parse(StringList(lines, source=source), self.content_offset,
                                 container)
         return container.children
 
 
 class Parameters(Generated):
-    """``formation-parameters``: the parameter reference."""
+    """``formation-parameters [NAMES]``: the parameter reference, or a part of it."""
 
     has_content = False
+    final_argument_whitespace = True
     reads = ('formation_ros/core/declarations.py',)
+    kind = 'parameters'
 
     def markdown(self) -> Tuple[List[str], List[str]]:
-        """Return the parameter table of core/declarations.py."""
+        """Return the table of the parameters named (all without a name)."""
         from formation_ros.core.declarations import DECLARATIONS
-        return parameter_markdown(DECLARATIONS), parameter_problems(DECLARATIONS)
+        chosen = select_parameters(DECLARATIONS, self.arguments[0].split() if self.arguments
+                                   else [])
+        env = self.state.document.settings.env
+        listed = getattr(env, 'formation_parameters', {})
+        listed.setdefault(env.docname, set()).update(p.name for p in chosen)
+        env.formation_parameters = listed
+        return parameter_markdown(chosen), parameter_problems(chosen)
+
+
+def purge_parameters(app: Any, env: Any, docname: str) -> None:
+    """Forget the parameters a page listed before it is read again."""
+    getattr(env, 'formation_parameters', {}).pop(docname, None)
+
+
+def merge_parameters(app: Any, env: Any, docnames: Any, other: Any) -> None:
+    """Take the parameters listed by pages read in another process (parallel builds)."""
+    listed = getattr(env, 'formation_parameters', {})
+    listed.update(getattr(other, 'formation_parameters', {}))
+    env.formation_parameters = listed
+
+
+def check_parameters(app: Any, env: Any) -> None:
+    """Warn about parameters that no table lists, once some page has parameter tables."""
+    from formation_ros.core.declarations import DECLARATIONS
+    listed = getattr(env, 'formation_parameters', {})
+    if listed:
+        for problem in unlisted_parameters(DECLARATIONS, set().union(*listed.values())):
+            LOG.warning(problem, type='formation_docs')
 
 
 class Topics(Generated):
     """``formation-topics``: the topic table; the body describes each topic."""
 
     reads = ('formation_ros/ros/topics.py', 'formation_ros/ros/qos.py')
+    kind = 'topics'
 
     def markdown(self) -> Tuple[List[str], List[str]]:
         """Return the topic table and the topics that lack (or have a stray) description."""
@@ -488,5 +543,8 @@ def setup(app: Any) -> Dict[str, Any]:
                             ('formation-argparse', Arguments), ('formation-usage', Usage),
                             ('formation-bench', Bench)):
         app.add_directive(name, directive)
+    app.connect('env-purge-doc', purge_parameters)
+    app.connect('env-merge-info', merge_parameters)
+    app.connect('env-check-consistency', check_parameters)
     return {'version': '1', 'parallel_read_safe': True, 'parallel_write_safe': True,
             'env_version': 1}

@@ -350,7 +350,7 @@ def find_install(prefix: Optional[str], env: Mapping[str, str]) -> Install:
         prefix = next((p for p in candidates if _has_plant(p)), None)
         if prefix is None:
             raise UsageError("formation_ros is not installed: build it with 'colcon build' "
-                             '(see README) or pass --prefix INSTALL_DIR')
+                             '(docs/ros_interface.md) or pass --prefix INSTALL_DIR')
     if not _has_plant(prefix):
         raise UsageError(f'no {os.path.join(prefix, "lib", PACKAGE, "plant")}')
     return Install(os.path.abspath(prefix))
