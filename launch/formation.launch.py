@@ -4,7 +4,7 @@
 """
 Start a whole formation with ``ros2 launch``: the system that scripts/launch_formation.sh starts.
 
-The plant, the reference node on the plant's simulated time, and one ``robot`` node per robot
+The plant, and on its simulated time the reference node and one ``robot`` node per robot
 (namespace ``/robot_<i>``, ``robot_id`` i; with ``robots_per_process`` above 1, ``fleet``
 processes of that many robot nodes each), all with one parameters file; ``num_robots`` is read
 from that file, which is checked as the launcher checks it. The first node to exit ends the
