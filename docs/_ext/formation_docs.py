@@ -479,16 +479,20 @@ class Topics(Generated):
         return topic_markdown(parse_descriptions(self.content))
 
 
-class Arguments(Generated):
-    """``formation-argparse MODULE:FUNCTION``: the options of a command line."""
+class _OneArgument(Generated):
+    """A generated table of one ``MODULE:NAME`` (or script) argument, without content."""
 
     has_content = False
     required_arguments = 1
     optional_arguments = 0
 
     def inputs(self) -> Tuple[str, ...]:
-        """Return the module's file."""
+        """Return the module's (or the script's) file."""
         return (module_file(self.arguments[0]),)
+
+
+class Arguments(_OneArgument):
+    """``formation-argparse MODULE:FUNCTION``: the options of a command line."""
 
     def markdown(self) -> Tuple[List[str], List[str]]:
         """Return the options of the parser FUNCTION builds."""
@@ -498,16 +502,8 @@ class Arguments(Generated):
         return argparse_markdown(parser), []
 
 
-class Usage(Generated):
+class Usage(_OneArgument):
     """``formation-usage MODULE:NAME`` or ``formation-usage scripts/X.sh``: a usage text."""
-
-    has_content = False
-    required_arguments = 1
-    optional_arguments = 0
-
-    def inputs(self) -> Tuple[str, ...]:
-        """Return the module's (or the script's) file."""
-        return (module_file(self.arguments[0]),)
 
     def markdown(self) -> Tuple[List[str], List[str]]:
         """Return the usage text as a literal block."""

@@ -31,7 +31,9 @@ One team per domain: before its first state the plant looks for :data:`LOOK_TIME
 one, another plant or anything else, that sends ``/clock`` or announces itself on
 ``/diagnostics`` from another process, the plant refuses to start: one line naming it and its
 host, exit 2. A silent one with the plant's own name is taken for a killed plant's leftover (DDS
-forgets it within about 20 s): said once, and the plant starts. While running, it looks up the
+forgets it within about 20 s): said once, and the plant starts. Until its first step (while
+its clock waits for the robots) it goes on looking every :data:`LOOK_PERIOD` s, since discovery
+on a busy machine can take longer than the look. While running, it looks up the
 graph once a second (:class:`formation_ros.ros.team.PublisherWatch`) for a second publisher on
 ``/clock``, a robot's ``pose``, ``neighbors`` or ``cmd_vel``: ERROR in ``/diagnostics`` and
 one log line per topic, naming the other publisher.
@@ -100,6 +102,8 @@ at no cost: the robots take longer than that to start."""
 LOOK_LIMIT = 5.0
 """With another /clock publisher found, how long the plant waits to hear its host on
 /diagnostics before refusing without it, s."""
+LOOK_PERIOD = 0.5
+"""Seconds between looks at the graph while the clock waits for the robots."""
 
 
 class PlantNode(Node):
@@ -123,6 +127,7 @@ class PlantNode(Node):
         self.refusal: Optional[str] = None
         self.exit_code: Optional[int] = None
         self.looked = False
+        self.next_look = 0.0
         self.created_wall = time.monotonic()
         self.clock_heard = 0
         self.graph = PublisherWatch(self, self.team)
@@ -283,6 +288,7 @@ class PlantNode(Node):
             self._publish()
             return
         if self.waiting and not self._all_robots_up():
+            self._look_while_waiting()
             return
         if self.lockstep:
             self._lockstep_tick()
@@ -303,9 +309,7 @@ class PlantNode(Node):
         waited = now - self.created_wall
         if waited < LOOK_TIME or self.refusal:
             return False
-        others = self.graph.publishers(self.clock_pub.topic_name)
-        if self.own_name in others:
-            others.remove(self.own_name)
+        others = self._other_clock_publishers()
         if not others:
             return self._looked()
         running = any(self.team.running(name, now) for name in others)
@@ -318,6 +322,34 @@ class PlantNode(Node):
             return self._looked()
         if not running and waited < LOOK_LIMIT:
             return False
+        self._refuse(others, now)
+        return False
+
+    def _other_clock_publishers(self) -> List[str]:
+        """Return the /clock publishers of the graph other than this node (one per writer)."""
+        others = self.graph.publishers(self.clock_pub.topic_name)
+        if self.own_name in others:
+            others.remove(self.own_name)
+        return others
+
+    def _look_while_waiting(self) -> None:
+        """
+        While the clock waits for the robots: refuse another team's /clock publisher found late.
+
+        Discovery on a busy machine can take longer than LOOK_TIME; until the first step a
+        publisher with another name, or one that announces itself from another process, still
+        means another team, and this plant has not moved a body yet.
+        """
+        now = time.monotonic()
+        if now < self.next_look or self.refusal:
+            return
+        self.next_look = now + LOOK_PERIOD
+        others = self._other_clock_publishers()
+        if any(name != self.own_name or self.team.running(name, now) for name in others):
+            self._refuse(others, now)
+
+    def _refuse(self, others: List[str], now: float) -> None:
+        """Log once why this plant will not start (``others`` publish /clock) and exit REFUSED."""
         plants = [name for name in others if name.rsplit('/', 1)[-1] == 'plant']
         what = 'plant' if plants else '/clock publisher'
         self.refusal = (f'refusing to start: another {what} is on ROS_DOMAIN_ID '
@@ -327,7 +359,6 @@ class PlantNode(Node):
                         'ROS_DOMAIN_ID=N, or the launcher without ROS_DOMAIN_ID set)')
         self.get_logger().error(self.refusal)
         self.exit_code = REFUSED
-        return False
 
     def _looked(self) -> bool:
         self.looked = True

@@ -60,11 +60,11 @@ Usage: scripts/launch_formation.sh PARAMS.yaml [--duration S] [--out DIR] [--rec
                                    [--no-plant [--cmd-topic TEMPLATE] [--source-topic TEMPLATE]]
 
 Starts the plant, the reference node and N robot nodes (N = num_robots in PARAMS.yaml), robot i
-in namespace /robot_<i>, all with the same parameters file, the reference node and the robots
-on the plant's simulated time (/clock). With --no-plant (a lab), the relay instead of the plant, and the
-reference node and the robots on wall-clock time. Output lines are prefixed with the node's
-name. Stops every process it started when the duration ends, on Ctrl-C, SIGTERM or SIGHUP
-(then still writes the report of --out / --record), and when the plant (the relay), the
+in namespace /robot_<i>, all with the same parameters file, the reference node and robots
+on the plant's simulated time (/clock). With --no-plant (a lab), the relay instead of the
+plant, and the reference node and the robots on wall-clock time. Output lines are prefixed with
+the node's name. Stops every process it started when the duration ends, on Ctrl-C, SIGTERM or
+SIGHUP (then still writes the report of --out / --record), and when the plant (the relay), the
 reference node or the recorder exits on its own; what happens when a robot exits on its own is
 set by --on-exit. If the launcher itself is killed (even with kill -9), every node notices
 within 0.1 s and stops as on Ctrl-C.

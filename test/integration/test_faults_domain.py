@@ -80,13 +80,19 @@ def test_a_plant_refuses_a_domain_with_another_clock(processes, install, probe):
     assert 'another /clock publisher' in line and '/probe (host unknown' in line, line
 
 
-def test_a_running_plant_names_a_second_publisher_on_pose_and_cmd_vel(processes, install, probe):
-    statuses = statuses_of(probe)
+def start_plant_and_robot_1(processes, install, probe):
+    """Start a plant that does not wait for robots and robot 1; return the clock once it runs."""
     processes.start(node(install, 'plant', SQUARE, '-p', 'plant.wait_for_robots:=false'))
     processes.start(node(install, 'robot', SQUARE, '-r', '__ns:=/robot_1',
                          '-p', 'use_sim_time:=true', process='robot_1'))
     clock = SimClock(probe)
     assert probe.spin_until(lambda: clock.seconds > 0.5, START_UP), processes.log('plant')
+    return clock
+
+
+def test_a_running_plant_names_a_second_publisher_on_pose_and_cmd_vel(processes, install, probe):
+    statuses = statuses_of(probe)
+    start_plant_and_robot_1(processes, install, probe)
     commands = probe.create_publisher(TwistStamped, '/robot_1/cmd_vel', qos.COMMAND)
     poses = probe.create_publisher(PoseStamped, '/robot_1/pose', qos.STATE)
 
@@ -124,11 +130,7 @@ def test_a_robot_names_a_second_reference_publisher(processes, install, probe):
 
 def test_a_robot_on_two_clocks_names_them_instead_of_advising_use_sim_time(
         processes, install, probe):
-    processes.start(node(install, 'plant', SQUARE, '-p', 'plant.wait_for_robots:=false'))
-    processes.start(node(install, 'robot', SQUARE, '-r', '__ns:=/robot_1',
-                         '-p', 'use_sim_time:=true', process='robot_1'))
-    clock = SimClock(probe)
-    assert probe.spin_until(lambda: clock.seconds > 0.5, START_UP), processes.log('plant')
+    start_plant_and_robot_1(processes, install, probe)
     other = probe.create_publisher(ClockMsg, '/clock', qos.CLOCK)
     far = ClockMsg()
     far.clock = messages.ns_to_stamp(1000 * 10 ** 9)
