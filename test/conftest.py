@@ -1,7 +1,14 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""Test isolation: each run talks DDS on its own domain, on this host only, signals as default."""
+"""
+Test isolation: each run talks DDS on its own domain, on this host only, signals as default.
+
+Under pytest-xdist every worker has a domain of its own: the controlling process draws the
+first domain of the run before it starts the workers (they inherit it as
+``FORMATION_TEST_DOMAIN``), and worker ``gw<k>`` takes the k-th domain after it, so two
+workers never hear each other's nodes.
+"""
 
 import os
 import random
@@ -9,7 +16,22 @@ import signal
 
 import pytest
 
-os.environ['ROS_DOMAIN_ID'] = str(random.SystemRandom().randint(1, 101))
+DOMAINS = 101
+"""Domain ids 1..101 (the largest that Fast DDS's default ports allow for many participants)."""
+
+
+def _domain_of_this_process():
+    """Return the ROS_DOMAIN_ID of this process: the run's first, or a worker's own."""
+    first = os.environ.get('FORMATION_TEST_DOMAIN')
+    if first is None:
+        first = str(random.SystemRandom().randint(1, DOMAINS))
+        os.environ['FORMATION_TEST_DOMAIN'] = first
+    worker = os.environ.get('PYTEST_XDIST_WORKER', '')
+    index = int(worker[2:]) if worker.startswith('gw') and worker[2:].isdigit() else 0
+    return (int(first) - 1 + index) % DOMAINS + 1
+
+
+os.environ['ROS_DOMAIN_ID'] = str(_domain_of_this_process())
 os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
 os.environ.setdefault('MPLBACKEND', 'Agg')
 
@@ -24,6 +46,10 @@ for _number in (signal.SIGINT, signal.SIGTERM):
 
 def pytest_report_header(config):
     """Show the DDS domain of this run in pytest's header."""
+    workers = getattr(config.option, 'numprocesses', None)
+    if workers:
+        return (f"ROS_DOMAIN_ID={os.environ['ROS_DOMAIN_ID']} and the next ones, one per "
+                'xdist worker (discovery: localhost only)')
     return f"ROS_DOMAIN_ID={os.environ['ROS_DOMAIN_ID']} (discovery: localhost only)"
 
 

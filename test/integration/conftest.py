@@ -4,9 +4,12 @@
 """
 Fixtures of the integration tests: a colcon install space, supervised processes, a probe node.
 
-The install space is built once per test run with ``python -m colcon build`` into a temporary
-directory; every executable is started from it, as ``ros2 run`` would, with the test run's
-ROS_DOMAIN_ID and discovery limited to this host. Processes run under
+The install space is built once per test process with ``python -m colcon build`` into a
+temporary directory; every executable is started from it, as ``ros2 run`` would, with the test
+process's ROS_DOMAIN_ID and discovery limited to this host. Under pytest-xdist each worker
+builds its own (a few seconds; the builds write nothing into the source tree), in its own
+temporary directory: its path is in every command line of the worker's processes, so
+``helpers.project_processes`` never counts another worker's processes. Processes run under
 :class:`formation_ros.tools.supervise.Supervisor`, each in its own process group with its
 output in ``<tmp_path>/logs/<name>.log``, and are all ended when the test ends, pass or fail.
 Helpers for the tests are in ``helpers.py``.
