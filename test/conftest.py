@@ -1,7 +1,14 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""Test isolation: each run talks DDS on its own domain, on this host only, signals as default."""
+"""
+Test isolation: each run talks DDS on its own domain, on this host only, signals as default.
+
+Under pytest-xdist every worker has a domain of its own: the controlling process draws the
+first domain of the run before it starts the workers (they inherit it as
+``FORMATION_TEST_DOMAIN``), and worker ``gw<k>`` takes the k-th domain after it, so two
+workers never hear each other's nodes.
+"""
 
 import os
 import random
@@ -10,9 +17,33 @@ import signal
 from formation_ros.tools.domain import ports_busy
 import pytest
 
-_DOMAINS = random.SystemRandom().sample(range(1, 102), 101)
-os.environ['ROS_DOMAIN_ID'] = str(next((d for d in _DOMAINS if not ports_busy(d)), _DOMAINS[0]))
-"""A domain no participant of this host is on (another test run's plant would refuse ours)."""
+DOMAINS = 101
+"""Domain ids 1..101 (the largest that Fast DDS's default ports allow for many participants)."""
+LOOK_AHEAD = 8
+"""Domains from the run's first that must be free: one per worker, at most this many workers."""
+
+
+def _free_first_domain():
+    """Return a first domain with LOOK_AHEAD free ones from it (another run's plant refuses)."""
+    candidates = random.SystemRandom().sample(range(1, DOMAINS + 1), DOMAINS)
+    for first in candidates:
+        if not any(ports_busy((first - 1 + k) % DOMAINS + 1) for k in range(LOOK_AHEAD)):
+            return first
+    return candidates[0]
+
+
+def _domain_of_this_process():
+    """Return the ROS_DOMAIN_ID of this process: the run's first, or a worker's own."""
+    first = os.environ.get('FORMATION_TEST_DOMAIN')
+    if first is None:
+        first = str(_free_first_domain())
+        os.environ['FORMATION_TEST_DOMAIN'] = first
+    worker = os.environ.get('PYTEST_XDIST_WORKER', '')
+    index = int(worker[2:]) if worker.startswith('gw') and worker[2:].isdigit() else 0
+    return (int(first) - 1 + index) % DOMAINS + 1
+
+
+os.environ['ROS_DOMAIN_ID'] = str(_domain_of_this_process())
 os.environ['ROS_AUTOMATIC_DISCOVERY_RANGE'] = 'LOCALHOST'
 os.environ.setdefault('MPLBACKEND', 'Agg')
 
@@ -27,6 +58,10 @@ for _number in (signal.SIGINT, signal.SIGTERM):
 
 def pytest_report_header(config):
     """Show the DDS domain of this run in pytest's header."""
+    workers = getattr(config.option, 'numprocesses', None)
+    if workers:
+        return (f"ROS_DOMAIN_ID={os.environ['ROS_DOMAIN_ID']} and the next ones, one per "
+                'xdist worker (discovery: localhost only)')
     return f"ROS_DOMAIN_ID={os.environ['ROS_DOMAIN_ID']} (discovery: localhost only)"
 
 

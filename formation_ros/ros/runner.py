@@ -26,6 +26,7 @@ import gc
 import os
 import signal
 import sys
+import threading
 import time
 from typing import Any, Callable, List, Mapping, Optional, Sequence, Union
 
@@ -39,6 +40,13 @@ from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
 
 SIGNAL_LATENCY = 0.1
+TEARDOWN_LIMIT = 5.0
+"""
+Seconds the destruction of the nodes and rclpy's shutdown may take once every node has finished
+(its files written): they take well under a second, but a Fast DDS lock-order deadlock between
+a reader being destroyed and the liveliness thread can hang them for ever (seen once in about
+90 launcher kills), and signals are ignored by then. The process then ends without them.
+"""
 
 
 def make_executor() -> Executor:
@@ -257,11 +265,22 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
         requested = _exit_request(nodes)
         if requested is not None and code == 0:
             code = requested
+        watchdog = threading.Timer(TEARDOWN_LIMIT, _teardown_hung, args=(name, code))
+        watchdog.daemon = True
+        watchdog.start()
         for node in nodes:
             node.destroy_node()
         if executor is not None:
             executor.shutdown()
         rclpy.try_shutdown()
+        watchdog.cancel()
         if orphaned:
             _exit_now(code)
     return code
+
+
+def _teardown_hung(name: str, code: int) -> None:
+    """End a process whose DDS teardown has not returned in TEARDOWN_LIMIT s (work saved)."""
+    print(f'{name}: the DDS teardown did not end within {TEARDOWN_LIMIT:g} s; exiting without it',
+          file=sys.stderr)
+    _exit_now(code)

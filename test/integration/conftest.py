@@ -4,23 +4,30 @@
 """
 Fixtures of the integration tests: a colcon install space, supervised processes, a probe node.
 
-The install space is built once per test run with ``python -m colcon build`` into a temporary
-directory; every executable is started from it, as ``ros2 run`` would, with the test run's
-ROS_DOMAIN_ID and discovery limited to this host. Processes run under
+The install space is built once per test process with ``python -m colcon build`` into a
+temporary directory; every executable is started from it, as ``ros2 run`` would, with the test
+process's ROS_DOMAIN_ID and discovery limited to this host. Under pytest-xdist each worker
+builds its own (a few seconds; the builds write nothing into the source tree), in its own
+temporary directory: its path is in every command line of the worker's processes, so
+``helpers.project_processes`` never counts another worker's processes. Processes run under
 :class:`formation_ros.tools.supervise.Supervisor`, each in its own process group with its
 output in ``<tmp_path>/logs/<name>.log``, and are all ended when the test ends, pass or fail.
 Helpers for the tests are in ``helpers.py``.
 """
 
 import os
+import signal
 import subprocess
 import sys
 import time
 
 from formation_ros.tools.launcher import Install
 from formation_ros.tools.supervise import Supervisor
-from helpers import ROOT
+from helpers import project_processes, ROOT
 import pytest
+
+LEFT_WITHIN = 20.0
+"""Seconds a test's processes may take to end after it (a node sees its launcher gone in 1 s)."""
 
 
 @pytest.fixture(scope='session')
@@ -49,6 +56,32 @@ def processes(ros_env, tmp_path):
     """Give the test a Supervisor with logs in tmp_path/logs; it ends them all afterwards."""
     with Supervisor(log_dir=str(tmp_path / 'logs'), env=ros_env) as supervisor:
         yield supervisor
+
+
+@pytest.fixture(autouse=True)
+def _no_process_left(request):
+    """
+    Fail a test whose processes outlive it, and kill them so that the tests after it can run.
+
+    A node that hangs while it ends (seen once: Fast DDS deadlocked deleting a reader after
+    its launcher was killed) would otherwise stay on the worker's domain and in its process
+    table, and every later test that counts processes or nodes would fail too.
+    """
+    yield
+    if 'install' not in request.fixturenames:
+        return
+    install = request.getfixturevalue('install')
+    deadline = time.monotonic() + LEFT_WITHIN
+    while project_processes(install) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    left = project_processes(install)
+    for line in left:
+        try:
+            os.kill(int(line.split()[0]), signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+    assert not left, f'processes left running {LEFT_WITHIN:g} s after the test (killed):\n' + \
+        '\n'.join(left)
 
 
 @pytest.fixture

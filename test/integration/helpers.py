@@ -120,7 +120,12 @@ def stop_when(probe, processes, condition, timeout=START_UP, name='launcher'):
 
 
 def project_processes(install):
-    """Command lines of the running processes that mention the install space."""
+    """
+    Command lines of the running processes that mention the install space.
+
+    Each pytest-xdist worker has an install space of its own (conftest.py), so this sees only
+    the processes of the worker's tests, orphans of a killed launcher included.
+    """
     listing = subprocess.run(['ps', '-ww', '-eo', 'pid=,args='], capture_output=True,
                              text=True, check=True).stdout
     return [line for line in listing.splitlines() if install in line]

@@ -24,6 +24,9 @@ from test_parameters import call
 import yaml
 
 SIX = os.path.join(CONFIG, 'circle_2d.yaml')
+SETTLED = 10.0
+"""Simulated seconds after which the six robots track the circle (formation_sim: within 0.014 m
+at 5 s, 0.002 m at 6 s; test_system's one-robot processes are held to 0.02 m at 10 s)."""
 
 
 def fleet_pids(install, name_part):
@@ -36,7 +39,7 @@ def test_six_robots_in_two_fleet_processes_converge(processes, install, probe, t
     clock = SimClock(probe)
     out = tmp_path / 'run'
     launch(processes, install, SIX, out=out, options=('--robots-per-process', '3'))
-    info = stop_when(probe, processes, lambda: clock.seconds > 20.0)
+    info = stop_when(probe, processes, lambda: clock.seconds > SETTLED)
     log = processes.log('launcher')
     assert info.returncode == 0, log
     assert '6 robots in 2 fleet processes of up to 3' in log, log

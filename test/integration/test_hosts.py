@@ -10,7 +10,9 @@ that notes the simulated time; robots 1 and 3 run on host ``robots_1``, robots 2
 (UDP, no shared memory), so the tests can cut a link or drop 20 % of its packets. Outcomes come
 from the recorded bag on the plant's host (``formation_report``'s metrics), from probes inside
 the robot hosts, and from the process and namespace tables. Every test also checks that its
-run left no namespace and no process behind.
+run left no namespace and no process behind. Under pytest-xdist they all run on one worker
+(group ``hosts``), one after another: each compares the computer's own links and nftables
+rules before and after, and a multi-host run is timed by its own busy processes.
 """
 
 import dataclasses
@@ -34,7 +36,7 @@ from helpers import project_processes, SQUARE, START_UP, write_params
 import numpy as np
 import pytest
 
-pytestmark = pytest.mark.hosts
+pytestmark = [pytest.mark.hosts, pytest.mark.xdist_group('hosts')]
 
 PROBE = os.path.join(os.path.dirname(os.path.abspath(__file__)), 'hosts_probe.py')
 ROBOT_HOSTS = 2
@@ -43,7 +45,7 @@ SETTLED = 0.05
 
 _REASON = hosts_module.unavailable(loss=True)
 if _REASON is not None:
-    pytestmark = [pytestmark, pytest.mark.skip(reason=f'multi-host tests: {_REASON}')]
+    pytestmark = [*pytestmark, pytest.mark.skip(reason=f'multi-host tests: {_REASON}')]
 
 
 def root_links():
