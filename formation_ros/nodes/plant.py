@@ -484,7 +484,11 @@ class PlantNode(Node):
         self.waiting = False
         self.started_wall = time.monotonic()
         self.rate_window = (self.started_wall, self.model.counts.steps)
-        self.once.end('waiting', f'all {self.n} robots are up: starting the clock')
+        started = f'all {self.n} robots are up: starting the clock'
+        if self.once.is_active('waiting'):
+            self.once.end('waiting', started)
+        else:
+            self.get_logger().info(started)
         self._publish()
         return True
 

@@ -87,8 +87,10 @@ LAST_WORD = 0.5
 RATE_TOLERANCE = 1e-3
 INPUTS = ('pose', 'neighbour', 'reference')
 COPY_GAP_NS = 25_000_000
-"""A copy of the state answered last that arrives sooner than this after the previous state
-counts as flooding (the plant sends a state again 0.05 s after the last, while it waits)."""
+"""A copy of the state answered last that arrives sooner than this after the previous state is
+a fast copy (the plant sends a state again 0.05 s after the last while it waits, and once more
+when it starts its clock); more than FAST_COPIES of them in a row count as flooding."""
+FAST_COPIES = 3
 
 
 class Reason(enum.Enum):
@@ -155,6 +157,7 @@ class RobotNode(Node):
         self.flooded_reported = 0
         self.flood_stamp: Optional[int] = None
         self.copy_arrived_ns = 0
+        self.fast_copies = 0
         self.graph = PublisherWatch(self)
         self.shared: Dict[str, str] = {}
 
@@ -470,12 +473,15 @@ class RobotNode(Node):
         """
         Whether the state stamped ``stamp`` is answered: a new one, within the answer budget.
 
-        A copy of the state answered last is not (it counts as flooding when it comes within
-        COPY_GAP_NS of the previous state); a new state beyond the budget counts as flooding.
+        A copy of the state answered last is not (more than FAST_COPIES in a row, each within
+        COPY_GAP_NS of the one before, count as flooding); a new state beyond the budget counts
+        as flooding.
         """
         now = self._now_ns()
         if stamp == self.answered_stamp:
-            if now - self.copy_arrived_ns < COPY_GAP_NS:
+            fast = now - self.copy_arrived_ns < COPY_GAP_NS
+            self.fast_copies = self.fast_copies + 1 if fast else 0
+            if self.fast_copies > FAST_COPIES:
                 self._flooding(stamp)
             self.copy_arrived_ns = now
             self.answered_count = self.pose_count

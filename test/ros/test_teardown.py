@@ -10,7 +10,7 @@ import textwrap
 
 from formation_ros.ros.runner import TEARDOWN_LIMIT
 
-CHILD = textwrap.dedent('''
+CHILD = textwrap.dedent("""
     import sys
     import threading
     from formation_ros.ros import runner
@@ -27,7 +27,7 @@ CHILD = textwrap.dedent('''
 
 
     sys.exit(runner.run(Stuck, name='stuck'))
-''')
+""")
 
 
 def test_a_hung_teardown_ends_the_process_with_its_exit_code_and_one_line():
