@@ -158,6 +158,8 @@ class RobotNode(Node):
         self.flood_stamp: Optional[int] = None
         self.copy_arrived_ns = 0
         self.fast_copies = 0
+        self.last_message: Optional[bytes] = None
+        self.resent_ns = 0
         self.graph = PublisherWatch(self)
         self.shared: Dict[str, str] = {}
 
@@ -423,6 +425,7 @@ class RobotNode(Node):
         else:
             message = encode_twist(linear, angular)
         self.cmd_pub.publish(message)
+        self.last_message = message
 
     def on_state(self) -> None:
         """
@@ -473,8 +476,11 @@ class RobotNode(Node):
         """
         Whether the state stamped ``stamp`` is answered: a new one, within the answer budget.
 
-        A copy of the state answered last is not (more than FAST_COPIES in a row, each within
-        COPY_GAP_NS of the one before, count as flooding); a new state beyond the budget counts
+        A copy of the state answered last is not computed again: the plant sends one when it
+        has not heard the answer (which went, say, only to a recorder that subscribed first),
+        so the answer already sent is sent again, at most once per state period (steady clock)
+        whatever the copies' rate; more than FAST_COPIES copies in a row, each within
+        COPY_GAP_NS of the one before, count as flooding. A new state beyond the budget counts
         as flooding.
         """
         now = self._now_ns()
@@ -483,6 +489,10 @@ class RobotNode(Node):
             self.fast_copies = self.fast_copies + 1 if fast else 0
             if self.fast_copies > FAST_COPIES:
                 self._flooding(stamp)
+            elif (self.last_message is not None
+                  and now - self.resent_ns >= max(COPY_GAP_NS, self.budget.period_ns)):
+                self.cmd_pub.publish(self.last_message)
+                self.resent_ns = now
             self.copy_arrived_ns = now
             self.answered_count = self.pose_count
             return False

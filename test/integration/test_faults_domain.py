@@ -76,8 +76,9 @@ def test_a_plant_refuses_a_domain_with_another_clock(processes, install, probe):
     assert probe.spin_until(tick, START_UP), processes.log('plant')
     info = processes.exit_info('plant')
     assert info is not None and info.returncode == 2, processes.log('plant')
-    [line] = error_lines(processes.log('plant'))
-    assert 'another /clock publisher' in line and '/probe (host unknown' in line, line
+    lines = error_lines(processes.log('plant'))
+    assert len(lines) == 1, processes.log('plant')
+    assert 'another /clock publisher' in lines[0] and '/probe (host unknown' in lines[0], lines
 
 
 def start_plant_and_robot_1(processes, install, probe):
