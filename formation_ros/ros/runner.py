@@ -31,6 +31,7 @@ import time
 from typing import Any, Callable, List, Mapping, Optional, Sequence, Union
 
 from formation_ros.core.declarations import ParamError
+from formation_ros.core.exits import REFUSED
 from formation_ros.core.file_guard import (check_params_text, ParamsFileError,
                                            read_params_file_text)
 from formation_ros.ros.watch import LAUNCHER_PID_ENV, LAUNCHER_START_ENV, process_start
@@ -216,7 +217,7 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
     cannot start from; a node's ``exit_code``.
     """
     if not _init(args, name):
-        return 2
+        return REFUSED
     signal.signal(signal.SIGINT, _StopRequest.handler)
     signal.signal(signal.SIGTERM, _StopRequest.handler)
     launcher = LauncherWatch.from_environment(os.environ)
@@ -248,7 +249,7 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
         logger = rclpy.logging.get_logger(name)
         for line in str(exc).splitlines():
             logger.error(f'invalid {line}')
-        code = 2
+        code = REFUSED
     except (KeyboardInterrupt, ExternalShutdownException):
         pass
     finally:
