@@ -90,6 +90,8 @@ class Lab:
     """(steady s, q (N, 2), heading (N,)) after every tick."""
     measured: Dict[int, Tuple[float, Tuple[float, float]]] = field(default_factory=dict)
     """Robot (0-based) -> (steady s, position) of its latest measurement sent."""
+    measure_times: List[float] = field(default_factory=list)
+    """Steady s of every measurement round (all visible bodies at once)."""
 
     def __post_init__(self) -> None:
         """Start at rest."""
@@ -192,6 +194,7 @@ class Lab:
 
     def measure(self, now: float) -> None:
         """Publish every visible body's pose, each stamped with its own capture time."""
+        self.measure_times.append(now)
         for i, publisher in enumerate(self.mocap):
             if i in self.hidden:
                 continue
@@ -201,6 +204,10 @@ class Lab:
                 WALL.now().nanoseconds, self.frame, position,
                 (0.0, 0.0, math.sin(half), math.cos(half))))
             self.measured[i] = (now, (float(position[0]), float(position[1])))
+
+    def stalls(self, longer_than: float) -> int:
+        """How many times this stand-in (a busy test process) measured nothing for a while, s."""
+        return int(np.count_nonzero(np.diff(self.measure_times) > longer_than))
 
     def closest_pair(self) -> float:
         """Smallest distance between two bodies over the whole run so far, m."""

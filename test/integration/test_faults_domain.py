@@ -22,12 +22,37 @@ START_UP = 90.0
 HOST = socket.gethostname()
 
 
+class Statuses(dict):
+    """{status name: the latest status on /diagnostics}, and how many of each were heard."""
+
+    def __init__(self, probe):
+        super().__init__()
+        self.heard = {}
+        probe.create_subscription(DiagnosticArray, '/diagnostics', self._store, qos.DIAGNOSTICS)
+
+    def _store(self, message):
+        for status in message.status:
+            self[status.name] = status
+            self.heard[status.name] = self.heard.get(status.name, 0) + 1
+
+
 def statuses_of(probe):
-    """Subscribe ``probe`` to /diagnostics; return {status name: the latest status}."""
-    statuses = {}
-    probe.create_subscription(DiagnosticArray, '/diagnostics', lambda m: statuses.update(
-        {status.name: status for status in m.status}), qos.DIAGNOSTICS)
-    return statuses
+    """Subscribe ``probe`` to /diagnostics; return the :class:`Statuses` it fills."""
+    return Statuses(probe)
+
+
+def said_once(probe, processes, name, text, statuses, status):
+    """
+    Wait until process ``name`` has logged ``text``, then for two more ``status`` reports.
+
+    A node's log reaches the test through a pipe, its diagnostics over DDS: either may come
+    first. Each report is a moment at which a repeat would have been logged; return how
+    many times ``text`` is in the log after them.
+    """
+    assert probe.spin_until(lambda: text in processes.log(name), 30), processes.log(name)
+    after = statuses.heard.get(status, 0) + 2
+    assert probe.spin_until(lambda: statuses.heard.get(status, 0) >= after, 30), statuses
+    return processes.log(name).count(text)
 
 
 def value(statuses, name, key):
@@ -51,15 +76,17 @@ def test_a_second_plant_refuses_to_start_naming_the_first(processes, install, pr
     info = wait_exit(probe, processes, 'plant_2', START_UP)
     assert info is not None and info.returncode == 2, processes.log('plant_2')
     log = processes.log('plant_2')
-    [line] = error_lines(log)
+    lines = error_lines(log)
+    assert len(lines) == 1, log
+    line = lines[0]
     assert f'another plant is on ROS_DOMAIN_ID {os.environ["ROS_DOMAIN_ID"]}' in line, line
     assert f'/plant on host {HOST} (process {first.pid})' in line, line
     assert 'Traceback' not in log and 'stopped before the first step' not in log, log
     named = f'another plant runs on this domain: /plant on host {HOST} (process {second.pid})'
     assert probe.spin_until(lambda: named in processes.log('plant'), 30), processes.log('plant')
-    assert processes.log('plant').count(named) == 1, processes.log('plant')
     assert processes.running('plant')
     assert probe.spin_until(lambda: 'the other plant is gone' in processes.log('plant'), 60)
+    assert processes.log('plant').count(named) == 1, processes.log('plant')
     assert probe.spin_until(lambda: statuses.get('formation_ros/plant') is not None
                             and statuses['formation_ros/plant'].level != DiagnosticStatus.ERROR,
                             30)
@@ -105,9 +132,10 @@ def test_a_running_plant_names_a_second_publisher_on_pose_and_cmd_vel(processes,
                                          processes.log('plant'))
     text = value(statuses, 'formation_ros/plant', 'topics with more than one publisher')
     assert '/robot_1/robot' in text.split('/robot_1/cmd_vel: ')[1], text
-    log = processes.log('plant')
-    assert log.count('/robot_1/pose has more than one publisher: /probe') == 1, log
-    assert log.count('/robot_1/cmd_vel has more than one publisher: /probe') == 1, log
+    for text in ('/robot_1/pose has more than one publisher: /probe',
+                 '/robot_1/cmd_vel has more than one publisher: /probe'):
+        assert said_once(probe, processes, 'plant', text, statuses,
+                         'formation_ros/plant') == 1, processes.log('plant')
     assert commands.topic_name == '/robot_1/cmd_vel' and poses.topic_name == '/robot_1/pose'
 
 
@@ -124,9 +152,9 @@ def test_a_robot_names_a_second_reference_publisher(processes, install, probe):
 
     assert probe.spin_until(named, START_UP), (statuses.get('formation_ros/robot_1'),
                                                processes.log('robot_1'))
-    log = processes.log('robot_1')
-    assert log.count('/formation/reference has more than one publisher') == 1, log
-    assert 'two teams on one domain' in log
+    assert said_once(probe, processes, 'robot_1', '/formation/reference has more than one '
+                     'publisher', statuses, 'formation_ros/robot_1') == 1, processes.log('robot_1')
+    assert 'two teams on one domain' in processes.log('robot_1')
 
 
 def test_a_robot_on_two_clocks_names_them_instead_of_advising_use_sim_time(

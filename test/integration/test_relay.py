@@ -385,9 +385,13 @@ def test_mocap_dropout_stops_one_robot_and_the_others_keep_it_in_their_lists(
 
     assert probe.spin_until(back, 30), (outputs.values(), processes.log('relay'))
     log = processes.log('relay')
-    assert log.count('robot 3: no new measurement on /robot_3/measured_pose') == 1, log
-    assert log.count('robot 3: measured again') == 1, log
-    assert 'robot 1: no new measurement' not in log
+    stalls = lab.stalls(max_age / 2)
+    said = ['stale' if 'robot 3: no new measurement' in line else 'again'
+            for line in log.splitlines() if 'robot 3: ' in line]
+    assert said == ['stale', 'again'] * (len(said) // 2), log
+    assert 1 <= len(said) // 2 <= 1 + stalls, (stalls, log)
+    for i in (1, 2, 4):
+        assert log.count(f'robot {i}: no new measurement') <= stalls, (stalls, log)
 
 
 @pytest.mark.parametrize('name, first_source', [('lab_turtlebot3.yaml', '/vrpn_mocap/tb1/pose'),
