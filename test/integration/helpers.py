@@ -36,6 +36,10 @@ def node(install, name, params, *extra, process=None):
                        [exe(install, name), '--ros-args', '--params-file', str(params), *extra])
 
 
+TWICE_REAL_TIME = {'plant.realtime_factor': 2.0}
+"""For a test of what the team does over simulated time, not of keeping up with the wall clock."""
+
+
 def write_params(folder, source, changes, name='params.yaml'):
     """Copy a shipped config with parameters (dotted names) added or replaced; return its path."""
     values = load_params_file(os.path.join(CONFIG, source))

@@ -17,7 +17,7 @@ from formation_ros.core.params import load_config
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.ros import qos
 from geometry_msgs.msg import PoseStamped, TwistStamped
-from helpers import exe, launch, SimClock, stop_when, write_params
+from helpers import exe, launch, SimClock, stop_when, TWICE_REAL_TIME, write_params
 import numpy as np
 from PIL import Image
 from rcl_interfaces.msg import Parameter, ParameterType, ParameterValue
@@ -82,7 +82,7 @@ class Poses:
 
 
 def test_shapes_switch_and_the_team_stops_and_goes(processes, install, probe, tmp_path):
-    params = write_params(tmp_path, 'square_4.yaml', SHAPES)
+    params = write_params(tmp_path, 'square_4.yaml', {**SHAPES, **TWICE_REAL_TIME})
     config = load_config(params, 'plant')
     bound = config.law().u_bound
     poses, clock = Poses(probe, 4), SimClock(probe)

@@ -25,7 +25,7 @@ import pytest
 pytestmark = pytest.mark.faults
 
 DISK = '2m'
-RUN = 20.0
+RUN = 12.0
 """Wall-clock seconds of a run that goes to its end (its --duration)."""
 LONG_RUN = 600.0
 """A run that only a failure can end within the test."""

@@ -15,15 +15,14 @@ import signal
 
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.tools.supervise import ProcessSpec
-from helpers import (CONFIG, exe, launch, project_processes, SimClock, SQUARE, START_UP,
-                     stop_when, watch_commands)
+from helpers import (exe, launch, project_processes, SimClock, SQUARE, START_UP,
+                     stop_when, TWICE_REAL_TIME, watch_commands, write_params)
 import numpy as np
 from rcl_interfaces.srv import GetParameters, SetParameters
 from rclpy.parameter import Parameter
 from test_parameters import call
 import yaml
 
-SIX = os.path.join(CONFIG, 'circle_2d.yaml')
 SETTLED = 10.0
 """Simulated seconds after which the six robots track the circle (formation_sim: within 0.014 m
 at 5 s, 0.002 m at 6 s; test_system's one-robot processes are held to 0.02 m at 10 s)."""
@@ -38,7 +37,8 @@ def fleet_pids(install, name_part):
 def test_six_robots_in_two_fleet_processes_converge(processes, install, probe, tmp_path):
     clock = SimClock(probe)
     out = tmp_path / 'run'
-    launch(processes, install, SIX, out=out, options=('--robots-per-process', '3'))
+    launch(processes, install, write_params(tmp_path, 'circle_2d.yaml', TWICE_REAL_TIME), out=out,
+           options=('--robots-per-process', '3'))
     info = stop_when(probe, processes, lambda: clock.seconds > SETTLED)
     log = processes.log('launcher')
     assert info.returncode == 0, log

@@ -10,8 +10,8 @@ import signal
 from formation_ros.core.params import load_config
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.tools.sim import simulate
-from helpers import (CONFIG, exe, launch, matched, node, project_processes,
-                     SimClock, SQUARE, stop_when, watch_commands, write_params)
+from helpers import (exe, launch, matched, node, project_processes,
+                     SimClock, SQUARE, stop_when, TWICE_REAL_TIME, watch_commands, write_params)
 import numpy as np
 
 
@@ -44,7 +44,7 @@ def test_formation_converges_bounded_without_collision(processes, install, probe
 def test_tracking_follows_a_circle(processes, install, probe, tmp_path):
     clock = SimClock(probe)
     out = tmp_path / 'circle'
-    launch(processes, install, os.path.join(CONFIG, 'circle_2d.yaml'), out=out)
+    launch(processes, install, write_params(tmp_path, 'circle_2d.yaml', TWICE_REAL_TIME), out=out)
     info = stop_when(probe, processes, lambda: clock.seconds >= 10.0)
     assert info.returncode == 0, processes.log('launcher')
     metrics = json.loads((out / 'metrics.json').read_text())
