@@ -4,8 +4,10 @@
 """The shell scripts' command lines: help, clear errors, strict mode."""
 
 import os
+import signal
 import subprocess
 import sys
+import time
 
 import pytest
 
@@ -117,21 +119,52 @@ def fake_install(tmp_path):
     return make_fake_install(tmp_path)
 
 
-def launch_fake(prefix, dies, *options):
-    """Run the launcher on the fake install for 10 s with FAKE_DIES=dies; return its result."""
+FAKE_RUN_LIMIT = 120.0
+"""Seconds after which a fake run that neither met its condition nor ended is ended (a fail)."""
+
+
+def launch_fake(prefix, dies, *options, until=None):
+    """
+    Run the launcher on the fake install with FAKE_DIES=dies; return its result.
+
+    until(stdout, stderr): when it holds, the launcher is sent Ctrl-C as a user would; without
+    it the run lasts until the launcher stops on its own (a node it cannot do without ended).
+    """
     up = prefix.parent / 'up'
     up.mkdir(exist_ok=True)
     env = dict(os.environ, FAKE_DIES=dies, FAKE_UP_DIR=str(up))
     env.pop('FORMATION_PREFIX', None)
-    return subprocess.run(
-        ['bash', os.path.join(ROOT, 'scripts', 'launch_formation.sh'),
-         os.path.join(ROOT, 'config', 'square_4.yaml'), '--prefix', str(prefix),
-         '--duration', '10', *options], capture_output=True, text=True, timeout=120, env=env)
+    out, err = prefix.parent / 'launcher.out', prefix.parent / 'launcher.err'
+    with open(out, 'w') as stdout, open(err, 'w') as stderr:
+        launcher = subprocess.Popen(
+            ['bash', os.path.join(ROOT, 'scripts', 'launch_formation.sh'),
+             os.path.join(ROOT, 'config', 'square_4.yaml'), '--prefix', str(prefix),
+             '--duration', '0', *options], stdout=stdout, stderr=stderr, text=True, env=env)
+        try:
+            deadline = time.monotonic() + FAKE_RUN_LIMIT
+            while launcher.poll() is None and time.monotonic() < deadline:
+                if until is not None and until(out.read_text(), err.read_text()):
+                    launcher.send_signal(signal.SIGINT)
+                    break
+                time.sleep(0.05)
+            launcher.wait(timeout=FAKE_RUN_LIMIT)
+        finally:
+            if launcher.poll() is None:
+                launcher.kill()
+                launcher.wait()
+    return subprocess.CompletedProcess(launcher.args, launcher.returncode, out.read_text(),
+                                       err.read_text())
+
+
+def all_up(stdout, stderr):
+    """Whether the six fake nodes (plant, reference, four robots) have said they are up."""
+    return stdout.count('] up ') >= 6
 
 
 @pytest.mark.faults
 def test_launcher_goes_on_without_a_dead_robot_by_default(fake_install):
-    result = launch_fake(fake_install, 'robot_2')
+    result = launch_fake(fake_install, 'robot_2',
+                         until=lambda stdout, stderr: 'the others go on' in stderr)
     assert result.returncode == 1, result.stderr
     assert 'robot_2 ended on its own (exit code 3); the others go on' in result.stderr
     assert result.stderr.rstrip().endswith(
@@ -151,7 +184,8 @@ def test_launcher_stops_everything_when_a_robot_dies_with_on_exit_stop(fake_inst
 
 @pytest.mark.faults
 def test_launcher_respawns_a_robot_at_most_five_times(fake_install):
-    result = launch_fake(fake_install, 'robot_2', '--on-exit', 'respawn')
+    result = launch_fake(fake_install, 'robot_2', '--on-exit', 'respawn',
+                         until=lambda stdout, stderr: 'after 5 restarts' in stderr)
     assert result.returncode == 1, result.stderr
     for k in range(1, 6):
         assert result.stderr.count(f'starting it again (restart {k} of 5)') == 1, result.stderr
@@ -171,7 +205,7 @@ def test_launcher_always_stops_when_plant_or_reference_dies(fake_install, essent
 
 @pytest.mark.faults
 def test_nodes_are_told_the_launcher_process(fake_install):
-    result = launch_fake(fake_install, '')
+    result = launch_fake(fake_install, '', until=all_up)
     assert result.returncode == 0, result.stderr
     pids = {line.split()[-1] for line in result.stdout.splitlines() if ' up ' in line}
     assert len(pids) == 1 and pids.pop().isdigit(), result.stdout
