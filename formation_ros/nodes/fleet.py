@@ -24,7 +24,7 @@ import re
 import sys
 from typing import List, Optional, Sequence
 
-from formation_ros.nodes.robot import RobotNode
+from formation_ros.nodes.robot import RobotNode, TeamLink
 from formation_ros.ros.runner import run
 from formation_ros.ros.topics import robot_namespace
 from rcl_interfaces.msg import SetParametersResult
@@ -128,10 +128,14 @@ def make_fleet(ids: Sequence[int]) -> List[RobotNode]:
     Build one robot node per id, robot i in ``/robot_<i>``, sharing one ``/clock`` subscription.
 
     Each node checks its parameters as a robot process does (a ``robot_id`` given to the fleet
-    disagrees with every namespace but one and is refused there).
+    disagrees with every namespace but one and is refused there). With ``transport: team`` the
+    fleet's robots hear the team's states and send their commands through one
+    :class:`formation_ros.nodes.robot.TeamLink`: one message in and one out per state.
     """
     nodes = [RobotNode(namespace=robot_namespace(i)) for i in ids]
     shared = share_sim_clock(nodes)
+    if nodes and nodes[0].config.team_transport:
+        TeamLink(nodes)
     if nodes and nodes[0].sim_time:
         nodes[0].get_logger().info(f'fleet of {len(nodes)} robots: {shared + 1} clocks driven '
                                    'by one /clock subscription')
