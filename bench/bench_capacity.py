@@ -228,10 +228,10 @@ def _sum_where(values: Mapping[str, float], robots: bool) -> float:
 
 def format_row(row: Mapping[str, Any]) -> str:
     """One Markdown table row."""
-    head = (f"| {row.get('transport', 'robot')} | {row['mode']} | {row['robots']} | "
-            f"{row['rate_hz']:g} |")
+    head = f"| {row['mode']} | {row['robots']} | {row['rate_hz']:g} |"
+    transport = f" {row.get('transport', 'robot')} |"
     if 'error' in row:
-        return head + f" {row['error']} |" + ' |' * 8
+        return head + f" {row['error']} |" + ' |' * 8 + transport
     latency = row['latency_ms']
     fresh = row['fresh_fraction']
     cpu, rss = row['cpu_percent'], row['rss_mib']
@@ -240,13 +240,13 @@ def format_row(row: Mapping[str, Any]) -> str:
             f"{latency['p50_ms'] or 0:.1f} / {latency['p99_ms'] or 0:.1f} / "
             f"{latency['max_ms']:.0f} | {cpu.get('plant', 0.0):.0f} | "
             f'{_sum_where(cpu, True):.0f} | {rss.get("plant", 0.0):.0f} | '
-            f'{sum(rss.values()) / 1024.0:.2f} |')
+            f'{sum(rss.values()) / 1024.0:.2f} |' + transport)
 
 
-HEADER = ('| transport | mode | N | rate (Hz) | processes | start-up (s) | plant steps/s | '
-          'fresh (%) | latency p50 / p99 / max (ms) | plant CPU (%) | robots CPU (%) | '
-          'plant RSS (MiB) | all RSS (GiB) |\n'
-          '|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|')
+HEADER = ('| mode | N | rate (Hz) | processes | start-up (s) | plant steps/s | fresh (%) | '
+          'latency p50 / p99 / max (ms) | plant CPU (%) | robots CPU (%) | plant RSS (MiB) | '
+          'all RSS (GiB) | transport |\n'
+          '|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|')
 
 
 def write_figure(path: str, rows: Sequence[Mapping[str, Any]]) -> None:

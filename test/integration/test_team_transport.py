@@ -4,9 +4,10 @@
 """
 The team transport (``transport: team``) over real DDS: one state message, one per fleet back.
 
-Lockstep gives the robot transport's trajectory; free-running, the team converges, a robot's own
-``cmd_vel`` carries what its team message carries while someone listens, untrusted team command
-bytes are counted and dropped, and a dead robot process is reported and its body held still.
+Lockstep gives the robot transport's trajectory (and formation_sim's, unicycles); free-running,
+the team converges, a robot's own ``cmd_vel`` carries what its team message carries while
+someone listens, untrusted team command bytes are counted and dropped, and a dead robot process
+is reported and its body held still.
 """
 
 import signal
@@ -17,6 +18,7 @@ from formation_ros.core.params import load_config
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.ros import fields, qos
 from formation_ros.ros.cdr import encode_header, encode_names, encode_team_commands
+from formation_ros.tools.sim import simulate
 from geometry_msgs.msg import PoseArray, TwistStamped
 from helpers import launch, node, SimClock, START_UP, stop_when, write_params
 import numpy as np
@@ -30,14 +32,13 @@ NOTICE_WITHIN = 10.0
 
 def lockstep_run(processes, probe, install, tmp_path, transport):
     """Run square_4 on a moving reference in lockstep, two robots a fleet; its trajectory."""
+    out = tmp_path / transport
     params = write_params(tmp_path, 'square_4.yaml', {
         'plant.lockstep': True, 'plant.realtime_factor': 200.0, 'transport': transport,
-        'reference.kind': 'circle', 'reference.radius': 1.0, 'reference.speed': 0.5},
-        name=f'{transport}.yaml')
+        'reference.kind': 'circle', 'reference.radius': 1.0, 'reference.speed': 0.5,
+        'plant.output_dir': str(out)}, name=f'{transport}.yaml')
     clock = SimClock(probe)
-    out = tmp_path / transport
-    launch(processes, install, params, out=out, name=transport,
-           options=('--robots-per-process', '2'))
+    launch(processes, install, params, name=transport, options=('--robots-per-process', '2'))
     info = stop_when(probe, processes, lambda: clock.seconds >= UNTIL, name=transport)
     probe.destroy_subscription(clock.subscription)
     assert info.returncode == 0, processes.log(transport)
@@ -56,6 +57,25 @@ def test_team_and_robot_transports_give_one_trajectory_in_lockstep(processes, in
     assert np.max(np.abs(robot.q[:steps] - team.q[:steps])) < 1e-12
     assert np.max(np.abs(robot.u[:steps] - team.u[:steps])) < 1e-12
     assert np.ptp(team.q[:steps], axis=0).max() > 0.5
+
+
+def test_unicycles_of_the_team_transport_in_lockstep_are_formation_sims(
+        processes, install, probe, tmp_path):
+    out = tmp_path / 'unicycles'
+    params = write_params(tmp_path, 'unicycle_2d.yaml', {
+        'plant.lockstep': True, 'plant.realtime_factor': 200.0, 'transport': 'team',
+        'plant.output_dir': str(out)})
+    clock = SimClock(probe)
+    launch(processes, install, params, options=('--robots-per-process', '4'))
+    info = stop_when(probe, processes, lambda: clock.seconds >= UNTIL)
+    assert info.returncode == 0, processes.log('launcher')
+    plant = Trajectory.load(str(out / 'trajectory.npz'))
+    assert plant.heading is not None and len(plant.t) >= 100 * UNTIL
+    sim = simulate(load_config(params), duration=plant.t[-1], dt=0.01, sample_dt=0.01)
+    assert np.max(np.abs(sim.q - plant.q)) < 1e-9
+    assert np.max(np.abs(sim.heading - plant.heading)) < 1e-9
+    assert np.max(np.abs(sim.body_command - plant.body_command)) < 1e-9
+    assert np.max(np.abs(plant.body_command)) > 0.05
 
 
 class Heard:
