@@ -551,23 +551,25 @@ class PlantNode(Node):
     def _all_robots_up(self) -> bool:
         """While waiting: start the clock once every robot has sent a command."""
         missing = (np.flatnonzero(~self.commands.present) + 1).tolist()
-        wanted = self.settings.wait_for_subscribers
-        if self.team_transport:
-            wanted -= 1
-            self._look_at_listeners()
-        unheard = [pub for pub in self.pose_pubs if pub.get_subscription_count() < wanted]
+        wanted = self.settings.wait_for_subscribers - (1 if self.team_transport else 0)
+        unheard = ([pub for pub in self.pose_pubs if pub.get_subscription_count() < wanted]
+                   if wanted > 0 else [])
         if self.team_transport and self.states_pub.get_subscription_count() < 1:
             unheard.append(self.states_pub)
         if missing or unheard:
             more = '...' if len(missing) > 10 else ''
-            where = (f'{topics.STATES} and {wanted} more' if self.team_transport
-                     else f'{wanted}')
+            listeners = f'{wanted} subscribers on every pose topic'
+            if self.team_transport:
+                listeners = (f'a subscriber of {topics.STATES}'
+                             + (f' and {listeners}' if wanted > 0 else ''))
             self.once.start('waiting', f'waiting for {len(missing)} of {self.n} robots to send '
                                        f'a command (robots {missing[:10]}{more}) and for '
-                                       f'{where} subscribers on every pose topic', 'info')
+                                       f'{listeners}', 'info')
             self._resend_if_due()
             return False
         self.waiting = False
+        if self.team_transport:
+            self._look_at_listeners()
         self.started_wall = time.monotonic()
         self.rate_window = (self.started_wall, self.model.counts.steps)
         started = f'all {self.n} robots are up: starting the clock'

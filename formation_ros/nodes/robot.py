@@ -556,6 +556,8 @@ class RobotNode(Node):
             return False
         self.once.end('waiting')
         self.waiting = False
+        if self.team is not None:
+            self.team.look_at_listeners()
         return True
 
     def _lockstep_answer(self) -> None:
@@ -710,7 +712,7 @@ class TeamLink:
                                            qos.COMMAND)
         leader.create_subscription(PoseArray, topics.STATES, self.on_states, qos.STATE_INPUT,
                                    raw=True)
-        self.listeners_timer = leader.create_timer(LISTENERS_PERIOD, self._look_at_listeners,
+        self.listeners_timer = leader.create_timer(LISTENERS_PERIOD, self.look_at_listeners,
                                                    clock=leader.steady)
 
     def on_states(self, data: bytes) -> None:
@@ -718,7 +720,7 @@ class TeamLink:
         self.heard = data
         self.leader.answer.arm()
 
-    def _look_at_listeners(self) -> None:
+    def look_at_listeners(self) -> None:
         """Note which robots' cmd_vel someone subscribes to (published only then)."""
         self.listening = np.array([node.cmd_pub.get_subscription_count() > 0
                                    for node in self.nodes], dtype=bool)
