@@ -17,7 +17,9 @@ Parameters given on the command line (``-p``) or in a parameters file apply to e
 the fleet; a file's ``/robot_3/robot:`` section applies to robot 3 alone, as it would to a
 robot process. The namespace of each robot is set by the fleet: ``-r __ns:=...`` is refused,
 and a ``robot_id`` must match it. The robots share one ``/clock`` subscription, so their
-``use_sim_time`` cannot be changed while they run.
+``use_sim_time`` cannot be changed while they run. With ``transport: team`` they share one
+``/formation/states`` subscription and one ``/formation/commands`` publisher too, and their
+commands come from one call of the law per state.
 """
 
 import re

@@ -26,6 +26,13 @@ the collision check. This node only moves messages in and out:
 With ``plant.lockstep`` it steps only when every robot has answered the latest state, which
 makes a run reproduce ``formation_sim --dt 1/plant.rate``.
 
+With ``transport: team`` (``core.transport``) it publishes each state once for every robot on
+``/formation/states`` and reads the commands from ``/formation/commands`` (one message per robot
+process or fleet, bytes checked before any element is read, malformed ones counted and dropped),
+admitted as every ``cmd_vel`` is; robot i's ``pose`` and ``neighbors`` are published only while
+someone subscribes to them, and ``cmd_vel`` is not subscribed to. Which robots are gone it tells
+from when their latest command arrived.
+
 One team per domain: before its first state the plant looks for :data:`LOOK_TIME` s (up to
 :data:`LOOK_LIMIT` s to hear the other's host) for another ``/clock`` publisher. If there is
 one, another plant or anything else, that sends ``/clock`` or announces itself on

@@ -37,6 +37,11 @@ one on ``cmd_vel``. A robot also looks up, once a second, who publishes ``/clock
 naming them (two teams on one domain), and a robot refusing stamps from another clock says so
 then instead of advising ``use_sim_time``.
 
+With ``transport: team`` a robot hears no ``pose`` or ``neighbors``: its process reads the
+team's ``/formation/states`` once for all its robots and answers with one
+``/formation/commands`` message (:class:`TeamLink`); its ``cmd_vel`` carries its command only
+while someone subscribes to it.
+
 Every state and reference message must be in ``world_frame`` (default ``world``). Commands for
 real bases: ``command.type: twist`` publishes a geometry_msgs/Twist (no stamp) instead of a
 TwistStamped, and ``command.frame: body`` publishes a point robot's u in its
