@@ -599,7 +599,15 @@ class RobotNode(Node):
             Duration(seconds=LAST_WORD))
 
     def on_diagnostics(self) -> None:
-        """Publish this robot's status: input ages, neighbours in range, command size."""
+        """
+        Publish this robot's status: input ages, neighbours in range, command size.
+
+        Team transport: what the robot's link last gave it, and the link's state (waiting,
+        stale, flooding: its leader's).
+        """
+        if self.member_of is not None:
+            self.member_of.give(self)
+        leader = self if self.member_of is None else self.member_of.leader
         now = self._now_ns()
         values = {f'{name} message age [s]': ('never' if self.received_ns[name] is None
                                               else (now - self.received_ns[name]) / NS_PER_S)
@@ -624,18 +632,18 @@ class RobotNode(Node):
                 np.max(np.abs(self.last_body_command)))
         values.update({f'rejected {name} messages ({reason.value})': count
                        for (name, reason), count in self.rejected.items()})
-        values['states not answered (flooding)'] = self.flooded
-        flooding = self.flooded > self.flooded_reported
-        self.flooded_reported = self.flooded
+        values['states not answered (flooding)'] = leader.flooded
+        flooding = leader.flooded > self.flooded_reported
+        self.flooded_reported = leader.flooded
         shared = self._shared_topics()
         if shared:
             values['topics with more than one publisher'] = ' | '.join(
                 f'{topic}: {names}' for topic, names in sorted(shared.items()))
             level, message = 'error', (f"{', '.join(sorted(shared))}: more than one publisher "
                                        '(two teams on one domain?)')
-        elif self.waiting:
+        elif leader.waiting:
             level, message = 'warn', 'waiting for its first inputs'
-        elif self.once.is_active('stale'):
+        elif leader.once.is_active('stale'):
             level, message = 'warn', 'publishing zero: inputs stale'
         elif flooding:
             level, message = 'warn', 'flooding: states beyond the state rate dropped'
@@ -665,8 +673,9 @@ class TeamLink:
     the first robot node (the leader), for all robots of the process. The callback stores the
     bytes and wakes the leader, whose timer (:meth:`RobotNode.on_state`) reads and checks the
     state (:meth:`take`), senses each robot's neighbours within its R_i with the plant's
-    sensing function (``core.sensing.sensed_pairs``), gives every robot node its pose and
-    neighbours (what its diagnostics report), and answers the state as a robot answers one
+    sensing function (``core.sensing.sensed_pairs``), gives the leader its pose and neighbours
+    (each other robot node gets its own when it reports them: :meth:`give`), and answers the
+    state as a robot answers one
     (the leader's answer budget, watchdog and lockstep rules): every robot's command from one
     call of the law (``core.law.robot_commands``, :meth:`commands`), in one team command
     message (:meth:`publish`). Robot i's own ``cmd_vel`` carries its command too while
@@ -701,6 +710,12 @@ class TeamLink:
         self.local[self.indices] = np.arange(len(self.nodes))
         self.names = encode_names([robot_name(int(i) + 1) for i in self.indices])
         self.heard: Optional[bytes] = None
+        self.state: Optional[PoseArrayData] = None
+        self.taken_ns = 0
+        self.bounds = np.zeros(len(self.nodes) + 1, dtype=np.intp)
+        self.command: Optional[Command] = None
+        self.body: Optional[NDArray[np.float64]] = None
+        self.vertices = np.zeros((len(self.nodes), self.dim))
         self.points = np.zeros((self.n, self.dim))
         self.headings = np.zeros(self.n)
         self.orientations = np.zeros((self.n, 4))
@@ -769,21 +784,34 @@ class TeamLink:
         else:
             self.points = positions
         self.orientations = orientations
-        self._give(state)
+        self.bounds = np.searchsorted(self.observer, np.arange(len(self.nodes) + 1))
+        self.state, self.taken_ns = state, leader._now_ns()
+        self.give(leader)
+        leader.pose_count += 1
 
-    def _give(self, state: PoseArrayData) -> None:
-        """Give every robot node its pose and neighbours of ``state`` (what it would hear)."""
-        now = self.leader._now_ns()
-        bounds = np.searchsorted(self.observer, np.arange(len(self.nodes) + 1)).tolist()
-        rows = state.positions[self.indices].tolist()
-        turns = state.orientations[self.indices].tolist()
-        for k, node in enumerate(self.nodes):
-            seen = self.seen[bounds[k]:bounds[k + 1]]
-            node.pose = PoseData(state.stamp_ns, state.frame_id, tuple(rows[k]), tuple(turns[k]))
-            node.neighbours = PoseArrayData(state.stamp_ns, state.frame_id,
-                                            state.positions[seen], state.orientations[seen])
-            node.pose_count += 1
-            node.received_ns['pose'] = node.received_ns['neighbour'] = now
+    def give(self, node: RobotNode) -> None:
+        """
+        Give robot ``node`` what it would have heard and computed, as of the state taken last.
+
+        Its pose and neighbours in that state and its latest command: what its diagnostics
+        report (and the leader's answers use).
+        """
+        state = self.state
+        if state is None:
+            return
+        k = int(self.local[node.index])
+        seen = self.seen[self.bounds[k]:self.bounds[k + 1]]
+        node.pose = PoseData(state.stamp_ns, state.frame_id,
+                             tuple(state.positions[node.index].tolist()),
+                             tuple(state.orientations[node.index].tolist()))
+        node.neighbours = PoseArrayData(state.stamp_ns, state.frame_id, state.positions[seen],
+                                        state.orientations[seen])
+        node.received_ns['pose'] = node.received_ns['neighbour'] = self.taken_ns
+        if self.command is not None:
+            node.vertex = self.vertices[k]
+            node.last = Command(u=self.command.u[k], u_hat=self.command.u_hat[k],
+                                omega=self.command.omega[k])
+            node.last_body_command = None if self.body is None else self.body[k]
 
     def commands(self, stamp_ns: int, frame: FrameSample) -> NDArray[np.float64]:
         """
@@ -793,8 +821,8 @@ class TeamLink:
         ``robot_command`` gives), then (v, w) for unicycles or the body frame's u.
         """
         leader = self.leader
-        vertices = leader.changes.shapes.at(stamp_ns).vertices[self.indices]
-        command = robot_commands(self.points[self.indices], vertices, self.observer,
+        self.vertices = leader.changes.shapes.at(stamp_ns).vertices[self.indices]
+        command = robot_commands(self.points[self.indices], self.vertices, self.observer,
                                  self.points[self.seen], self.radii, leader.law, frame)
         if self.unicycle:
             body: Optional[NDArray[np.float64]] = unicycle_commands(
@@ -803,11 +831,7 @@ class TeamLink:
             body = to_body_frame(command.u, self.orientations[self.indices])
         else:
             body = None
-        for k, node in enumerate(self.nodes):
-            node.vertex = vertices[k]
-            node.last = Command(u=command.u[k], u_hat=command.u_hat[k], omega=command.omega[k])
-            if body is not None:
-                node.last_body_command = body[k]
+        self.command, self.body = command, body
         return command.u if body is None else body
 
     def publish(self, u: Optional[NDArray[np.float64]], stamp_ns: int) -> bytes:

@@ -38,10 +38,22 @@ def lockstep_run(processes, probe, install, tmp_path, transport):
         'reference.kind': 'circle', 'reference.radius': 1.0, 'reference.speed': 0.5,
         'plant.output_dir': str(out)}, name=f'{transport}.yaml')
     clock = SimClock(probe)
+    statuses = {}
+    diagnostics = probe.create_subscription(DiagnosticArray, '/diagnostics', lambda message: (
+        statuses.update({status.name: (status.message, {pair.key for pair in status.values})
+                         for status in message.status})), qos.DIAGNOSTICS)
+    robots = [f'formation_ros/robot_{i}' for i in range(1, 5)]
+
+    def every_robot_reports():
+        return all(statuses.get(name, ('',))[0] == 'lockstep' for name in robots)
+
     launch(processes, install, params, name=transport, options=('--robots-per-process', '2'))
-    info = stop_when(probe, processes, lambda: clock.seconds >= UNTIL, name=transport)
+    info = stop_when(probe, processes, lambda: clock.seconds >= UNTIL and every_robot_reports(),
+                     name=transport)
     probe.destroy_subscription(clock.subscription)
+    probe.destroy_subscription(diagnostics)
     assert info.returncode == 0, processes.log(transport)
+    assert all('neighbours within R_i' in statuses[name][1] for name in robots), statuses
     return Trajectory.load(str(out / 'trajectory.npz'))
 
 
