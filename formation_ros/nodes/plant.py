@@ -619,6 +619,8 @@ class PlantNode(Node):
             values['malformed team command messages'] = self.malformed_team
             values['team command messages in another frame'] = self.wrong_frame_team
             values['team command publishers alive'] = self.team_liveliness.alive
+            values['robots with pose and neighbors published'] = ', '.join(
+                str(i + 1) for i in np.flatnonzero(self.listened).tolist()) or 'none'
         for status in (CommandStatus.STALE, CommandStatus.FUTURE, CommandStatus.NON_FINITE,
                        CommandStatus.SATURATED):
             robots = counts.by_robot(status)

@@ -633,6 +633,8 @@ class RobotNode(Node):
         values.update({f'rejected {name} messages ({reason.value})': count
                        for (name, reason), count in self.rejected.items()})
         values['states not answered (flooding)'] = leader.flooded
+        if self.member_of is not None:
+            values['cmd_vel published'] = self.member_of.publishes_cmd_vel(self)
         flooding = leader.flooded > self.flooded_reported
         self.flooded_reported = leader.flooded
         shared = self._shared_topics()
@@ -744,6 +746,10 @@ class TeamLink:
         """Note which robots' cmd_vel someone subscribes to (published only then)."""
         self.listening = np.array([node.cmd_pub.get_subscription_count() > 0
                                    for node in self.nodes], dtype=bool)
+
+    def publishes_cmd_vel(self, node: RobotNode) -> str:
+        """Return 'yes' while robot ``node``'s own cmd_vel is published (someone listens)."""
+        return 'yes' if self.listening[self.local[node.index]] else 'no'
 
     def listeners(self) -> int:
         """Return the command subscribers every robot has: team topic plus its fewest cmd_vel."""

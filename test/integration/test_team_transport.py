@@ -4,10 +4,10 @@
 """
 The team transport (``transport: team``) over real DDS: one state message, one per fleet back.
 
-Lockstep gives the robot transport's trajectory (and formation_sim's, unicycles); free-running,
-the team converges, a robot's own ``cmd_vel`` carries what its team message carries while
-someone listens, untrusted team command bytes are counted and dropped, and a dead robot process
-is reported and its body held still.
+Lockstep gives the robot transport's trajectory (and formation_sim's: unicycles, points that
+take body-frame commands); free-running, the team converges, a robot's own ``cmd_vel`` carries
+what its team message carries while someone listens (and only then), untrusted team command
+bytes are counted and dropped, and a dead robot process is reported and its body held still.
 """
 
 import signal
@@ -22,6 +22,7 @@ from formation_ros.tools.sim import simulate
 from geometry_msgs.msg import PoseArray, TwistStamped
 from helpers import launch, node, SimClock, START_UP, stop_when, write_params
 import numpy as np
+import pytest
 from trajectory_msgs.msg import MultiDOFJointTrajectory
 
 UNTIL = 2.0
@@ -31,7 +32,12 @@ NOTICE_WITHIN = 10.0
 
 
 def lockstep_run(processes, probe, install, tmp_path, transport):
-    """Run square_4 on a moving reference in lockstep, two robots a fleet; its trajectory."""
+    """
+    Run square_4 on a moving reference in lockstep, two robots a fleet; return its trajectory.
+
+    With the team transport, run until every robot (the second of each fleet too) reports
+    'lockstep' with its neighbours in /diagnostics.
+    """
     out = tmp_path / transport
     params = write_params(tmp_path, 'square_4.yaml', {
         'plant.lockstep': True, 'plant.realtime_factor': 200.0, 'transport': transport,
@@ -45,7 +51,8 @@ def lockstep_run(processes, probe, install, tmp_path, transport):
     robots = [f'formation_ros/robot_{i}' for i in range(1, 5)]
 
     def every_robot_reports():
-        return all(statuses.get(name, ('',))[0] == 'lockstep' for name in robots)
+        return transport == 'robot' or all(statuses.get(name, ('',))[0] == 'lockstep'
+                                           for name in robots)
 
     launch(processes, install, params, name=transport, options=('--robots-per-process', '2'))
     info = stop_when(probe, processes, lambda: clock.seconds >= UNTIL and every_robot_reports(),
@@ -53,7 +60,8 @@ def lockstep_run(processes, probe, install, tmp_path, transport):
     probe.destroy_subscription(clock.subscription)
     probe.destroy_subscription(diagnostics)
     assert info.returncode == 0, processes.log(transport)
-    assert all('neighbours within R_i' in statuses[name][1] for name in robots), statuses
+    assert transport == 'robot' or all('neighbours within R_i' in statuses[name][1]
+                                       for name in robots), statuses
     return Trajectory.load(str(out / 'trajectory.npz'))
 
 
@@ -71,23 +79,30 @@ def test_team_and_robot_transports_give_one_trajectory_in_lockstep(processes, in
     assert np.ptp(team.q[:steps], axis=0).max() > 0.5
 
 
-def test_unicycles_of_the_team_transport_in_lockstep_are_formation_sims(
-        processes, install, probe, tmp_path):
-    out = tmp_path / 'unicycles'
-    params = write_params(tmp_path, 'unicycle_2d.yaml', {
+@pytest.mark.parametrize('source, changes', [
+    ('unicycle_2d.yaml', {}),
+    ('square_4.yaml', {'command.frame': 'body', 'start.headings': [0.5, 2.0, -1.0, 3.0]})],
+    ids=['unicycles', 'body-frame points'])
+def test_bodies_of_the_team_transport_in_lockstep_are_formation_sims(
+        processes, install, probe, tmp_path, source, changes):
+    out = tmp_path / 'run'
+    params = write_params(tmp_path, source, {
         'plant.lockstep': True, 'plant.realtime_factor': 200.0, 'transport': 'team',
-        'plant.output_dir': str(out)})
+        'plant.output_dir': str(out), **changes})
     clock = SimClock(probe)
     launch(processes, install, params, options=('--robots-per-process', '4'))
     info = stop_when(probe, processes, lambda: clock.seconds >= UNTIL)
     assert info.returncode == 0, processes.log('launcher')
     plant = Trajectory.load(str(out / 'trajectory.npz'))
-    assert plant.heading is not None and len(plant.t) >= 100 * UNTIL
+    assert len(plant.t) >= 100 * UNTIL
     sim = simulate(load_config(params), duration=plant.t[-1], dt=0.01, sample_dt=0.01)
     assert np.max(np.abs(sim.q - plant.q)) < 1e-9
-    assert np.max(np.abs(sim.heading - plant.heading)) < 1e-9
-    assert np.max(np.abs(sim.body_command - plant.body_command)) < 1e-9
-    assert np.max(np.abs(plant.body_command)) > 0.05
+    assert np.max(np.abs(sim.u - plant.u)) < 1e-9
+    if plant.heading is not None:
+        assert np.max(np.abs(sim.heading - plant.heading)) < 1e-9
+        assert np.max(np.abs(sim.body_command - plant.body_command)) < 1e-9
+    assert (plant.heading is not None) == (source == 'unicycle_2d.yaml')
+    assert np.max(np.abs(plant.u)) > 0.05
 
 
 class Heard:
@@ -95,7 +110,7 @@ class Heard:
 
     def __init__(self, probe):
         """Subscribe ``probe`` to the team topics, /robot_2/cmd_vel and /diagnostics."""
-        self.states, self.team, self.own, self.plant = [], {}, {}, []
+        self.states, self.team, self.own, self.status = [], {}, {}, []
         probe.create_subscription(PoseArray, '/formation/states', self.states.append,
                                   qos.STATE_INPUT)
         probe.create_subscription(MultiDOFJointTrajectory, '/formation/commands',
@@ -116,16 +131,18 @@ class Heard:
         self.own[fields.stamp_to_ns(message.header.stamp)] = (twist.linear.x, twist.linear.y)
 
     def _on_diagnostics(self, message):
-        self.plant.extend((time.monotonic(), {pair.key: pair.value for pair in status.values})
-                          for status in message.status if status.name == 'formation_ros/plant')
+        self.status.extend((time.monotonic(), status.name,
+                            {pair.key: pair.value for pair in status.values})
+                           for status in message.status)
 
     def common(self):
         """Return the stamps at which robot 2 answered on both topics."""
         return sorted(set(self.team) & set(self.own))
 
-    def plant_value(self, key, since=0.0):
+    def plant_value(self, key, since=0.0, name='formation_ros/plant'):
         """Return the latest value of ``key`` in the plant's status since ``since`` (or None)."""
-        found = [values.get(key) for at, values in self.plant if at >= since and key in values]
+        found = [values[key] for at, who, values in self.status
+                 if who == name and at >= since and key in values]
         return found[-1] if found else None
 
     def poses(self, robot):
@@ -156,6 +173,9 @@ def test_a_free_running_team_converges_and_shows_its_commands_per_robot(processe
     common = heard.common()
     assert [heard.own[stamp] for stamp in common] == [heard.team[stamp] for stamp in common]
     assert max(max(abs(v) for v in heard.team[stamp]) for stamp in common) > 0.0
+    assert heard.plant_value('robots with pose and neighbors published') == 'none'
+    assert heard.plant_value('cmd_vel published', name='formation_ros/robot_2') == 'yes'
+    assert heard.plant_value('cmd_vel published', name='formation_ros/robot_1') == 'no'
 
     publisher = probe.create_publisher(MultiDOFJointTrajectory, '/formation/commands',
                                        qos.COMMAND)
@@ -182,4 +202,4 @@ def test_a_free_running_team_converges_and_shows_its_commands_per_robot(processe
     assert probe.spin_until(lambda: len(heard.states) > reported + 25, 30)
     still = heard.poses(4)[reported:]
     assert still[-1][0] > still[0][0] and len({position for _, position in still}) == 1, still
-    assert '4' in (heard.plant_value('robots with stale commands') or ''), heard.plant[-1]
+    assert '4' in (heard.plant_value('robots with stale commands') or ''), heard.status[-1]
