@@ -603,7 +603,7 @@ class RobotNode(Node):
         Publish this robot's status: input ages, neighbours in range, command size.
 
         Team transport: what the robot's link last gave it, and the link's state (waiting,
-        stale, flooding: its leader's).
+        stale, flooding, the look at who publishes /clock and the reference: its leader's).
         """
         if self.member_of is not None:
             self.member_of.give(self)
@@ -637,7 +637,7 @@ class RobotNode(Node):
             values['cmd_vel published'] = self.member_of.publishes_cmd_vel(self)
         flooding = leader.flooded > self.flooded_reported
         self.flooded_reported = leader.flooded
-        shared = self._shared_topics()
+        shared = self._shared_topics() if leader is self else leader.shared
         if shared:
             values['topics with more than one publisher'] = ' | '.join(
                 f'{topic}: {names}' for topic, names in sorted(shared.items()))
