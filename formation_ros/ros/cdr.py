@@ -154,12 +154,17 @@ class _Reader:
         return struct.unpack_from(self.endian + fmt, self.view, start)
 
     def string(self, name: str) -> str:
+        start = self.skip_string(name)
+        return bytes(self.view[start:self.offset - 1]).decode('utf-8', 'replace')
+
+    def skip_string(self, name: str) -> int:
+        """Check that a whole string is next, move past it; return where its bytes start."""
         (length,) = self._take('I', 4, 4)
         start = self.offset
         if length < 1 or start + length > len(self.view) or self.view[start + length - 1] != 0:
             raise CdrError(f'{name} is cut short or not terminated')
         self.offset = start + length
-        return bytes(self.view[start:start + length - 1]).decode('utf-8', 'replace')
+        return start
 
     def header(self) -> Tuple[int, str]:
         sec, nanosec = self._take('iI', 8, 4)
@@ -440,10 +445,15 @@ class TeamCommandReader:
             raise TooManyPoses(f'{count} robots, more than {self.num_robots}')
         if count * 5 > len(reader.view) - reader.offset:
             raise CdrError(f'cut short: {count} names do not fit')
-        names = [reader.string('a joint name') for _ in range(count)]
+        first = reader.offset
+        for _ in range(count):
+            reader.skip_string('a joint name')
         key = bytes(reader.view[names_at:reader.offset])
         indices = self.names.get(key)
         if indices is None:
+            end, reader.offset = reader.offset, first
+            names = [reader.string('a joint name') for _ in range(count)]
+            assert reader.offset == end
             try:
                 indices = robot_indices(names, self.num_robots)
             except ValueError as exc:
