@@ -677,12 +677,12 @@ class TeamLink:
     state (:meth:`take`), senses each robot's neighbours within its R_i with the plant's
     sensing function (``core.sensing.sensed_pairs``), gives the leader its pose and neighbours
     (each other robot node gets its own when it reports them: :meth:`give`), and answers the
-    state as a robot answers one
-    (the leader's answer budget, watchdog and lockstep rules): every robot's command from one
-    call of the law (``core.law.robot_commands``, :meth:`commands`), in one team command
-    message (:meth:`publish`). Robot i's own ``cmd_vel`` carries its command too while
-    something subscribes to it. Each robot stays its own node: namespace, parameters,
-    diagnostics, its ``/formation/reference`` and changes subscriptions.
+    state as a robot answers one (the leader's answer budget, watchdog and lockstep rules):
+    every robot's command from one call of the law (``core.law.robot_commands``,
+    :meth:`commands`), in one team command message (:meth:`publish`). Robot i's own
+    ``cmd_vel`` carries its command too while something subscribes to it. Each robot stays its
+    own node: namespace, parameters, diagnostics, its ``/formation/reference`` and changes
+    subscriptions.
     """
 
     def __init__(self, nodes: Sequence[RobotNode]) -> None:
