@@ -11,7 +11,7 @@ Two standard messages carry a whole team's state and a robot process's or fleet'
   ``header.frame_id`` the ``world_frame``; ``poses[i - 1]`` is robot i's body: position (x, y,
   z; z = 0 in 2D) and orientation (x, y, z, w), the heading of a unicycle or of a point with
   ``command.frame: body``, else the identity. Exactly ``num_robots`` poses:
-  :func:`state_rows`, :func:`split_state`.
+  :func:`state_rows`.
 * ``/formation/commands``, a trajectory_msgs/MultiDOFJointTrajectory: ``header.stamp`` is the
   stamp of the state the commands answer, ``header.frame_id`` the ``world_frame``;
   ``joint_names`` the robots' names ``robot_<i>`` (:func:`robot_name`), in any order, each at
@@ -67,12 +67,6 @@ def state_rows(q: ArrayLike, orientations: ArrayLike) -> NDArray[np.float64]:
     rows[:, :q.shape[1]] = q
     rows[:, 3:] = orientations
     return rows
-
-
-def split_state(rows: ArrayLike, dim: int) -> Tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Return (q (N, dim), orientations (N, 4)) of a team state's (N, 7) rows (copies)."""
-    rows = np.asarray(rows, dtype=float)
-    return rows[:, :dim].copy(), rows[:, 3:POSE_WIDTH].copy()
 
 
 def command_vectors(u: ArrayLike,

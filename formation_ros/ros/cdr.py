@@ -27,7 +27,7 @@ import struct
 from typing import Dict, List, Optional, Sequence, Tuple
 
 from formation_ros.core.frames import frame_from_pose, FrameSample
-from formation_ros.core.transport import robot_indices
+from formation_ros.core.transport import robot_indices, state_rows
 from formation_ros.core.unicycle import quaternions_from_headings
 from formation_ros.core.units import NS_PER_S
 import numpy as np
@@ -373,12 +373,14 @@ class StateEncoder:
 
     def set_rows(self, q: NDArray[np.float64], headings: Optional[NDArray[np.float64]] = None,
                  orientations: Optional[NDArray[np.float64]] = None) -> None:
-        """Take the poses of every robot (as :meth:`encode` takes them) without encoding."""
-        self.rows[:, :self.dim] = q
+        """
+        Take the poses of every robot (as :meth:`encode` takes them) without encoding.
+
+        The rows are those of a team state (``core.transport.state_rows``): robot i's at i - 1.
+        """
         if headings is not None:
-            self.rows[:, 3:] = quaternions_from_headings(headings)
-        elif orientations is not None:
-            self.rows[:, 3:] = orientations
+            orientations = quaternions_from_headings(headings)
+        self.rows[:] = state_rows(q, self.rows[:, 3:] if orientations is None else orientations)
 
     def team(self, stamp_ns: int) -> bytes:
         """Return the team state (``core.transport``) of the poses last taken, at ``stamp_ns``."""

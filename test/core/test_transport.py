@@ -7,7 +7,7 @@ from formation_ros.core.frames import frame_from_pose, STATIONARY
 from formation_ros.core.law import make_law, robot_command, robot_commands
 from formation_ros.core.sensing import neighbour_lists, sensed_pairs, sensor_radii
 from formation_ros.core.transport import (command_vectors, commands_of, robot_indices,
-                                          robot_name, split_state, state_rows)
+                                          robot_name, state_rows)
 from formation_ros.core.unicycle import quaternions_from_headings
 import numpy as np
 import pytest
@@ -36,8 +36,7 @@ def test_state_rows_put_robot_i_at_entry_i_minus_1():
     rows = state_rows(q, turns)
     assert rows.shape == (3, 7)
     assert rows[1].tolist() == [3.0, 4.0, 0.0, *turns[1].tolist()]
-    back, orientations = split_state(rows, 2)
-    assert np.array_equal(back, q) and np.array_equal(orientations, turns)
+    assert np.array_equal(state_rows(np.c_[q, q[:, :1]], turns)[:, 2], q[:, 0])
 
 
 @pytest.mark.parametrize('unicycle', [False, True])
