@@ -343,7 +343,7 @@ class RobotNode(Node):
         else:
             self.references.append(msg)
             self.received_ns['reference'] = self._now_ns()
-            if self.lockstep:
+            if self.lockstep and (self.member_of is None or self.team is not None):
                 self.answer.arm()
 
     def _reject_change(self, what: str, why: str) -> None:
