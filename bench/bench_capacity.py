@@ -5,22 +5,26 @@
 Capacity benchmark: how many robots, at what rate, on this machine (on demand, not in CI).
 
 Usage: python bench/bench_capacity.py [--sizes 10 20 50 100] [--rates 20 50]
-[--modes process fleet] [--robots-per-process 25] [--measure 20] [--lockstep]
-[--prefix INSTALL] [--out DIR]; or python bench/bench_capacity.py --figure JSON... --out DIR
+[--modes process fleet] [--transport robot team] [--robots-per-process 25] [--measure 20]
+[--lockstep] [--prefix INSTALL] [--out DIR]; or python bench/bench_capacity.py --figure JSON...
+--out DIR
 
-For each mode, team size N and control rate it runs scripts/launch_formation.sh on the Section 5
-constants with N robots (random start at about 10 robots per m^2, lattice goal 2 m apart),
-control_rate, plant.publish_rate and reference.rate = RATE, plant.rate 100 Hz, one process per
-robot ('process') or --robots-per-process robots per 'fleet' process ('fleet'). It measures the
+For each transport, mode, team size N and control rate it runs scripts/launch_formation.sh on
+the Section 5 constants with N robots (random start at about 10 robots per m^2, lattice goal 2 m
+apart), control_rate, plant.publish_rate and reference.rate = RATE, plant.rate 100 Hz, one
+process per robot ('process') or --robots-per-process robots per 'fleet' process ('fleet'),
+with the per-robot topics ('robot', the default) or the team messages ('team': one state message,
+one command message per process per state; parameter transport). It measures the
 start-up (launch until the plant starts its clock: every robot has answered), then for MEASURE
 wall seconds the CPU time and resident memory of every process of the run, then stops the run
 with Ctrl-C and reads the plant's plant_stats.json: the achieved step rate, the fraction of
 steps at which every robot's applied command answered a state at most two control periods old
 ('fresh'), and the latency from the plant publishing a state to the answer arriving (p50, p99,
 max). With --lockstep it runs lockstep instead (plant.lockstep, as fast as the robots answer)
-and reports steps per second. Prints a Markdown table, writes OUT/capacity.json and a figure of
-the fresh fraction against N (OUT/capacity_fresh.png); --figure draws that figure from the
-capacity.json files of earlier runs (one per mode, say) and runs nothing.
+and reports steps per second. Prints a Markdown table, writes OUT/capacity.json and one figure
+of the fresh fraction against N for every transport, mode and rate side by side
+(OUT/capacity_fresh.png); --figure draws that figure from the capacity.json files of earlier
+runs (one per mode, say) and runs nothing.
 """
 
 import argparse
@@ -46,6 +50,7 @@ from formation_ros.ros.watch import stat_fields  # noqa: E402
 
 PLANT_RATE = 100.0
 MODES = ('process', 'fleet')
+TRANSPORTS = ('robot', 'team')
 CLOCK_STARTED = 'starting the clock'
 STOP_TIMEOUT = 120.0
 TICKS = os.sysconf('SC_CLK_TCK')
@@ -62,6 +67,10 @@ def build_parser() -> argparse.ArgumentParser:
                         help='control rates, Hz (default: %(default)s)')
     parser.add_argument('--modes', nargs='+', choices=MODES, default=list(MODES),
                         help='process: one per robot; fleet: --robots-per-process per process')
+    parser.add_argument('--transport', nargs='+', choices=TRANSPORTS, default=['robot'],
+                        dest='transports',
+                        help="robot: each robot's own topics; team: one message per state "
+                             'each way per process (default: %(default)s)')
     parser.add_argument('--robots-per-process', type=int, default=25,
                         help='robots per fleet process (default: %(default)s)')
     parser.add_argument('--measure', type=float, default=20.0,
@@ -123,11 +132,13 @@ def fresh_fraction(age_steps: Sequence[int], max_age: int) -> Optional[float]:
     return sum(age_steps[:kept + 1]) / total if total else None
 
 
-def case_params(n: int, rate: float, lockstep: bool) -> Dict[str, Any]:
+def case_params(n: int, rate: float, lockstep: bool,
+                transport: str = 'robot') -> Dict[str, Any]:
     """Parameters of one case (Section 5 constants, N robots, control and publish at RATE)."""
     params = params_for(n)
     params.update({'control_rate': float(rate), 'plant.publish_rate': float(rate),
-                   'reference.rate': float(rate), 'plant.rate': PLANT_RATE, 'duration': 1e4})
+                   'reference.rate': float(rate), 'plant.rate': PLANT_RATE, 'duration': 1e4,
+                   'transport': transport})
     if lockstep:
         params.update({'plant.lockstep': True, 'plant.realtime_factor': 1e3})
     return params
@@ -162,17 +173,18 @@ def stop(process: 'subprocess.Popen[bytes]') -> None:
 
 
 def run_case(args: argparse.Namespace, mode: str, n: int, rate: float,
-             folder: str) -> Dict[str, Any]:
+             folder: str, transport: str = 'robot') -> Dict[str, Any]:
     """Run one case and return its row."""
     params = os.path.join(folder, 'params.yaml')
-    write_params_file(params, case_params(n, rate, args.lockstep))
+    write_params_file(params, case_params(n, rate, args.lockstep, transport))
     run_dir = os.path.join(folder, 'run')
     log = os.path.join(folder, 'launcher.txt')
     command = ['bash', os.path.join(ROOT, 'scripts', 'launch_formation.sh'), params,
                '--duration', '0', '--out', run_dir, '--prefix', args.prefix]
     if mode == 'fleet':
         command += ['--robots-per-process', str(args.robots_per_process)]
-    row: Dict[str, Any] = {'mode': mode, 'robots': n, 'rate_hz': rate, 'lockstep': args.lockstep}
+    row: Dict[str, Any] = {'transport': transport, 'mode': mode, 'robots': n, 'rate_hz': rate,
+                           'lockstep': args.lockstep}
     with open(log, 'wb') as output:
         started = time.monotonic()
         process = subprocess.Popen(command, stdout=output, stderr=subprocess.STDOUT,
@@ -217,8 +229,9 @@ def _sum_where(values: Mapping[str, float], robots: bool) -> float:
 def format_row(row: Mapping[str, Any]) -> str:
     """One Markdown table row."""
     head = f"| {row['mode']} | {row['robots']} | {row['rate_hz']:g} |"
+    transport = f" {row.get('transport', 'robot')} |"
     if 'error' in row:
-        return head + f" {row['error']} |" + ' |' * 8
+        return head + f" {row['error']} |" + ' |' * 8 + transport
     latency = row['latency_ms']
     fresh = row['fresh_fraction']
     cpu, rss = row['cpu_percent'], row['rss_mib']
@@ -227,27 +240,33 @@ def format_row(row: Mapping[str, Any]) -> str:
             f"{latency['p50_ms'] or 0:.1f} / {latency['p99_ms'] or 0:.1f} / "
             f"{latency['max_ms']:.0f} | {cpu.get('plant', 0.0):.0f} | "
             f'{_sum_where(cpu, True):.0f} | {rss.get("plant", 0.0):.0f} | '
-            f'{sum(rss.values()) / 1024.0:.2f} |')
+            f'{sum(rss.values()) / 1024.0:.2f} |' + transport)
 
 
 HEADER = ('| mode | N | rate (Hz) | processes | start-up (s) | plant steps/s | fresh (%) | '
           'latency p50 / p99 / max (ms) | plant CPU (%) | robots CPU (%) | plant RSS (MiB) | '
-          'all RSS (GiB) |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|')
+          'all RSS (GiB) | transport |\n'
+          '|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|')
 
 
 def write_figure(path: str, rows: Sequence[Mapping[str, Any]]) -> None:
-    """Plot the fresh fraction against N per mode and rate into the PNG file ``path``."""
+    """Plot the fresh fraction against N per transport, mode and rate into PNG file ``path``."""
     import matplotlib
     matplotlib.use('Agg')
     import matplotlib.pyplot as plt
     figure, axes = plt.subplots(figsize=(7, 4.5))
-    keys = sorted({(row['mode'], row['rate_hz']) for row in rows})
-    for mode, rate in keys:
+
+    def key(row: Mapping[str, Any]) -> Tuple[str, str, float]:
+        return row.get('transport', 'robot'), row['mode'], row['rate_hz']
+
+    for transport, mode, rate in sorted({key(row) for row in rows}):
         points = sorted((row['robots'], 100.0 * row['fresh_fraction']) for row in rows
-                        if (row['mode'], row['rate_hz']) == (mode, rate)
+                        if key(row) == (transport, mode, rate)
                         and row.get('fresh_fraction') is not None)
         if points:
-            axes.plot(*zip(*points), marker='o', label=f'{mode}, {rate:g} Hz')
+            axes.plot(*zip(*points), marker='o' if transport == 'robot' else 's',
+                      linestyle='-' if transport == 'robot' else '--',
+                      label=f'{transport} transport, {mode}, {rate:g} Hz')
     axes.axhline(99.0, color='grey', linestyle='--', linewidth=0.8)
     axes.set_xscale('log')
     axes.set_xlabel('robots N')
@@ -292,10 +311,11 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     for mode in args.modes:
         for rate in args.rates:
             for n in args.sizes:
-                with tempfile.TemporaryDirectory(dir=args.out) as folder:
-                    row = run_case(args, mode, n, rate, folder)
-                rows.append(row)
-                print(format_row(row), flush=True)
+                for transport in args.transports:
+                    with tempfile.TemporaryDirectory(dir=args.out) as folder:
+                        row = run_case(args, mode, n, rate, folder, transport)
+                    rows.append(row)
+                    print(format_row(row), flush=True)
     result = {**machine, 'load_after': os.getloadavg(), 'arguments': vars(args), 'rows': rows}
     with open(os.path.join(args.out, 'capacity.json'), 'w', encoding='utf-8') as stream:
         json.dump(result, stream, indent=2, default=str)

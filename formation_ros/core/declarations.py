@@ -84,6 +84,13 @@ class CommandFrame(Choice):
     BODY = 'body'
 
 
+class Transport(Choice):
+    """How states and commands travel between the plant and the robots: ``transport``."""
+
+    ROBOT = 'robot'
+    TEAM = 'team'
+
+
 class SourceType(Choice):
     """The message the relay reads a measured pose from: ``relay.source_type``."""
 
@@ -303,6 +310,13 @@ DECLARATIONS = (
           "'body' (robot_<i>/base_link, rotated by the pose's orientation: holonomic bases "
           'that take body-frame velocities; unicycles always command (v, w) in their body '
           'frame).', choices=_choices(CommandFrame), users=COMMAND),
+    Param('transport', Kind.STRING, Transport.ROBOT.value,
+          "How states and commands travel: 'robot' (each robot's pose, neighbors and cmd_vel "
+          "topics, what real robots and the relay use) or 'team' (one /formation/states "
+          'message per state for every robot, one /formation/commands message per robot '
+          'process or fleet per state; the per-robot topics only while something subscribes '
+          'to them).', choices=_choices(Transport),
+          users=frozenset({Exe.PLANT, Exe.ROBOT, Exe.RECORD})),
     Param('wait_for_subscribers', Kind.INT, 1,
           'A robot sends its first command only once cmd_vel has this many subscribers (the '
           'plant; 2 when a recorder listens too).', low=at_least(0), high=at_least(1000),

@@ -201,6 +201,35 @@ def robot_command(q_i: ArrayLike, vertex_i: ArrayLike, neighbours: ArrayLike,
     return Command(u=u, u_hat=u_hat, omega=omega_hat)
 
 
+def robot_commands(q_own: ArrayLike, vertices: ArrayLike, observer: ArrayLike,
+                   neighbours: ArrayLike, sensing_radii: ArrayLike, law: LawParams,
+                   frame: Optional[FrameSample] = STATIONARY) -> Command:
+    """
+    Control of K robots, each from what it knows: :func:`robot_command` for all in one call.
+
+    q_own: (K, dim) the robots' own positions, world frame, m; vertices: (K, dim) their places
+    in the formation frame; (observer, neighbours): (P,) 0-based indices into the K robots and
+    (P, dim) world positions, row p a neighbour robot ``observer[p]`` has sensed (as the rows
+    of each robot's ``neighbours``, in the same order: the sums run in that order); those at
+    distance >= R_i (``sensing_radii``, (K,) m) of their observer are ignored. frame: the
+    reference's ``FrameSample`` (one for all). Returns a :class:`Command` with (K, dim) arrays,
+    equal to each robot's :func:`robot_command` (to rounding: tested to 1e-12).
+    """
+    q_own = np.asarray(q_own, dtype=float)
+    k, dim = q_own.shape
+    observer = np.asarray(observer, dtype=np.intp)
+    q_ij = q_own[observer] - np.asarray(neighbours, dtype=float).reshape(-1, dim)
+    radii = np.minimum(np.asarray(sensing_radii, dtype=float), RADIUS_MAX)
+    in_range = np.einsum('kd,kd->k', q_ij, q_ij) < radii[observer] ** 2
+    terms = repulsion_terms(to_frame_vectors(q_ij[in_range], frame), law)
+    heard = observer[in_range]
+    rep = np.stack([np.bincount(heard, terms[:, axis], k) for axis in range(dim)], axis=1)
+    error_hat = to_frame(q_own, frame) - np.asarray(vertices, dtype=float)
+    omega_hat = omega(error_hat, rep, law)
+    u_hat = bounded_command(omega_hat, law)
+    return Command(u=from_frame_velocity(u_hat, q_own, frame), u_hat=u_hat, omega=omega_hat)
+
+
 def neighbour_pairs(q: ArrayLike, radius: float,
                     tree: Optional['cKDTree'] = None) -> NDArray[np.intp]:
     """

@@ -24,7 +24,7 @@ from formation_ros.core.declarations import (BodyKind, BY_NAME, check_values, Co
                                              CommandType, DEFAULT_WORLD_FRAME, Exe,
                                              ParamError, PoseType, range_problem,
                                              ReferenceKind, SHAPE_NAME, shape_vertices_name,
-                                             SourceType, type_problem)
+                                             SourceType, Transport, type_problem)
 from formation_ros.core.dynamics import IDEAL, Imperfections
 from formation_ros.core.frames import desired_positions, from_frame_velocity
 from formation_ros.core.jump import JumpKind
@@ -183,7 +183,9 @@ class FormationConfig:
     ``formation.vertices``; ``vertices`` are then that shape's), schedule: (time in s, shape
     name) switches (``formation.schedule.*``); command: what cmd_vel carries (``command.*``);
     imperfections: how the bodies differ from q' = u (``plant.actuator_lag`` ...: ideal for
-    the executables that do not step bodies); relay: the relay's settings (None for the others).
+    the executables that do not step bodies); relay: the relay's settings (None for the others);
+    transport: per-robot topics or team messages (``transport``; robot for the executables that
+    do not read it).
     """
 
     num_robots: int
@@ -219,6 +221,12 @@ class FormationConfig:
     command: CommandSettings = CommandSettings()
     imperfections: Imperfections = IDEAL
     relay: Optional[RelaySettings] = None
+    transport: Transport = Transport.ROBOT
+
+    @property
+    def team_transport(self) -> bool:
+        """Tell whether states and commands travel as team messages (``transport: team``)."""
+        return self.transport is Transport.TEAM
 
     def law(self) -> LawParams:
         """Return the control law constants (``core.law.LawParams``)."""
@@ -744,7 +752,8 @@ def validate(raw: Mapping[str, Any], executable: Union[Exe, str] = Exe.SIM) -> F
         duration=values['duration'], lockstep=values.get('plant.lockstep', False),
         values=values, body=body, start_headings=headings, world_frame=world_frame,
         shapes=shapes, shape_name=values.get('formation.name', ''), schedule=schedule,
-        command=command, imperfections=imperfections, relay=relay, **own)
+        command=command, imperfections=imperfections, relay=relay,
+        transport=Transport(values.get('transport', Transport.ROBOT.value)), **own)
 
 
 def load_config(path: PathText,

@@ -21,6 +21,10 @@ from numpy.typing import NDArray
 if TYPE_CHECKING:
     from scipy.spatial import cKDTree
 
+SEARCH_MARGIN = 1.0 + 1e-9
+"""The ball search of a few observers reaches this much farther than their sensors; the strict
+test on squared distances then decides, as for the whole team."""
+
 
 def sensor_radii(radii: NDArray[np.float64], sensing_margin: float) -> NDArray[np.float64]:
     """Return how far each sensor reaches, m: R_i (N,) plus the bodies' margin (2 l or 0)."""
@@ -28,17 +32,23 @@ def sensor_radii(radii: NDArray[np.float64], sensing_margin: float) -> NDArray[n
 
 
 def sensed_pairs(q: NDArray[np.float64], reach: NDArray[np.float64],
-                 tree: Optional['cKDTree'] = None) -> Tuple[NDArray[np.intp], NDArray[np.intp]]:
+                 tree: Optional['cKDTree'] = None,
+                 observers: Optional[NDArray[np.intp]] = None
+                 ) -> Tuple[NDArray[np.intp], NDArray[np.intp]]:
     """
     Who senses whom: arrays (observer, seen) of every ordered pair with ||q_o - q_s|| < reach_o.
 
     q: (N, dim) body positions, m; reach: (N,) sensor reach, m (:func:`sensor_radii`); tree: a
-    k-d tree of ``q`` when the caller has one (else one is built). Sorted by observer, then
-    seen; indices 0-based.
+    k-d tree of ``q`` when the caller has one (else one is built); observers: (K,) distinct
+    0-based indices of the only observers wanted (a fleet's robots: the pairs of the whole team
+    whose observer is one of them, the same pairs), None for every robot. Sorted by observer,
+    then seen; indices 0-based.
     """
     if tree is None:
         from scipy.spatial import cKDTree  # here: a robot imports the plant model, not the tree
         tree = cKDTree(q)
+    if observers is not None:
+        return _pairs_of(q, reach, tree, np.asarray(observers, dtype=np.intp))
     pairs = tree.query_pairs(r=float(np.max(reach)), output_type='ndarray').reshape(-1, 2)
     diff = q[pairs[:, 0]] - q[pairs[:, 1]]
     d2 = np.einsum('kd,kd->k', diff, diff)
@@ -47,6 +57,24 @@ def sensed_pairs(q: NDArray[np.float64], reach: NDArray[np.float64],
     both = np.concatenate([first, second])
     order = np.lexsort((both[:, 1], both[:, 0]))
     return both[order, 0], both[order, 1]
+
+
+def _pairs_of(q: NDArray[np.float64], reach: NDArray[np.float64], tree: 'cKDTree',
+              observers: NDArray[np.intp]) -> Tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """:func:`sensed_pairs` of the given observers only, from a ball search around each."""
+    if len(observers) == 0:
+        empty = np.zeros(0, dtype=np.intp)
+        return empty, empty
+    found = tree.query_ball_point(q[observers], r=reach[observers] * SEARCH_MARGIN)
+    counts = np.fromiter(map(len, found), dtype=np.intp, count=len(observers))
+    observer = np.repeat(observers, counts)
+    seen = np.fromiter((j for near in found for j in near), dtype=np.intp, count=int(counts.sum()))
+    diff = q[observer] - q[seen]
+    d2 = np.einsum('kd,kd->k', diff, diff)
+    keep = (observer != seen) & (d2 < reach[observer] ** 2)
+    observer, seen = observer[keep], seen[keep]
+    order = np.lexsort((seen, observer))
+    return observer[order], seen[order]
 
 
 def neighbour_lists(observer: NDArray[np.intp], seen: NDArray[np.intp],

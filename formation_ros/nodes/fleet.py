@@ -17,14 +17,16 @@ Parameters given on the command line (``-p``) or in a parameters file apply to e
 the fleet; a file's ``/robot_3/robot:`` section applies to robot 3 alone, as it would to a
 robot process. The namespace of each robot is set by the fleet: ``-r __ns:=...`` is refused,
 and a ``robot_id`` must match it. The robots share one ``/clock`` subscription, so their
-``use_sim_time`` cannot be changed while they run.
+``use_sim_time`` cannot be changed while they run. With ``transport: team`` they share one
+``/formation/states`` subscription and one ``/formation/commands`` publisher too, and their
+commands come from one call of the law per state.
 """
 
 import re
 import sys
 from typing import List, Optional, Sequence
 
-from formation_ros.nodes.robot import RobotNode
+from formation_ros.nodes.robot import RobotNode, TeamLink
 from formation_ros.ros.runner import run
 from formation_ros.ros.topics import robot_namespace
 from rcl_interfaces.msg import SetParametersResult
@@ -128,10 +130,14 @@ def make_fleet(ids: Sequence[int]) -> List[RobotNode]:
     Build one robot node per id, robot i in ``/robot_<i>``, sharing one ``/clock`` subscription.
 
     Each node checks its parameters as a robot process does (a ``robot_id`` given to the fleet
-    disagrees with every namespace but one and is refused there).
+    disagrees with every namespace but one and is refused there). With ``transport: team`` the
+    fleet's robots hear the team's states and send their commands through one
+    :class:`formation_ros.nodes.robot.TeamLink`: one message in and one out per state.
     """
     nodes = [RobotNode(namespace=robot_namespace(i)) for i in ids]
     shared = share_sim_clock(nodes)
+    if nodes and nodes[0].config.team_transport:
+        TeamLink(nodes)
     if nodes and nodes[0].sim_time:
         nodes[0].get_logger().info(f'fleet of {len(nodes)} robots: {shared + 1} clocks driven '
                                    'by one /clock subscription')

@@ -26,6 +26,13 @@ the collision check. This node only moves messages in and out:
 With ``plant.lockstep`` it steps only when every robot has answered the latest state, which
 makes a run reproduce ``formation_sim --dt 1/plant.rate``.
 
+With ``transport: team`` (``core.transport``) it publishes each state once for every robot on
+``/formation/states`` and reads the commands from ``/formation/commands`` (one message per robot
+process or fleet, bytes checked before any element is read, malformed ones counted and dropped),
+admitted as every ``cmd_vel`` is; robot i's ``pose`` and ``neighbors`` are published only while
+someone subscribes to them, and ``cmd_vel`` is not subscribed to. Which robots are gone it tells
+from when their latest command arrived.
+
 One team per domain: before its first state the plant looks for :data:`LOOK_TIME` s (up to
 :data:`LOOK_LIMIT` s to hear the other's host) for another ``/clock`` publisher. If there is
 one, another plant or anything else, that sends ``/clock`` or announces itself on
@@ -66,10 +73,11 @@ from formation_ros.core.timeline import Mode
 from formation_ros.core.trajectory import (CHUNKS_DIR, ChunkWriter, read_body_chunks,
                                            read_chunks, save_atomically, Trajectory,
                                            TRAJECTORY_FILE)
+from formation_ros.core.transport import commands_of
 from formation_ros.core.units import NS_PER_S
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import (CdrError, encode_clock, read_twist, read_twist_stamped,
-                                   StateEncoder)
+                                   StateEncoder, TeamCommandReader)
 from formation_ros.ros.changes import Changes
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.liveliness import PeerLiveliness
@@ -84,6 +92,7 @@ import numpy as np
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock as ClockMsg
+from trajectory_msgs.msg import MultiDOFJointTrajectory
 from visualization_msgs.msg import MarkerArray
 
 PLANT_STATUS = 'formation_ros/plant'
@@ -104,6 +113,9 @@ LOOK_LIMIT = 5.0
 /diagnostics before refusing without it, s."""
 LOOK_PERIOD = 0.5
 """Seconds between looks at the graph while the clock waits for the robots."""
+LISTENERS_PERIOD = 0.5
+"""Team transport: seconds between looks at who subscribes to each robot's pose and neighbors
+(published only while someone does)."""
 
 
 class PlantNode(Node):
@@ -173,16 +185,24 @@ class PlantNode(Node):
         self.malformed = np.zeros(self.n, dtype=np.int64)
         self.pose_pubs, self.neighbour_pubs = [], []
         self.command_liveliness: List[PeerLiveliness] = []
+        self.team_transport = config.team_transport
+        self.listened = np.ones(self.n, dtype=bool)
         for i in range(1, self.n + 1):
             self.pose_pubs.append(self.create_publisher(
                 PoseStamped, topics.robot_topic(i, topics.POSE), qos.STATE))
             self.neighbour_pubs.append(self.create_publisher(
                 PoseArray, topics.robot_topic(i, topics.NEIGHBOURS), qos.STATE))
+            if self.team_transport:
+                continue
             self.command_liveliness.append(PeerLiveliness())
             self.command_subs.append(self.create_subscription(
                 TwistStamped if self.stamped else Twist, topics.robot_topic(i, topics.CMD_VEL),
                 lambda data, index=i - 1: self.on_command(index, data), qos.COMMAND, raw=True,
                 event_callbacks=self.command_liveliness[-1].callbacks()))
+        self.malformed_team = 0
+        self.wrong_frame_team = 0
+        if self.team_transport:
+            self._team_topics()
         self.clock_pub = self.create_publisher(ClockMsg, topics.CLOCK, qos.CLOCK)
         self.clock_sub = self.create_subscription(ClockMsg, topics.CLOCK, self.on_clock,
                                                   qos.CLOCK, raw=True)
@@ -191,6 +211,8 @@ class PlantNode(Node):
         for pose, neighbours in zip(self.pose_pubs, self.neighbour_pubs):
             self.expected_publishers[pose.topic_name] = self.own_name
             self.expected_publishers[neighbours.topic_name] = self.own_name
+        if self.team_transport:
+            self.expected_publishers[self.states_pub.topic_name] = self.own_name
         self.command_index = {sub.topic_name: i for i, sub in enumerate(self.command_subs)}
         self.expected_publishers.update(dict.fromkeys(self.command_index))
         self.diagnostics_pub = self.create_publisher(
@@ -212,9 +234,67 @@ class PlantNode(Node):
             f'reference {self.reference.kind}, '
             + ('lockstep' if self.lockstep
                else f'realtime factor {settings.realtime_factor:g}')
+            + (', team transport' if self.team_transport else '')
             + ('' if config.imperfections.is_ideal else ', bodies beyond the paper: ' + ', '.join(
                 f'{name} = {value:g}' for name, value in config.imperfections.as_dict().items()
                 if value)))
+
+    def _team_topics(self) -> None:
+        """
+        Team transport: publish /formation/states, hear /formation/commands.
+
+        The robots' pose and neighbors are published only while someone subscribes (looked up
+        every :data:`LISTENERS_PERIOD` s); cmd_vel is not subscribed to (a robot publishes it
+        while something else does).
+        """
+        self.states_pub = self.create_publisher(PoseArray, topics.STATES, qos.STATE)
+        self.team_reader = TeamCommandReader(self.n)
+        self.team_liveliness = PeerLiveliness()
+        self.team_sub = self.create_subscription(
+            MultiDOFJointTrajectory, topics.TEAM_COMMANDS, self.on_team_command, qos.COMMAND,
+            raw=True, event_callbacks=self.team_liveliness.callbacks())
+        self.listeners_timer = self.create_timer(LISTENERS_PERIOD, self._look_at_listeners,
+                                                 clock=self.steady)
+        self._look_at_listeners()
+
+    def _look_at_listeners(self) -> None:
+        """Team transport: note which robots' pose or neighbors someone subscribes to."""
+        self.listened = np.array([pose.get_subscription_count() > 0
+                                  or neighbours.get_subscription_count() > 0
+                                  for pose, neighbours in zip(self.pose_pubs,
+                                                              self.neighbour_pubs)], dtype=bool)
+
+    def on_team_command(self, data: bytes) -> None:
+        """
+        Team transport: store the commands of one team message, as :meth:`on_command` does.
+
+        Its header is in ``world_frame`` and stamped with the state its commands answer; each
+        velocity is in its robot's command frame (``core.transport``). Malformed or oversized
+        bytes (checked before any element is read) are counted and dropped, logged once.
+        """
+        try:
+            message = self.team_reader.read(data)
+        except CdrError as exc:
+            self.malformed_team += 1
+            self.once.start('malformed-team', 'ignoring /formation/commands bytes that are not '
+                                              f'a team command ({exc}; logged once, counted in '
+                                              'diagnostics)', 'error')
+            return
+        if message.frame_id != self.config.world_frame:
+            self.wrong_frame_team += 1
+            self.once.start('frame-team', 'ignoring /formation/commands in frame '
+                                          f'{message.frame_id!r}: its header is in '
+                                          f'{self.config.world_frame!r} (logged once, counted '
+                                          'in diagnostics)', 'error')
+            return
+        indices = message.indices
+        self.commands.u[indices] = commands_of(message.linear, message.angular, self.dim,
+                                               self.unicycles)
+        self.commands.stamp_ns[indices] = message.stamp_ns
+        self.commands.present[indices] = True
+        self.arrived_ns[indices] = time.monotonic_ns()
+        if self.lockstep:
+            self.step_wake.arm()
 
     def on_clock(self, data: bytes) -> None:
         """Before the first state: count /clock messages, which only another node sends."""
@@ -445,6 +525,9 @@ class PlantNode(Node):
         """
         Publish /clock, then what the robots sense: every pose and each range sensor's bodies.
 
+        Team transport: one /formation/states message, and robot i's pose and neighbors only
+        while someone subscribes to them.
+
         That is the model's sensed state (``PlantModel.sensed``): the present one for ideal
         sensing; with ``plant.pose_noise`` / ``plant.state_delay`` the noisy state measured the
         delay ago, stamped with its measurement time (the clock stays the present).
@@ -455,14 +538,17 @@ class PlantNode(Node):
         self.published_ns.setdefault(state.stamp_ns, time.monotonic_ns())
         while len(self.published_ns) > PUBLISHES_TIMED:
             self.published_ns.popitem(last=False)
-        observer, seen = self.model.sensed_pairs()
-        poses, arrays = self.state_encoder.encode(
-            state.q, observer, seen, state.stamp_ns,
-            state.heading if self.unicycles or self.body_frame else None)
-        for publisher, message in zip(self.pose_pubs, poses):
-            publisher.publish(message)
-        for publisher, message in zip(self.neighbour_pubs, arrays):
-            publisher.publish(message)
+        headings = state.heading if self.unicycles or self.body_frame else None
+        if self.team_transport:
+            self.state_encoder.set_rows(state.q, headings)
+            self.states_pub.publish(self.state_encoder.team(state.stamp_ns))
+        if not self.team_transport or np.any(self.listened):
+            observer, seen = self.model.sensed_pairs()
+            poses, arrays = self.state_encoder.encode(state.q, observer, seen, state.stamp_ns,
+                                                      headings)
+            for i in np.flatnonzero(self.listened).tolist():
+                self.pose_pubs[i].publish(poses[i])
+                self.neighbour_pubs[i].publish(arrays[i])
         self.last_publish_wall = time.monotonic()
 
     def _resend_if_due(self) -> None:
@@ -472,16 +558,25 @@ class PlantNode(Node):
     def _all_robots_up(self) -> bool:
         """While waiting: start the clock once every robot has sent a command."""
         missing = (np.flatnonzero(~self.commands.present) + 1).tolist()
-        wanted = self.settings.wait_for_subscribers
-        unheard = [pub for pub in self.pose_pubs if pub.get_subscription_count() < wanted]
+        wanted = self.settings.wait_for_subscribers - (1 if self.team_transport else 0)
+        unheard = ([pub for pub in self.pose_pubs if pub.get_subscription_count() < wanted]
+                   if wanted > 0 else [])
+        if self.team_transport and self.states_pub.get_subscription_count() < 1:
+            unheard.append(self.states_pub)
         if missing or unheard:
             more = '...' if len(missing) > 10 else ''
+            listeners = f'{wanted} subscribers on every pose topic'
+            if self.team_transport:
+                listeners = (f'a subscriber of {topics.STATES}'
+                             + (f' and {listeners}' if wanted > 0 else ''))
             self.once.start('waiting', f'waiting for {len(missing)} of {self.n} robots to send '
                                        f'a command (robots {missing[:10]}{more}) and for '
-                                       f'{wanted} subscribers on every pose topic', 'info')
+                                       f'{listeners}', 'info')
             self._resend_if_due()
             return False
         self.waiting = False
+        if self.team_transport:
+            self._look_at_listeners()
         self.started_wall = time.monotonic()
         self.rate_window = (self.started_wall, self.model.counts.steps)
         started = f'all {self.n} robots are up: starting the clock'
@@ -519,13 +614,20 @@ class PlantNode(Node):
         if np.any(self.malformed):
             values['robots with malformed cmd_vel messages'] = ', '.join(
                 f'{i + 1}: {count}' for i, count in enumerate(self.malformed.tolist()) if count)
+        if self.team_transport:
+            values['transport'] = 'team'
+            values['malformed team command messages'] = self.malformed_team
+            values['team command messages in another frame'] = self.wrong_frame_team
+            values['team command publishers alive'] = self.team_liveliness.alive
+            values['robots with pose and neighbors published'] = ', '.join(
+                str(i + 1) for i in np.flatnonzero(self.listened).tolist()) or 'none'
         for status in (CommandStatus.STALE, CommandStatus.FUTURE, CommandStatus.NON_FINITE,
                        CommandStatus.SATURATED):
             robots = counts.by_robot(status)
             if robots:
                 values[f'robots with {status.name.lower().replace("_", "-")} commands'] = \
                     ', '.join(f'{robot}: {steps}' for robot, steps in robots.items())
-        states = [peer.state() for peer in self.command_liveliness]
+        states = self._command_states()
         for state in ('alive', 'lost'):
             robots = [str(i + 1) for i, s in enumerate(states) if s == state]
             values[f'robots with {state} cmd_vel'] = ', '.join(robots) or 'none'
@@ -563,6 +665,22 @@ class PlantNode(Node):
         else:
             level, message = 'ok', 'running'
         self.diagnostics_pub.publish(diagnostics(PLANT_STATUS, level, message, values))
+
+    def _command_states(self) -> List[str]:
+        """
+        Return each robot's 'alive', 'lost' or 'unknown', as its commands show it.
+
+        Robot transport: its cmd_vel's DDS liveliness. Team transport: whether its latest
+        command arrived within the liveliness lease (wall clock; 'unknown' before the first),
+        so that the robots of a fleet that died show as lost within about a second, as the
+        robots of one that is alive do not (a robot process or fleet answers every state).
+        """
+        if not self.team_transport:
+            return [peer.state() for peer in self.command_liveliness]
+        lease_ns = int(qos.LIVELINESS_LEASE * NS_PER_S)
+        recent = time.monotonic_ns() - self.arrived_ns <= lease_ns
+        return ['unknown' if not present else 'alive' if fresh else 'lost'
+                for present, fresh in zip(self.commands.present.tolist(), recent.tolist())]
 
     def _shared_topics(self, now: float) -> Dict[str, str]:
         """
@@ -705,6 +823,9 @@ class PlantNode(Node):
             i + 1: count for i, count in enumerate(self.wrong_frame.tolist()) if count}
         stats['malformed_command_messages'] = {
             i + 1: count for i, count in enumerate(self.malformed.tolist()) if count}
+        stats['transport'] = self.config.transport.value
+        if self.team_transport:
+            stats['malformed_team_command_messages'] = self.malformed_team
         text = (json.dumps(stats, indent=2) + '\n').encode()
         where = os.path.join(output_dir, PLANT_STATS_FILE)
         try:

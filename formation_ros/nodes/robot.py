@@ -37,6 +37,11 @@ one on ``cmd_vel``. A robot also looks up, once a second, who publishes ``/clock
 naming them (two teams on one domain), and a robot refusing stamps from another clock says so
 then instead of advising ``use_sim_time``.
 
+With ``transport: team`` a robot hears no ``pose`` or ``neighbors``: its process reads the
+team's ``/formation/states`` once for all its robots and answers with one
+``/formation/commands`` message (:class:`TeamLink`); its ``cmd_vel`` carries its command only
+while someone subscribes to it.
+
 Every state and reference message must be in ``world_frame`` (default ``world``). Commands for
 real bases: ``command.type: twist`` publishes a geometry_msgs/Twist (no stamp) instead of a
 TwistStamped, and ``command.frame: body`` publishes a point robot's u in its
@@ -48,22 +53,25 @@ from collections import deque
 import enum
 import math
 import time
-from typing import Callable, Dict, List, Optional, Tuple, TypeVar
+from typing import Callable, Dict, List, Optional, Sequence, Tuple, TypeVar
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.answers import AnswerBudget
-from formation_ros.core.declarations import CommandFrame, Exe, PoseType
+from formation_ros.core.declarations import CommandFrame, Exe, ParamError, PoseType
 from formation_ros.core.frames import advance, FrameSample, to_body_frame, valid_quaternions
-from formation_ros.core.law import Command, robot_command
+from formation_ros.core.law import Command, robot_command, robot_commands
+from formation_ros.core.sensing import sensed_pairs, sensor_radii
 from formation_ros.core.team import team_values
 from formation_ros.core.timeline import Mode, TeamState
+from formation_ros.core.transport import command_vectors, robot_name
 from formation_ros.core.unicycle import (hand_points, headings_from_quaternions,
                                          unicycle_commands)
 from formation_ros.core.units import NS_PER_S
 from formation_ros.ros import messages, qos, topics
-from formation_ros.ros.cdr import (CdrError, encode_twist, encode_twist_stamped, OdometryData,
-                                   PoseArrayData, PoseData, read_odometry, read_pose_array,
-                                   read_pose_stamped, TooManyPoses)
+from formation_ros.ros.cdr import (CdrError, encode_names, encode_team_commands, encode_twist,
+                                   encode_twist_stamped, OdometryData, PoseArrayData, PoseData,
+                                   read_odometry, read_pose_array, read_pose_stamped,
+                                   TooManyPoses)
 from formation_ros.ros.changes import Changes
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.once import OnceLog
@@ -79,6 +87,7 @@ import rclpy
 from rclpy.clock import Clock, ClockType
 from rclpy.duration import Duration
 from rclpy.node import Node
+from trajectory_msgs.msg import MultiDOFJointTrajectory
 
 Read = TypeVar('Read')
 REFERENCE_BUFFER = 64
@@ -91,6 +100,13 @@ COPY_GAP_NS = 25_000_000
 a fast copy (the plant sends a state again 0.05 s after the last while it waits, and once more
 when it starts its clock); more than FAST_COPIES of them in a row count as flooding."""
 FAST_COPIES = 3
+LISTENERS_PERIOD = 0.5
+"""Team transport: seconds between looks at who subscribes to each robot's cmd_vel."""
+TEAM_VALUES = ('num_robots', 'dim', 'world_frame', 'repulsion_radius', 'controller.gain',
+               'controller.kappa', 'controller.psi', 'jump.kind', 'jump.order', 'body.kind',
+               'body.hand_distance', 'command.type', 'command.frame', 'plant.lockstep')
+"""Parameters the robots of one team link share: it computes their commands in one call (the
+watchdog and input timeout are the leader's)."""
 
 
 class Reason(enum.Enum):
@@ -162,15 +178,12 @@ class RobotNode(Node):
         self.resent_ns = 0
         self.graph = PublisherWatch(self)
         self.shared: Dict[str, str] = {}
+        self.team: Optional[TeamLink] = None
+        """The team link this robot leads (team transport: the first robot of its process)."""
+        self.member_of: Optional[TeamLink] = None
 
-        if settings.pose_type is PoseType.ODOMETRY:
-            self.create_subscription(Odometry, topics.POSE, self.on_odometry, qos.STATE_INPUT,
-                                     raw=True)
-        else:
-            self.create_subscription(PoseStamped, topics.POSE, self.on_pose, qos.STATE_INPUT,
-                                     raw=True)
-        self.create_subscription(PoseArray, topics.NEIGHBOURS, self.on_neighbours,
-                                 qos.STATE_INPUT, raw=True)
+        if not config.team_transport:
+            self._subscribe_to_states(settings.pose_type)
         reference = self.create_subscription(Odometry, topics.REFERENCE, self.on_reference,
                                              qos.REFERENCE, raw=True)
         self.expected_publishers: Dict[str, Optional[str]] = {reference.topic_name: None}
@@ -196,7 +209,19 @@ class RobotNode(Node):
             + f"commands as {'TwistStamped' if self.stamped else 'Twist'} in "
               f'{self.command_frame}, '
 
-            + ('lockstep' if self.lockstep else f'{settings.control_rate:g} Hz'))
+            + ('lockstep' if self.lockstep else f'{settings.control_rate:g} Hz')
+            + (', team transport' if config.team_transport else ''))
+
+    def _subscribe_to_states(self, pose_type: PoseType) -> None:
+        """Robot transport: hear this robot's ``pose`` and ``neighbors``."""
+        if pose_type is PoseType.ODOMETRY:
+            self.create_subscription(Odometry, topics.POSE, self.on_odometry, qos.STATE_INPUT,
+                                     raw=True)
+        else:
+            self.create_subscription(PoseStamped, topics.POSE, self.on_pose, qos.STATE_INPUT,
+                                     raw=True)
+        self.create_subscription(PoseArray, topics.NEIGHBOURS, self.on_neighbours,
+                                 qos.STATE_INPUT, raw=True)
 
     @staticmethod
     def _now_ns() -> int:
@@ -318,7 +343,7 @@ class RobotNode(Node):
         else:
             self.references.append(msg)
             self.received_ns['reference'] = self._now_ns()
-            if self.lockstep:
+            if self.lockstep and (self.member_of is None or self.team is not None):
                 self.answer.arm()
 
     def _reject_change(self, what: str, why: str) -> None:
@@ -370,8 +395,11 @@ class RobotNode(Node):
                                            'parameters file?)', 'warning')
         if self.changes.states.at(stamp_ns).mode is Mode.STOPPED:
             self.once.start('stopped', 'team stopped: holding still', 'info')
-            return np.zeros(2 if self.unicycle else self.dim)
+            width = 2 if self.unicycle else self.dim
+            return np.zeros(width if self.team is None else (len(self.team.nodes), width))
         self.once.end('stopped', 'team running again')
+        if self.team is not None:
+            return self.team.commands(stamp_ns, frame)
         self.vertex = self.changes.shapes.at(stamp_ns).vertices[self.index]
         self.last = robot_command(self._own_position(), self.vertex, self._neighbour_points(),
                                   self.sensing_radius, self.law, frame)
@@ -413,8 +441,12 @@ class RobotNode(Node):
 
         u: (dim,) m/s in the world frame or (``command.frame: body``) the body frame, or for a
         unicycle (v, w) in its body frame; as a TwistStamped in ``command_frame`` stamped
-        ``stamp_ns``, or a Twist (``command.type: twist``).
+        ``stamp_ns``, or a Twist (``command.type: twist``). Team transport: u (K, width) of
+        every robot of the link, as one team command (:meth:`TeamLink.publish`).
         """
+        if self.team is not None:
+            self.last_message = self.team.publish(u, stamp_ns)
+            return
         if self.unicycle:
             v, w = (0.0, 0.0) if u is None else (float(u[0]), float(u[1]))
             linear, angular = (v, 0.0, 0.0), (0.0, 0.0, w)
@@ -434,6 +466,10 @@ class RobotNode(Node):
         In lockstep the reference sample of the state's stamp is needed too; otherwise the
         newest sample is carried forward to the state's time.
         """
+        if self.member_of is not None and self.team is None:
+            return
+        if self.team is not None:
+            self.team.take()
         if self.lockstep:
             self._lockstep_answer()
         elif (self.pose is not None and self.neighbours is not None
@@ -491,7 +527,7 @@ class RobotNode(Node):
                 self._flooding(stamp)
             elif (self.last_message is not None
                   and now - self.resent_ns >= max(COPY_GAP_NS, self.budget.period_ns)):
-                self.cmd_pub.publish(self.last_message)
+                (self.cmd_pub if self.team is None else self.team.pub).publish(self.last_message)
                 self.resent_ns = now
             self.copy_arrived_ns = now
             self.answered_count = self.pose_count
@@ -515,14 +551,18 @@ class RobotNode(Node):
     def _ready(self) -> bool:
         """Start-up: every input heard once and cmd_vel has its subscribers (plant, recorder)."""
         never = [name for name in INPUTS if self.received_ns[name] is None]
-        listeners = self.cmd_pub.get_subscription_count()
+        listeners = (self.cmd_pub.get_subscription_count() if self.team is None
+                     else self.team.listeners())
         if never or listeners < self.wait_subscribers:
-            missing = never + ([f'{self.wait_subscribers} cmd_vel subscribers (have '
+            what = 'cmd_vel' if self.team is None else 'command (team topic and cmd_vel)'
+            missing = never + ([f'{self.wait_subscribers} {what} subscribers (have '
                                 f'{listeners})'] if listeners < self.wait_subscribers else [])
             self.once.start('waiting', f"waiting for {', '.join(missing)}", 'info')
             return False
         self.once.end('waiting')
         self.waiting = False
+        if self.team is not None:
+            self.team.look_at_listeners()
         return True
 
     def _lockstep_answer(self) -> None:
@@ -551,13 +591,23 @@ class RobotNode(Node):
         The zero answers the latest state (a base that drops old stamps still takes it), and
         the node waits up to :data:`LAST_WORD` s for its subscribers to have it.
         """
-        if self.pose is None or not rclpy.ok(context=self.context):
+        if (self.pose is None or not rclpy.ok(context=self.context)
+                or (self.member_of is not None and self.team is None)):
             return
         self._publish_command(None, self.pose.stamp_ns)
-        self.cmd_pub.wait_for_all_acked(Duration(seconds=LAST_WORD))
+        (self.cmd_pub if self.team is None else self.team.pub).wait_for_all_acked(
+            Duration(seconds=LAST_WORD))
 
     def on_diagnostics(self) -> None:
-        """Publish this robot's status: input ages, neighbours in range, command size."""
+        """
+        Publish this robot's status: input ages, neighbours in range, command size.
+
+        Team transport: what the robot's link last gave it, and the link's state (waiting,
+        stale, flooding, the look at who publishes /clock and the reference: its leader's).
+        """
+        if self.member_of is not None:
+            self.member_of.give(self)
+        leader = self if self.member_of is None else self.member_of.leader
         now = self._now_ns()
         values = {f'{name} message age [s]': ('never' if self.received_ns[name] is None
                                               else (now - self.received_ns[name]) / NS_PER_S)
@@ -582,18 +632,20 @@ class RobotNode(Node):
                 np.max(np.abs(self.last_body_command)))
         values.update({f'rejected {name} messages ({reason.value})': count
                        for (name, reason), count in self.rejected.items()})
-        values['states not answered (flooding)'] = self.flooded
-        flooding = self.flooded > self.flooded_reported
-        self.flooded_reported = self.flooded
-        shared = self._shared_topics()
+        values['states not answered (flooding)'] = leader.flooded
+        if self.member_of is not None:
+            values['cmd_vel published'] = self.member_of.publishes_cmd_vel(self)
+        flooding = leader.flooded > self.flooded_reported
+        self.flooded_reported = leader.flooded
+        shared = self._shared_topics() if leader is self else leader.shared
         if shared:
             values['topics with more than one publisher'] = ' | '.join(
                 f'{topic}: {names}' for topic, names in sorted(shared.items()))
             level, message = 'error', (f"{', '.join(sorted(shared))}: more than one publisher "
                                        '(two teams on one domain?)')
-        elif self.waiting:
+        elif leader.waiting:
             level, message = 'warn', 'waiting for its first inputs'
-        elif self.once.is_active('stale'):
+        elif leader.once.is_active('stale'):
             level, message = 'warn', 'publishing zero: inputs stale'
         elif flooding:
             level, message = 'warn', 'flooding: states beyond the state rate dropped'
@@ -615,6 +667,208 @@ class RobotNode(Node):
         return shared
 
 
+class TeamLink:
+    """
+    The team transport of one robot process or fleet: its robots' states in, their commands out.
+
+    One subscription to ``/formation/states`` and one publisher on ``/formation/commands``, on
+    the first robot node (the leader), for all robots of the process. The callback stores the
+    bytes and wakes the leader, whose timer (:meth:`RobotNode.on_state`) reads and checks the
+    state (:meth:`take`), senses each robot's neighbours within its R_i with the plant's
+    sensing function (``core.sensing.sensed_pairs``), gives the leader its pose and neighbours
+    (each other robot node gets its own when it reports them: :meth:`give`), and answers the
+    state as a robot answers one (the leader's answer budget, watchdog and lockstep rules):
+    every robot's command from one call of the law (``core.law.robot_commands``,
+    :meth:`commands`), in one team command message (:meth:`publish`). Robot i's own
+    ``cmd_vel`` carries its command too while something subscribes to it. Each robot stays its
+    own node: namespace, parameters, diagnostics, its ``/formation/reference`` and changes
+    subscriptions.
+    """
+
+    def __init__(self, nodes: Sequence[RobotNode]) -> None:
+        """
+        Link ``nodes`` (team transport, sharing :data:`TEAM_VALUES`; ParamError if not).
+
+        The first is the leader; the rows of the link's arrays are the robots in id order.
+        """
+        leader = self.leader = nodes[0]
+        self.nodes = sorted(nodes, key=lambda node: node.index)
+        config = leader.config
+        differing = [name for name in TEAM_VALUES for node in self.nodes[1:]
+                     if node.config.values.get(name) != config.values.get(name)]
+        if differing:
+            raise ParamError([(differing[0], 'must be the same for every robot of a process '
+                                             'with transport team (one call of the law '
+                                             'computes their commands)')])
+        self.n, self.dim = config.num_robots, config.dim
+        self.unicycle, self.body_frame = leader.unicycle, leader.body_frame
+        self.width = 2 if self.unicycle else self.dim
+        self.indices = np.array([node.index for node in self.nodes], dtype=np.intp)
+        self.radii = np.array([node.sensing_radius for node in self.nodes])
+        self.reach = np.zeros(self.n)
+        self.reach[self.indices] = sensor_radii(
+            self.radii, 2.0 * leader.hand_distance if self.unicycle else 0.0)
+        self.local = np.full(self.n, -1, dtype=np.intp)
+        self.local[self.indices] = np.arange(len(self.nodes))
+        self.names = encode_names([robot_name(int(i) + 1) for i in self.indices])
+        self.heard: Optional[bytes] = None
+        self.state: Optional[PoseArrayData] = None
+        self.taken_ns = 0
+        self.bounds = np.zeros(len(self.nodes) + 1, dtype=np.intp)
+        self.command: Optional[Command] = None
+        self.body: Optional[NDArray[np.float64]] = None
+        self.vertices = np.zeros((len(self.nodes), self.dim))
+        self.points = np.zeros((self.n, self.dim))
+        self.headings = np.zeros(self.n)
+        self.orientations = np.zeros((self.n, 4))
+        self.observer = np.zeros(0, dtype=np.intp)
+        self.seen = np.zeros(0, dtype=np.intp)
+        self.listening = np.zeros(len(self.nodes), dtype=bool)
+        for node in self.nodes:
+            node.member_of = self
+            timer = getattr(node, 'timer', None)
+            if node is not leader and timer is not None:
+                node.destroy_timer(timer)
+        leader.team = self
+        self.pub = leader.create_publisher(MultiDOFJointTrajectory, topics.TEAM_COMMANDS,
+                                           qos.COMMAND)
+        leader.create_subscription(PoseArray, topics.STATES, self.on_states, qos.STATE_INPUT,
+                                   raw=True)
+        self.listeners_timer = leader.create_timer(LISTENERS_PERIOD, self.look_at_listeners,
+                                                   clock=leader.steady)
+
+    def on_states(self, data: bytes) -> None:
+        """Store the latest team state's bytes and wake the leader."""
+        self.heard = data
+        self.leader.answer.arm()
+
+    def look_at_listeners(self) -> None:
+        """Note which robots' cmd_vel someone subscribes to (published only then)."""
+        self.listening = np.array([node.cmd_pub.get_subscription_count() > 0
+                                   for node in self.nodes], dtype=bool)
+
+    def publishes_cmd_vel(self, node: RobotNode) -> str:
+        """Return 'yes' while robot ``node``'s own cmd_vel is published (someone listens)."""
+        return 'yes' if self.listening[self.local[node.index]] else 'no'
+
+    def listeners(self) -> int:
+        """Return the command subscribers every robot has: team topic plus its fewest cmd_vel."""
+        return (self.pub.get_subscription_count()
+                + min(node.cmd_pub.get_subscription_count() for node in self.nodes))
+
+    def take(self) -> None:
+        """
+        Read the team state heard (if any), check it as a robot checks a pose, sense, store.
+
+        A state must hold exactly ``num_robots`` finite poses (and unit quaternions where the
+        headings are needed) in ``world_frame``, on this node's clock; others are counted and
+        logged once in the leader's diagnostics (``rejected states messages``).
+        """
+        data, self.heard = self.heard, None
+        leader = self.leader
+        if data is None:
+            return
+        state = leader._read('states', lambda raw: read_pose_array(raw, self.n), data)
+        if state is None:
+            return
+        if len(state.positions) != self.n:
+            leader._reject('states', Reason.MALFORMED, f' ({len(state.positions)} poses for '
+                                                       f'{self.n} robots)')
+            return
+        positions, orientations = state.positions[:, :self.dim], state.orientations
+        needs_orientation = self.unicycle or self.body_frame
+        finite = bool(np.all(np.isfinite(positions))
+                      and (not needs_orientation or np.all(np.isfinite(orientations))))
+        oriented = not needs_orientation or bool(np.all(valid_quaternions(orientations)))
+        if not leader._check('states', state.frame_id, state.stamp_ns, finite, oriented):
+            return
+        observer, self.seen = sensed_pairs(positions, self.reach, observers=self.indices)
+        self.observer = self.local[observer]
+        if self.unicycle:
+            self.headings = headings_from_quaternions(orientations)
+            self.points = hand_points(positions, self.headings, leader.hand_distance)
+        else:
+            self.points = positions
+        self.orientations = orientations
+        self.bounds = np.searchsorted(self.observer, np.arange(len(self.nodes) + 1))
+        self.state, self.taken_ns = state, leader._now_ns()
+        self.give(leader)
+        leader.pose_count += 1
+
+    def give(self, node: RobotNode) -> None:
+        """
+        Give robot ``node`` what it would have heard and computed, as of the state taken last.
+
+        Its pose and neighbours in that state and its latest command: what its diagnostics
+        report (and the leader's answers use).
+        """
+        state = self.state
+        if state is None:
+            return
+        k = int(self.local[node.index])
+        seen = self.seen[self.bounds[k]:self.bounds[k + 1]]
+        node.pose = PoseData(state.stamp_ns, state.frame_id,
+                             tuple(state.positions[node.index].tolist()),
+                             tuple(state.orientations[node.index].tolist()))
+        node.neighbours = PoseArrayData(state.stamp_ns, state.frame_id, state.positions[seen],
+                                        state.orientations[seen])
+        node.received_ns['pose'] = node.received_ns['neighbour'] = self.taken_ns
+        if self.command is not None:
+            node.vertex = self.vertices[k]
+            node.last = Command(u=self.command.u[k], u_hat=self.command.u_hat[k],
+                                omega=self.command.omega[k])
+            node.last_body_command = None if self.body is None else self.body[k]
+
+    def commands(self, stamp_ns: int, frame: FrameSample) -> NDArray[np.float64]:
+        """
+        Return every robot's command for the state taken: (K, width), in their command frames.
+
+        u of eqs. (14), (25) from ``core.law.robot_commands`` (what each robot's
+        ``robot_command`` gives), then (v, w) for unicycles or the body frame's u.
+        """
+        leader = self.leader
+        self.vertices = leader.changes.shapes.at(stamp_ns).vertices[self.indices]
+        command = robot_commands(self.points[self.indices], self.vertices, self.observer,
+                                 self.points[self.seen], self.radii, leader.law, frame)
+        if self.unicycle:
+            body: Optional[NDArray[np.float64]] = unicycle_commands(
+                command.u, self.headings[self.indices], leader.hand_distance)
+        elif self.body_frame:
+            body = to_body_frame(command.u, self.orientations[self.indices])
+        else:
+            body = None
+        self.command, self.body = command, body
+        return command.u if body is None else body
+
+    def publish(self, u: Optional[NDArray[np.float64]], stamp_ns: int) -> bytes:
+        """
+        Publish one team command answering the state ``stamp_ns``: u (K, width), None for zero.
+
+        Robot i's own cmd_vel carries its row too while someone subscribes to it. Returns the
+        team message's bytes.
+        """
+        if u is None:
+            u = np.zeros((len(self.nodes), self.width))
+        linear, angular = command_vectors(u, self.unicycle)
+        message = encode_team_commands(stamp_ns, self.leader.world_frame, self.names, linear,
+                                       angular)
+        self.pub.publish(message)
+        for k in np.flatnonzero(self.listening).tolist():
+            node = self.nodes[k]
+            node.cmd_pub.publish(
+                encode_twist_stamped(stamp_ns, node.command_frame, linear[k], angular[k])
+                if node.stamped else encode_twist(linear[k], angular[k]))
+        return message
+
+
+def make_robot() -> RobotNode:
+    """Build the robot node, linked to the team topics with ``transport: team``."""
+    node = RobotNode()
+    if node.config.team_transport:
+        TeamLink([node])
+    return node
+
+
 def main(args: Optional[List[str]] = None) -> int:
     """Entry point of ``ros2 run formation_ros robot``."""
-    return run(RobotNode, args, name='robot')
+    return run(make_robot, args, name='robot')

@@ -24,9 +24,10 @@ is not a whole message (:class:`CdrError`); writers write little endian with zer
 from dataclasses import dataclass
 import math
 import struct
-from typing import List, Optional, Sequence, Tuple
+from typing import Dict, List, Optional, Sequence, Tuple
 
 from formation_ros.core.frames import frame_from_pose, FrameSample
+from formation_ros.core.transport import robot_indices, state_rows
 from formation_ros.core.unicycle import quaternions_from_headings
 from formation_ros.core.units import NS_PER_S
 import numpy as np
@@ -153,12 +154,17 @@ class _Reader:
         return struct.unpack_from(self.endian + fmt, self.view, start)
 
     def string(self, name: str) -> str:
+        start = self.skip_string(name)
+        return bytes(self.view[start:self.offset - 1]).decode('utf-8', 'replace')
+
+    def skip_string(self, name: str) -> int:
+        """Check that a whole string is next, move past it; return where its bytes start."""
         (length,) = self._take('I', 4, 4)
         start = self.offset
         if length < 1 or start + length > len(self.view) or self.view[start + length - 1] != 0:
             raise CdrError(f'{name} is cut short or not terminated')
         self.offset = start + length
-        return bytes(self.view[start:start + length - 1]).decode('utf-8', 'replace')
+        return start
 
     def header(self) -> Tuple[int, str]:
         sec, nanosec = self._take('iI', 8, 4)
@@ -347,11 +353,7 @@ class StateEncoder:
         unit quaternions (x, y, z, w) written as they are (neither: the previous call's, at
         first identity).
         """
-        self.rows[:, :self.dim] = q
-        if headings is not None:
-            self.rows[:, 3:] = quaternions_from_headings(headings)
-        elif orientations is not None:
-            self.rows[:, 3:] = orientations
+        self.set_rows(q, headings, orientations)
         header = encode_header(stamp_ns, self.frame_id)
         pose_prefix = header + _pad(len(header), 8)
         poses = [pose_prefix + row for row in map(bytes, self.rows)]
@@ -368,3 +370,163 @@ class StateEncoder:
                           + body[start:end])
             start = end
         return poses, arrays
+
+    def set_rows(self, q: NDArray[np.float64], headings: Optional[NDArray[np.float64]] = None,
+                 orientations: Optional[NDArray[np.float64]] = None) -> None:
+        """
+        Take the poses of every robot (as :meth:`encode` takes them) without encoding.
+
+        The rows are those of a team state (``core.transport.state_rows``): robot i's at i - 1.
+        """
+        if headings is not None:
+            orientations = quaternions_from_headings(headings)
+        self.rows[:] = state_rows(q, self.rows[:, 3:] if orientations is None else orientations)
+
+    def team(self, stamp_ns: int) -> bytes:
+        """Return the team state (``core.transport``) of the poses last taken, at ``stamp_ns``."""
+        return encode_team_states(stamp_ns, self.frame_id, self.rows)
+
+
+NAME_BYTES = 16
+"""The longest robot name a team command may carry (``robot_<i>`` with i < 10**9), bytes."""
+TWIST_DOUBLES = 6
+TRANSFORM_DOUBLES = 7
+
+
+@dataclass(frozen=True)
+class TeamCommandsData:
+    """
+    A team command message (``core.transport``), as read.
+
+    stamp_ns: the stamp of the state it answers; frame_id: its header's frame; per robot
+    listed: its 0-based index (K,), linear (K, 3) m/s and angular (K, 3) rad/s.
+    """
+
+    stamp_ns: int
+    frame_id: str
+    indices: NDArray[np.intp]
+    linear: NDArray[np.float64]
+    angular: NDArray[np.float64]
+
+
+def team_command_limit(num_robots: int) -> int:
+    """Return the most bytes a team command message for ``num_robots`` robots may have."""
+    frame = 256
+    return (HEADER + 12 + frame + 4 + num_robots * (8 + NAME_BYTES)
+            + 32 + num_robots * (8 * (TRANSFORM_DOUBLES + 2 * TWIST_DOUBLES)) + 16)
+
+
+class TeamCommandReader:
+    """
+    Reads the plant's team commands (trajectory_msgs/MultiDOFJointTrajectory) from bytes.
+
+    Untrusted input: the byte count is checked against :func:`team_command_limit`, every count
+    against ``num_robots`` and the bytes left before any element is read. The names of a
+    message are read once: the robots a sender lists are the same message after message, so
+    their indices are kept by the bytes of the names (the last :data:`NAMES_KEPT` lists).
+    """
+
+    NAMES_KEPT = 64
+
+    def __init__(self, num_robots: int) -> None:
+        """Read messages for a team of ``num_robots`` robots."""
+        self.num_robots = num_robots
+        self.limit = team_command_limit(num_robots)
+        self.names: Dict[bytes, NDArray[np.intp]] = {}
+
+    def read(self, data: bytes) -> TeamCommandsData:
+        """Return the message of ``data``; :class:`CdrError` for anything else."""
+        if len(data) > self.limit:
+            raise TooManyPoses(f'{len(data)} bytes, more than a team command for '
+                               f'{self.num_robots} robots has')
+        reader = _Reader(data, 'MultiDOFJointTrajectory')
+        stamp_ns, frame_id = reader.header()
+        names_at = _align(reader.offset, 4)
+        count = reader.uint32()
+        if count > self.num_robots:
+            raise TooManyPoses(f'{count} robots, more than {self.num_robots}')
+        if count * 5 > len(reader.view) - reader.offset:
+            raise CdrError(f'cut short: {count} names do not fit')
+        first = reader.offset
+        for _ in range(count):
+            reader.skip_string('a joint name')
+        key = bytes(reader.view[names_at:reader.offset])
+        indices = self.names.get(key)
+        if indices is None:
+            end, reader.offset = reader.offset, first
+            names = [reader.string('a joint name') for _ in range(count)]
+            assert reader.offset == end
+            try:
+                indices = robot_indices(names, self.num_robots)
+            except ValueError as exc:
+                raise CdrError(f'joint_names: {exc}') from None
+            if len(self.names) >= self.NAMES_KEPT:
+                self.names.pop(next(iter(self.names)))
+            self.names[key] = indices
+        if reader.uint32() != 1:
+            raise CdrError('not one trajectory point')
+        transforms = reader.uint32()
+        if transforms > count:
+            raise CdrError(f'{transforms} transforms for {count} robots')
+        _skip_elements(reader, TRANSFORM_DOUBLES * transforms)
+        if reader.uint32() != count:
+            raise CdrError(f'not one velocity per robot ({count} robots)')
+        start = _align(reader.offset, 8)
+        _skip_elements(reader, TWIST_DOUBLES * count)
+        twists = np.frombuffer(reader.view, dtype=np.dtype(np.float64).newbyteorder(
+            reader.endian), count=count * TWIST_DOUBLES, offset=start) if count else np.zeros(0)
+        accelerations = reader.uint32()
+        if accelerations > count:
+            raise CdrError(f'{accelerations} accelerations for {count} robots')
+        _skip_elements(reader, TWIST_DOUBLES * accelerations)
+        reader._take('iI', 8, 4)
+        reader.end()
+        rows = twists.reshape(count, TWIST_DOUBLES).astype(np.float64)
+        return TeamCommandsData(stamp_ns, frame_id, indices, rows[:, :3], rows[:, 3:])
+
+
+def _skip_elements(reader: _Reader, doubles: int) -> None:
+    """Skip the float64 elements of a sequence (none: no alignment either), checking they fit."""
+    if doubles:
+        reader.skip_doubles(doubles)
+
+
+def encode_names(names: Sequence[str]) -> bytes:
+    """Return the CDR of a string sequence (count, strings) for a 4-aligned offset."""
+    out = struct.pack('<I', len(names))
+    for name in names:
+        out += _pad(HEADER + len(out), 4) + _string(name)
+    return out
+
+
+def encode_team_commands(stamp_ns: int, frame_id: str, names: bytes,
+                         linear: ArrayLike, angular: ArrayLike) -> bytes:
+    """
+    Return a serialized team command (``core.transport``): a MultiDOFJointTrajectory.
+
+    names: :func:`encode_names` of the robots' names; linear, angular: (K, 3) twists, row k
+    robot k's.
+    """
+    head = encode_header(stamp_ns, frame_id)
+    head += _pad(len(head), 4) + names
+    head += _pad(len(head), 4)
+    count = np.asarray(linear).shape[0]
+    head += struct.pack('<III', 1, 0, count)
+    if count:
+        head += _pad(len(head), 8)
+        rows = np.empty((count, TWIST_DOUBLES), dtype=LITTLE_DOUBLE)
+        rows[:, :3] = linear
+        rows[:, 3:] = angular
+        head += rows.tobytes()
+    return head + struct.pack('<IiI', 0, 0, 0)
+
+
+def encode_team_states(stamp_ns: int, frame_id: str, rows: ArrayLike) -> bytes:
+    """Return a serialized team state (``core.transport``): a PoseArray of (N, 7) rows."""
+    header = encode_header(stamp_ns, frame_id)
+    head = header + _pad(len(header), 4)
+    values = np.ascontiguousarray(rows, dtype=LITTLE_DOUBLE)
+    head += struct.pack('<I', len(values))
+    if len(values):
+        head += _pad(len(head), 8)
+    return head + values.tobytes()

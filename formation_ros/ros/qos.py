@@ -17,6 +17,9 @@ Quality of service of every formation topic, in one place.
   neighbours, a localisation system or range-sensor driver with the ROS default QoS too. A
   robot notices a silent plant by its watchdog instead (``input_timeout``, 0.5 s by default:
   it publishes zero and its ``/diagnostics`` says so).
+* Team transport (``transport: team``): ``/formation/states`` as the states (``STATE``
+  offered, ``STATE_INPUT`` asked), ``/formation/commands`` as the commands (``COMMAND``,
+  the lease on both sides: the plant hears within it that a robot process or fleet died).
 * Measurements (the relay's sources, ``relay.source_topic``: a motion-capture system's poses):
   best effort, keep last 1, volatile, no liveliness asked (``MEASUREMENT``). A best-effort
   subscriber matches best-effort publishers (vrpn_mocap, which uses the sensor-data QoS) and

@@ -6,7 +6,8 @@ Every topic name of the formation, in one place, and what the recorder records.
 
 Robot topics are relative (``pose``, ``neighbors``, ``cmd_vel``): a robot node started in
 namespace ``/robot_<i>`` resolves them to ``/robot_<i>/pose`` and so on, and the plant, which
-serves every robot, uses :func:`robot_topic`. The formation-wide topics are absolute.
+serves every robot, uses :func:`robot_topic`. The formation-wide topics are absolute, among them
+the team transport's (``transport: team``): :data:`STATES` and :data:`TEAM_COMMANDS`.
 """
 
 from dataclasses import dataclass
@@ -26,6 +27,10 @@ SHAPE = '/formation/shape'
 STATUS = '/formation/status'
 STOP = '/formation/stop'
 START = '/formation/start'
+STATES = '/formation/states'
+"""Team transport: every robot's pose in one PoseArray per state (``core.transport``)."""
+TEAM_COMMANDS = '/formation/commands'
+"""Team transport: one MultiDOFJointTrajectory per robot process or fleet per state."""
 MEASUREMENT_TYPES: Dict[str, str] = {
     'pose': 'geometry_msgs/msg/PoseStamped',
     'odometry': 'nav_msgs/msg/Odometry',
@@ -78,6 +83,12 @@ def robot_topics(robot_id: int, stamped_commands: bool = True) -> List[Topic]:
         Topic(robot_topic(robot_id, NEIGHBOURS), 'geometry_msgs/msg/PoseArray', QosKind.STATE),
         Topic(robot_topic(robot_id, CMD_VEL), command_type, QosKind.COMMAND),
     ]
+
+
+def team_topics() -> List[Topic]:
+    """Return the two topics of the team transport: the team's states and its commands."""
+    return [Topic(STATES, 'geometry_msgs/msg/PoseArray', QosKind.STATE),
+            Topic(TEAM_COMMANDS, 'trajectory_msgs/msg/MultiDOFJointTrajectory', QosKind.COMMAND)]
 
 
 def recorded_topics(num_robots: int, markers: bool,

@@ -361,7 +361,8 @@ def read_formation(params_file: str, plant: bool = True, cmd_topic: Optional[str
     cmd_topic: template of the robots' command topics (None: no remapping); source_topic:
     ``relay.source_topic`` instead of the file's (None: the file's); cmd_option /
     source_option: how the caller spells them (``--cmd-topic``). Raises ParamError for the
-    file, PlanError (one line, naming the option) for the templates.
+    file, PlanError (one line, naming the option) for the templates and for a lab (no
+    ``plant``) with ``transport: team``.
     """
     from formation_ros.core.declarations import Exe, ParamError
     from formation_ros.core.params import validate_for_every_executable
@@ -381,6 +382,9 @@ def read_formation(params_file: str, plant: bool = True, cmd_topic: Optional[str
     assert config.plant is not None
     relay = checked[Exe.RELAY].relay
     assert relay is not None
+    if not plant and config.team_transport:
+        raise PlanError("transport team needs the plant: the relay serves each robot's own "
+                        'topics (set transport: robot in a lab)')
     if source_topic is not None:
         topics_of(source_topic, config.num_robots, relay.source_names, source_option)
     cmd_topics: Tuple[str, ...] = ()

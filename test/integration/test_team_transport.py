@@ -1,0 +1,205 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+The team transport (``transport: team``) over real DDS: one state message, one per fleet back.
+
+Lockstep gives the robot transport's trajectory (and formation_sim's: unicycles, points that
+take body-frame commands); free-running, the team converges, a robot's own ``cmd_vel`` carries
+what its team message carries while someone listens (and only then), untrusted team command
+bytes are counted and dropped, and a dead robot process is reported and its body held still.
+"""
+
+import signal
+import time
+
+from diagnostic_msgs.msg import DiagnosticArray
+from formation_ros.core.params import load_config
+from formation_ros.core.trajectory import Trajectory
+from formation_ros.ros import fields, qos
+from formation_ros.ros.cdr import encode_header, encode_names, encode_team_commands
+from formation_ros.tools.sim import simulate
+from geometry_msgs.msg import PoseArray, TwistStamped
+from helpers import launch, node, SimClock, START_UP, stop_when, write_params
+import numpy as np
+import pytest
+from trajectory_msgs.msg import MultiDOFJointTrajectory
+
+UNTIL = 2.0
+"""Simulated seconds of each lockstep run (200 steps)."""
+NOTICE_WITHIN = 10.0
+"""Bound (s) on kill -> the plant's status: lease 1 s + diagnostics period 1 s + a busy machine."""
+
+
+def lockstep_run(processes, probe, install, tmp_path, transport):
+    """
+    Run square_4 on a moving reference in lockstep, two robots a fleet; return its trajectory.
+
+    With the team transport, run until every robot (the second of each fleet too) reports
+    'lockstep' with its neighbours in /diagnostics.
+    """
+    out = tmp_path / transport
+    params = write_params(tmp_path, 'square_4.yaml', {
+        'plant.lockstep': True, 'plant.realtime_factor': 200.0, 'transport': transport,
+        'reference.kind': 'circle', 'reference.radius': 1.0, 'reference.speed': 0.5,
+        'plant.output_dir': str(out)}, name=f'{transport}.yaml')
+    clock = SimClock(probe)
+    statuses = {}
+    diagnostics = probe.create_subscription(DiagnosticArray, '/diagnostics', lambda message: (
+        statuses.update({status.name: (status.message, {pair.key for pair in status.values})
+                         for status in message.status})), qos.DIAGNOSTICS)
+    robots = [f'formation_ros/robot_{i}' for i in range(1, 5)]
+
+    def every_robot_reports():
+        return transport == 'robot' or all(statuses.get(name, ('',))[0] == 'lockstep'
+                                           for name in robots)
+
+    launch(processes, install, params, name=transport, options=('--robots-per-process', '2'))
+    info = stop_when(probe, processes, lambda: clock.seconds >= UNTIL and every_robot_reports(),
+                     name=transport)
+    probe.destroy_subscription(clock.subscription)
+    probe.destroy_subscription(diagnostics)
+    assert info.returncode == 0, processes.log(transport)
+    assert transport == 'robot' or all('neighbours within R_i' in statuses[name][1]
+                                       for name in robots), statuses
+    return Trajectory.load(str(out / 'trajectory.npz'))
+
+
+def test_team_and_robot_transports_give_one_trajectory_in_lockstep(processes, install, probe,
+                                                                   tmp_path):
+    robot = lockstep_run(processes, probe, install, tmp_path, 'robot')
+    team = lockstep_run(processes, probe, install, tmp_path, 'team')
+    assert '[fleet_2] ' in processes.log('team') and 'team transport' in processes.log('team')
+    assert 'team transport' not in processes.log('robot')
+    steps = min(len(robot.t), len(team.t))
+    assert steps >= 100 * UNTIL
+    assert np.array_equal(robot.t[:steps], team.t[:steps])
+    assert np.max(np.abs(robot.q[:steps] - team.q[:steps])) < 1e-12
+    assert np.max(np.abs(robot.u[:steps] - team.u[:steps])) < 1e-12
+    assert np.ptp(team.q[:steps], axis=0).max() > 0.5
+
+
+@pytest.mark.parametrize('source, changes', [
+    ('unicycle_2d.yaml', {}),
+    ('square_4.yaml', {'command.frame': 'body', 'start.headings': [0.5, 2.0, -1.0, 3.0]})],
+    ids=['unicycles', 'body-frame points'])
+def test_bodies_of_the_team_transport_in_lockstep_are_formation_sims(
+        processes, install, probe, tmp_path, source, changes):
+    out = tmp_path / 'run'
+    params = write_params(tmp_path, source, {
+        'plant.lockstep': True, 'plant.realtime_factor': 200.0, 'transport': 'team',
+        'plant.output_dir': str(out), **changes})
+    clock = SimClock(probe)
+    launch(processes, install, params, options=('--robots-per-process', '4'))
+    info = stop_when(probe, processes, lambda: clock.seconds >= UNTIL)
+    assert info.returncode == 0, processes.log('launcher')
+    plant = Trajectory.load(str(out / 'trajectory.npz'))
+    assert len(plant.t) >= 100 * UNTIL
+    sim = simulate(load_config(params), duration=plant.t[-1], dt=0.01, sample_dt=0.01)
+    assert np.max(np.abs(sim.q - plant.q)) < 1e-9
+    assert np.max(np.abs(sim.u - plant.u)) < 1e-9
+    if plant.heading is not None:
+        assert np.max(np.abs(sim.heading - plant.heading)) < 1e-9
+        assert np.max(np.abs(sim.body_command - plant.body_command)) < 1e-9
+    assert (plant.heading is not None) == (source == 'unicycle_2d.yaml')
+    assert np.max(np.abs(plant.u)) > 0.05
+
+
+class Heard:
+    """What the probe hears: team states and commands, robot 2's cmd_vel, the plant's status."""
+
+    def __init__(self, probe):
+        """Subscribe ``probe`` to the team topics, /robot_2/cmd_vel and /diagnostics."""
+        self.states, self.team, self.own, self.status = [], {}, {}, []
+        probe.create_subscription(PoseArray, '/formation/states', self.states.append,
+                                  qos.STATE_INPUT)
+        probe.create_subscription(MultiDOFJointTrajectory, '/formation/commands',
+                                  self._on_team, qos.COMMAND)
+        self.cmd_vel = probe.create_subscription(TwistStamped, '/robot_2/cmd_vel', self._on_own,
+                                                 qos.COMMAND)
+        probe.create_subscription(DiagnosticArray, '/diagnostics', self._on_diagnostics,
+                                  qos.DIAGNOSTICS)
+
+    def _on_team(self, message):
+        if list(message.joint_names) == ['robot_2']:
+            twist = message.points[0].velocities[0]
+            stamp = fields.stamp_to_ns(message.header.stamp)
+            self.team[stamp] = (twist.linear.x, twist.linear.y)
+
+    def _on_own(self, message):
+        twist = message.twist
+        self.own[fields.stamp_to_ns(message.header.stamp)] = (twist.linear.x, twist.linear.y)
+
+    def _on_diagnostics(self, message):
+        self.status.extend((time.monotonic(), status.name,
+                            {pair.key: pair.value for pair in status.values})
+                           for status in message.status)
+
+    def common(self):
+        """Return the stamps at which robot 2 answered on both topics."""
+        return sorted(set(self.team) & set(self.own))
+
+    def plant_value(self, key, since=0.0, name='formation_ros/plant'):
+        """Return the latest value of ``key`` in the plant's status since ``since`` (or None)."""
+        found = [values[key] for at, who, values in self.status
+                 if who == name and at >= since and key in values]
+        return found[-1] if found else None
+
+    def poses(self, robot):
+        """Return (stamp in ns, position) of robot ``robot`` (1-based) in every state heard."""
+        return [(fields.stamp_to_ns(state.header.stamp),
+                 (state.poses[robot - 1].position.x, state.poses[robot - 1].position.y))
+                for state in self.states]
+
+
+def test_a_free_running_team_converges_and_shows_its_commands_per_robot(processes, install,
+                                                                        probe, tmp_path):
+    params = write_params(tmp_path, 'square_4.yaml', {'transport': 'team'})
+    heard = Heard(probe)
+    clock = SimClock(probe)
+    processes.start(node(install, 'plant', params))
+    processes.start(node(install, 'reference', params, '-p', 'use_sim_time:=true'))
+    for i in range(1, 5):
+        processes.start(node(install, 'robot', params, '-r', f'__ns:=/robot_{i}', '-p',
+                             f'robot_id:={i}', '-p', 'use_sim_time:=true',
+                             process=f'robot_{i}'))
+    assert probe.spin_until(lambda: clock.seconds >= 5.0 and len(heard.common()) >= 50,
+                            START_UP), processes.log('plant') + processes.log('robot_2')
+    vertices = load_config(params).vertices
+    final = heard.states[-1]
+    error = max(np.hypot(pose.position.x - x, pose.position.y - y)
+                for pose, (x, y) in zip(final.poses, vertices))
+    assert len(final.poses) == 4 and error < 0.05, error
+    common = heard.common()
+    assert [heard.own[stamp] for stamp in common] == [heard.team[stamp] for stamp in common]
+    assert max(max(abs(v) for v in heard.team[stamp]) for stamp in common) > 0.0
+    assert heard.plant_value('robots with pose and neighbors published') == 'none'
+    assert heard.plant_value('cmd_vel published', name='formation_ros/robot_2') == 'yes'
+    assert heard.plant_value('cmd_vel published', name='formation_ros/robot_1') == 'no'
+
+    publisher = probe.create_publisher(MultiDOFJointTrajectory, '/formation/commands',
+                                       qos.COMMAND)
+    oversized = encode_team_commands(0, 'world', encode_names(
+        [f'robot_{i}' for i in range(1, 6)]), np.zeros((5, 3)), np.zeros((5, 3)))
+    bad = [encode_header(0, 'world') + b'\x07' * 9, oversized, b'\x00\x01\x00\x00']
+    assert probe.spin_until(lambda: publisher.get_subscription_count() >= 1, 30)
+    for data in bad:
+        publisher.publish(data)
+    assert probe.spin_until(
+        lambda: heard.plant_value('malformed team command messages') == str(len(bad)),
+        NOTICE_WITHIN), heard.plant_value('malformed team command messages')
+    log = processes.log('plant')
+    assert log.count('ignoring /formation/commands bytes') == 1, log
+    assert heard.plant_value('robots with alive cmd_vel') == '1, 2, 3, 4'
+
+    processes.send_signal('robot_4', signal.SIGKILL)
+    killed = time.monotonic()
+    assert probe.spin_until(
+        lambda: heard.plant_value('robots with lost cmd_vel', killed) == '4', NOTICE_WITHIN), \
+        heard.plant_value('robots with lost cmd_vel')
+    assert heard.plant_value('robots with alive cmd_vel', killed) == '1, 2, 3'
+    reported = len(heard.states)
+    assert probe.spin_until(lambda: len(heard.states) > reported + 25, 30)
+    still = heard.poses(4)[reported:]
+    assert still[-1][0] > still[0][0] and len({position for _, position in still}) == 1, still
+    assert '4' in (heard.plant_value('robots with stale commands') or ''), heard.status[-1]
