@@ -12,6 +12,7 @@ import os
 import signal
 import subprocess
 
+from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.params_file import load_params_file, write_params_file
 from formation_ros.ros import fields, qos
 from formation_ros.tools.supervise import ProcessSpec
@@ -100,6 +101,46 @@ def watch_commands(probe, count):
 def matched(subscriptions):
     """Whether every subscription has matched at least one publisher."""
     return all(s.get_publisher_count() > 0 for s in subscriptions)
+
+
+class Statuses(dict):
+    """{status name: the latest status on /diagnostics}, and how many of each were heard."""
+
+    def __init__(self, probe):
+        super().__init__()
+        self.heard = {}
+        probe.create_subscription(DiagnosticArray, '/diagnostics', self._store, qos.DIAGNOSTICS)
+
+    def _store(self, message):
+        for status in message.status:
+            self[status.name] = status
+            self.heard[status.name] = self.heard.get(status.name, 0) + 1
+
+
+def said_once(probe, processes, name, text, statuses, status):
+    """
+    Wait until process ``name`` has logged ``text``, then for two more ``status`` reports.
+
+    A node's log reaches the test through a pipe, its diagnostics over DDS: either may come
+    first. Each report is a moment at which a repeat would have been logged; return how
+    many times ``text`` is in the log after them.
+    """
+    logged(probe, processes, name, text)
+    after = statuses.heard.get(status, 0) + 2
+    assert probe.spin_until(lambda: statuses.heard.get(status, 0) >= after, 30), statuses
+    return processes.log(name).count(text)
+
+
+def logged(probe, processes, name, *texts, timeout=30.0):
+    """
+    Wait until process ``name`` has logged every one of ``texts``; return its log.
+
+    A node's log reaches the test through a pipe, its diagnostics over DDS: a test that has
+    seen a node report something waits for the line too before it counts it.
+    """
+    assert probe.spin_until(lambda: all(text in processes.log(name) for text in texts),
+                            timeout), processes.log(name)
+    return processes.log(name)
 
 
 def wait_exit(probe, processes, name, timeout):

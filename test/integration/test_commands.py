@@ -18,7 +18,7 @@ from formation_ros.core.params import load_config
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.ros import qos
 from geometry_msgs.msg import PoseStamped, Twist
-from helpers import launch, node, SimClock, stop_when, TWICE_REAL_TIME, write_params
+from helpers import launch, logged, node, SimClock, stop_when, TWICE_REAL_TIME, write_params
 import numpy as np
 
 HEADINGS = [0.5, 2.0, -1.0, 3.0]
@@ -83,7 +83,7 @@ def test_a_robot_refuses_states_in_another_world_frame(processes, install, probe
         int(kv.value) for status in m.status if status.name == 'formation_ros/robot_1'
         for kv in status.values if kv.key == key), qos.DIAGNOSTICS)
     assert probe.spin_until(lambda: refused and refused[-1] >= 20, 60), processes.log('robot_1')
-    assert processes.log('robot_1').count(line) == 1
+    assert logged(probe, processes, 'robot_1', line).count(line) == 1
     assert not heard
 
 

@@ -7,11 +7,12 @@ import os
 import re
 import socket
 
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from diagnostic_msgs.msg import DiagnosticStatus
 from formation_ros.ros import messages, qos
 from formation_ros.tools import domain
 from geometry_msgs.msg import PoseStamped, TwistStamped
-from helpers import launch, node, SimClock, SQUARE, stop_when, wait_exit, write_params
+from helpers import (launch, node, said_once, SimClock, SQUARE, Statuses, stop_when,
+                     wait_exit, write_params)
 from nav_msgs.msg import Odometry
 import pytest
 from rosgraph_msgs.msg import Clock as ClockMsg
@@ -20,39 +21,6 @@ import wire
 pytestmark = pytest.mark.faults
 START_UP = 90.0
 HOST = socket.gethostname()
-
-
-class Statuses(dict):
-    """{status name: the latest status on /diagnostics}, and how many of each were heard."""
-
-    def __init__(self, probe):
-        super().__init__()
-        self.heard = {}
-        probe.create_subscription(DiagnosticArray, '/diagnostics', self._store, qos.DIAGNOSTICS)
-
-    def _store(self, message):
-        for status in message.status:
-            self[status.name] = status
-            self.heard[status.name] = self.heard.get(status.name, 0) + 1
-
-
-def statuses_of(probe):
-    """Subscribe ``probe`` to /diagnostics; return the :class:`Statuses` it fills."""
-    return Statuses(probe)
-
-
-def said_once(probe, processes, name, text, statuses, status):
-    """
-    Wait until process ``name`` has logged ``text``, then for two more ``status`` reports.
-
-    A node's log reaches the test through a pipe, its diagnostics over DDS: either may come
-    first. Each report is a moment at which a repeat would have been logged; return how
-    many times ``text`` is in the log after them.
-    """
-    assert probe.spin_until(lambda: text in processes.log(name), 30), processes.log(name)
-    after = statuses.heard.get(status, 0) + 2
-    assert probe.spin_until(lambda: statuses.heard.get(status, 0) >= after, 30), statuses
-    return processes.log(name).count(text)
 
 
 def value(statuses, name, key):
@@ -69,7 +37,7 @@ def error_lines(log):
 
 def test_a_second_plant_refuses_to_start_naming_the_first(processes, install, probe):
     clock = SimClock(probe)
-    statuses = statuses_of(probe)
+    statuses = Statuses(probe)
     first = processes.start(node(install, 'plant', SQUARE, '-p', 'plant.wait_for_robots:=false'))
     assert probe.spin_until(lambda: clock.seconds > 0.5, START_UP), processes.log('plant')
     second = processes.start(node(install, 'plant', SQUARE, process='plant_2'))
@@ -119,7 +87,7 @@ def start_plant_and_robot_1(processes, install, probe):
 
 
 def test_a_running_plant_names_a_second_publisher_on_pose_and_cmd_vel(processes, install, probe):
-    statuses = statuses_of(probe)
+    statuses = Statuses(probe)
     start_plant_and_robot_1(processes, install, probe)
     commands = probe.create_publisher(TwistStamped, '/robot_1/cmd_vel', qos.COMMAND)
     poses = probe.create_publisher(PoseStamped, '/robot_1/pose', qos.STATE)
@@ -140,7 +108,7 @@ def test_a_running_plant_names_a_second_publisher_on_pose_and_cmd_vel(processes,
 
 
 def test_a_robot_names_a_second_reference_publisher(processes, install, probe):
-    statuses = statuses_of(probe)
+    statuses = Statuses(probe)
     processes.start(node(install, 'reference', SQUARE))
     processes.start(node(install, 'robot', SQUARE, '-r', '__ns:=/robot_1', process='robot_1'))
     forged = probe.create_publisher(Odometry, '/formation/reference', qos.REFERENCE)

@@ -3,9 +3,8 @@
 
 """One team: a node started with another parameters file is named by the plant and reference."""
 
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
-from formation_ros.ros import qos
-from helpers import node, write_params
+from diagnostic_msgs.msg import DiagnosticStatus
+from helpers import logged, node, said_once, Statuses, write_params
 
 
 def test_a_robot_with_another_file_is_named_by_plant_and_reference(
@@ -15,9 +14,7 @@ def test_a_robot_with_another_file_is_named_by_plant_and_reference(
     moved = write_params(tmp_path, 'square_4.yaml', {
         'formation.vertices': [1.0, 1.0, -1.0, 1.0, -1.5, -1.5, 1.0, -1.0]}, name='moved.yaml')
     files = {3: moved, 4: other}
-    statuses = {}
-    probe.create_subscription(DiagnosticArray, '/diagnostics', lambda m: statuses.update(
-        {status.name: status for status in m.status}), qos.DIAGNOSTICS)
+    statuses = Statuses(probe)
     processes.start(node(install, 'plant', params))
     processes.start(node(install, 'reference', params, '-p', 'use_sim_time:=true'))
     for i in range(1, 5):
@@ -40,6 +37,6 @@ def test_a_robot_with_another_file_is_named_by_plant_and_reference(
         assert all(f'formation_ros/robot_{i}' not in text for i in (1, 2, 3)), text
     assert probe.spin_until(lambda: "following the reference's shape"
                             in processes.log('robot_3'), 60), processes.log('robot_3')
-    log = processes.log('plant')
-    assert log.count('formation_ros/robot_4: law') == 1, log
-    assert 'formation_ros/robot_4: law' in processes.log('reference')
+    assert said_once(probe, processes, 'plant', 'formation_ros/robot_4: law', statuses,
+                     'formation_ros/plant') == 1, processes.log('plant')
+    logged(probe, processes, 'reference', 'formation_ros/robot_4: law')

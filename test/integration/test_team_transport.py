@@ -20,7 +20,7 @@ from formation_ros.ros import fields, qos
 from formation_ros.ros.cdr import encode_header, encode_names, encode_team_commands
 from formation_ros.tools.sim import simulate
 from geometry_msgs.msg import PoseArray, TwistStamped
-from helpers import launch, node, SimClock, START_UP, stop_when, write_params
+from helpers import launch, logged, node, SimClock, START_UP, stop_when, write_params
 import numpy as np
 import pytest
 from trajectory_msgs.msg import MultiDOFJointTrajectory
@@ -188,7 +188,7 @@ def test_a_free_running_team_converges_and_shows_its_commands_per_robot(processe
     assert probe.spin_until(
         lambda: heard.plant_value('malformed team command messages') == str(len(bad)),
         NOTICE_WITHIN), heard.plant_value('malformed team command messages')
-    log = processes.log('plant')
+    log = logged(probe, processes, 'plant', 'ignoring /formation/commands bytes')
     assert log.count('ignoring /formation/commands bytes') == 1, log
     assert heard.plant_value('robots with alive cmd_vel') == '1, 2, 3, 4'
 
