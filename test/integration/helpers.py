@@ -143,6 +143,16 @@ def logged(probe, processes, name, *texts, timeout=30.0):
     return processes.log(name)
 
 
+def start_system(processes, install, params, robots):
+    """Start plant, reference and robots 1..robots by hand (no launcher)."""
+    processes.start(node(install, 'plant', params))
+    processes.start(node(install, 'reference', params, '-p', 'use_sim_time:=true'))
+    for i in range(1, robots + 1):
+        processes.start(node(install, 'robot', params, '-r', f'__ns:=/robot_{i}',
+                             '-p', f'robot_id:={i}', '-p', 'use_sim_time:=true',
+                             process=f'robot_{i}'))
+
+
 def wait_exit(probe, processes, name, timeout):
     """Spin ``probe`` until process ``name`` has ended (up to ``timeout`` s); return its exit."""
     probe.spin_until(lambda: not processes.running(name), timeout)

@@ -17,7 +17,7 @@ import time
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.ros import qos
 from formation_ros.ros.diagnostics import PERIOD
-from helpers import node, SQUARE, START_UP
+from helpers import SQUARE, start_system, START_UP
 import pytest
 
 pytestmark = pytest.mark.faults
@@ -54,12 +54,7 @@ def test_dead_robot_and_dead_plant_are_noticed(processes, install, probe):
         return next(at for at, who, message, values in heard
                     if who == name and at >= since and condition(message, values))
 
-    processes.start(node(install, 'plant', SQUARE))
-    processes.start(node(install, 'reference', SQUARE, '-p', 'use_sim_time:=true'))
-    for i in range(1, 5):
-        processes.start(node(install, 'robot', SQUARE, '-r', f'__ns:=/robot_{i}', '-p',
-                             f'robot_id:={i}', '-p', 'use_sim_time:=true',
-                             process=f'robot_{i}'))
+    start_system(processes, install, SQUARE, 4)
     assert probe.spin_until(
         lambda: latest('formation_ros/plant').get('robots with alive cmd_vel') == '1, 2, 3, 4'
         and status_of('formation_ros/robot_2') == 'controlling',

@@ -10,8 +10,8 @@ import signal
 from formation_ros.core.params import load_config
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.tools.sim import simulate
-from helpers import (exe, launch, matched, node, project_processes,
-                     SimClock, SQUARE, stop_when, TWICE_REAL_TIME, watch_commands, write_params)
+from helpers import (exe, launch, matched, node, project_processes, SimClock, SQUARE,
+                     start_system, stop_when, TWICE_REAL_TIME, watch_commands, write_params)
 import numpy as np
 
 
@@ -54,16 +54,6 @@ def test_tracking_follows_a_circle(processes, install, probe, tmp_path):
     assert metrics['settle_time'] is not None
     assert metrics['final_max_error'] < 0.02
     assert metrics['bound_violations'] == 0 and metrics['collisions'] == 0
-
-
-def start_system(processes, install, params, robots):
-    """Start plant, reference and robots 1..robots by hand (no launcher)."""
-    processes.start(node(install, 'plant', params))
-    processes.start(node(install, 'reference', params, '-p', 'use_sim_time:=true'))
-    for i in range(1, robots + 1):
-        processes.start(node(install, 'robot', params, '-r', f'__ns:=/robot_{i}',
-                             '-p', f'robot_id:={i}', '-p', 'use_sim_time:=true',
-                             process=f'robot_{i}'))
 
 
 def test_robot_publishes_zero_when_its_plant_stops(processes, install, probe):

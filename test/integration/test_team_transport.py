@@ -20,7 +20,8 @@ from formation_ros.ros import fields, qos
 from formation_ros.ros.cdr import encode_header, encode_names, encode_team_commands
 from formation_ros.tools.sim import simulate
 from geometry_msgs.msg import PoseArray, TwistStamped
-from helpers import launch, logged, node, SimClock, START_UP, stop_when, write_params
+from helpers import (launch, logged, SimClock, start_system, START_UP, stop_when,
+                     write_params)
 import numpy as np
 import pytest
 from trajectory_msgs.msg import MultiDOFJointTrajectory
@@ -157,12 +158,7 @@ def test_a_free_running_team_converges_and_shows_its_commands_per_robot(processe
     params = write_params(tmp_path, 'square_4.yaml', {'transport': 'team'})
     heard = Heard(probe)
     clock = SimClock(probe)
-    processes.start(node(install, 'plant', params))
-    processes.start(node(install, 'reference', params, '-p', 'use_sim_time:=true'))
-    for i in range(1, 5):
-        processes.start(node(install, 'robot', params, '-r', f'__ns:=/robot_{i}', '-p',
-                             f'robot_id:={i}', '-p', 'use_sim_time:=true',
-                             process=f'robot_{i}'))
+    start_system(processes, install, params, 4)
     assert probe.spin_until(lambda: clock.seconds >= 5.0 and len(heard.common()) >= 50,
                             START_UP), processes.log('plant') + processes.log('robot_2')
     vertices = load_config(params).vertices
