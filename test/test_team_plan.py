@@ -5,6 +5,8 @@
 
 import os
 
+from formation_ros.core.declarations import Exe
+from formation_ros.core.params import load_config
 from formation_ros.core.params_file import load_params_file, write_params_file
 from formation_ros.tools.system import PlanError, read_formation
 import pytest
@@ -22,8 +24,10 @@ def with_team_transport(tmp_path, name):
 
 
 def test_a_plants_run_takes_the_team_transport(tmp_path):
-    formation = read_formation(with_team_transport(tmp_path, 'square_4.yaml'))
-    assert formation.num_robots == 4
+    path = with_team_transport(tmp_path, 'square_4.yaml')
+    assert read_formation(path).num_robots == 4
+    assert load_config(path, Exe.PLANT).team_transport
+    assert not load_config(os.path.join(CONFIG, 'square_4.yaml'), Exe.PLANT).team_transport
 
 
 def test_a_lab_refuses_the_team_transport(tmp_path):

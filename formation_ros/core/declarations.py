@@ -316,7 +316,7 @@ DECLARATIONS = (
           'message per state for every robot, one /formation/commands message per robot '
           'process or fleet per state; the per-robot topics only while something subscribes '
           'to them).', choices=_choices(Transport),
-          users=frozenset({Exe.PLANT, Exe.ROBOT, Exe.RECORD})),
+          users=frozenset({Exe.PLANT, Exe.ROBOT})),
     Param('wait_for_subscribers', Kind.INT, 1,
           'A robot sends its first command only once cmd_vel has this many subscribers (the '
           'plant; 2 when a recorder listens too).', low=at_least(0), high=at_least(1000),
@@ -329,7 +329,8 @@ DECLARATIONS = (
           'A command whose state stamp is older than this counts as zero, s (simulated time).',
           low=above(0.0), users=PLANT),
     Param('plant.publish_rate', Kind.DOUBLE, 50.0,
-          'Rate of /robot_<i>/pose, /robot_<i>/neighbors and /clock, Hz of simulated time '
+          'Rate of /robot_<i>/pose, /robot_<i>/neighbors (or /formation/states with transport '
+          'team) and /clock, Hz of simulated time '
           '(at most plant.rate; every step in lockstep). Robots answer at most about one state '
           'per period.', low=above(0.0), high=at_least(100000.0), users=PLANT | {Exe.ROBOT}),
     Param('plant.realtime_factor', Kind.DOUBLE, 1.0,

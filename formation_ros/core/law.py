@@ -191,14 +191,10 @@ def robot_command(q_i: ArrayLike, vertex_i: ArrayLike, neighbours: ArrayLike,
     """
     q_i = np.asarray(q_i, dtype=float)
     neighbours = np.asarray(neighbours, dtype=float).reshape(-1, q_i.shape[0])
-    q_ij = q_i[None, :] - neighbours
-    in_range = np.einsum('kd,kd->k', q_ij, q_ij) < min(float(sensing_radius), RADIUS_MAX) ** 2
-    q_hat_ij = to_frame_vectors(q_ij[in_range], frame)
-    error_hat = to_frame(q_i[None, :], frame)[0] - np.asarray(vertex_i, dtype=float)
-    omega_hat = omega(error_hat, repulsion_terms(q_hat_ij, law).sum(axis=0), law)
-    u_hat = bounded_command(omega_hat, law)
-    u = from_frame_velocity(u_hat[None, :], q_i[None, :], frame)[0]
-    return Command(u=u, u_hat=u_hat, omega=omega_hat)
+    command = robot_commands(q_i[None, :], np.asarray(vertex_i, dtype=float)[None, :],
+                             np.zeros(len(neighbours), dtype=np.intp), neighbours,
+                             [sensing_radius], law, frame)
+    return Command(u=command.u[0], u_hat=command.u_hat[0], omega=command.omega[0])
 
 
 def robot_commands(q_own: ArrayLike, vertices: ArrayLike, observer: ArrayLike,
@@ -212,8 +208,8 @@ def robot_commands(q_own: ArrayLike, vertices: ArrayLike, observer: ArrayLike,
     (P, dim) world positions, row p a neighbour robot ``observer[p]`` has sensed (as the rows
     of each robot's ``neighbours``, in the same order: the sums run in that order); those at
     distance >= R_i (``sensing_radii``, (K,) m) of their observer are ignored. frame: the
-    reference's ``FrameSample`` (one for all). Returns a :class:`Command` with (K, dim) arrays,
-    equal to each robot's :func:`robot_command` (to rounding: tested to 1e-12).
+    reference's ``FrameSample`` (one for all). Returns a :class:`Command` with (K, dim) arrays;
+    :func:`robot_command` is this for K = 1.
     """
     q_own = np.asarray(q_own, dtype=float)
     k, dim = q_own.shape

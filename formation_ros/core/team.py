@@ -41,10 +41,10 @@ def team_values(config: FormationConfig, shape: NDArray[np.float64]) -> Dict[str
 
     num_robots, dim, the law's constants (c, kappa, psi, the jump function, b), the sensing radii
     and the shape in force (``shape``, (N, dim): fingerprints of their exact values), the world
-    frame and the bodies.
+    frame, the bodies and (for the programs that read it) the transport.
     """
     body = config.body
-    return {
+    values = {
         'num_robots': str(config.num_robots), 'dim': str(config.dim),
         'law': (f'c={config.gain!r} kappa={config.kappa!r} psi={config.psi.value} '
                 f'jump={config.jump_kind.value}/{config.jump_order} '
@@ -55,6 +55,9 @@ def team_values(config: FormationConfig, shape: NDArray[np.float64]) -> Dict[str
         'body': (f'{body.kind.value} l={body.hand_distance!r}' if body.is_unicycle
                  else body.kind.value),
     }
+    if 'transport' in config.values:
+        values['transport'] = config.transport.value
+    return values
 
 
 def differences(own: Mapping[str, str], other: Mapping[str, str]) -> Dict[str, str]:

@@ -671,13 +671,15 @@ class PlantNode(Node):
         Return each robot's 'alive', 'lost' or 'unknown', as its commands show it.
 
         Robot transport: its cmd_vel's DDS liveliness. Team transport: whether its latest
-        command arrived within the liveliness lease (wall clock; 'unknown' before the first),
+        command arrived within the liveliness lease or two state periods, whichever is longer
+        (wall clock; 'unknown' before the first),
         so that the robots of a fleet that died show as lost within about a second, as the
         robots of one that is alive do not (a robot process or fleet answers every state).
         """
         if not self.team_transport:
             return [peer.state() for peer in self.command_liveliness]
-        lease_ns = int(qos.LIVELINESS_LEASE * NS_PER_S)
+        state_period = self.publish_every * self.model.dt / self.settings.realtime_factor
+        lease_ns = int(max(qos.LIVELINESS_LEASE, 2.0 * state_period) * NS_PER_S)
         recent = time.monotonic_ns() - self.arrived_ns <= lease_ns
         return ['unknown' if not present else 'alive' if fresh else 'lost'
                 for present, fresh in zip(self.commands.present.tolist(), recent.tolist())]

@@ -57,6 +57,7 @@ from typing import Callable, Dict, List, Optional, Sequence, Tuple, TypeVar
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.answers import AnswerBudget
+from formation_ros.core.bodies import make_bodies
 from formation_ros.core.declarations import CommandFrame, Exe, ParamError, PoseType
 from formation_ros.core.frames import advance, FrameSample, to_body_frame, valid_quaternions
 from formation_ros.core.law import Command, robot_command, robot_commands
@@ -104,7 +105,8 @@ LISTENERS_PERIOD = 0.5
 """Team transport: seconds between looks at who subscribes to each robot's cmd_vel."""
 TEAM_VALUES = ('num_robots', 'dim', 'world_frame', 'repulsion_radius', 'controller.gain',
                'controller.kappa', 'controller.psi', 'jump.kind', 'jump.order', 'body.kind',
-               'body.hand_distance', 'command.type', 'command.frame', 'plant.lockstep')
+               'body.hand_distance', 'command.type', 'command.frame', 'plant.lockstep',
+               'transport')
 """Parameters the robots of one team link share: it computes their commands in one call (the
 watchdog and input timeout are the leader's)."""
 
@@ -706,8 +708,8 @@ class TeamLink:
         self.indices = np.array([node.index for node in self.nodes], dtype=np.intp)
         self.radii = np.array([node.sensing_radius for node in self.nodes])
         self.reach = np.zeros(self.n)
-        self.reach[self.indices] = sensor_radii(
-            self.radii, 2.0 * leader.hand_distance if self.unicycle else 0.0)
+        self.reach[self.indices] = sensor_radii(self.radii,
+                                                make_bodies(config.body).sensing_margin)
         self.local = np.full(self.n, -1, dtype=np.intp)
         self.local[self.indices] = np.arange(len(self.nodes))
         self.names = encode_names([robot_name(int(i) + 1) for i in self.indices])
