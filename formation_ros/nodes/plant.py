@@ -215,6 +215,11 @@ class PlantNode(Node):
             self.expected_publishers[self.states_pub.topic_name] = self.own_name
         self.command_index = {sub.topic_name: i for i, sub in enumerate(self.command_subs)}
         self.expected_publishers.update(dict.fromkeys(self.command_index))
+        self.team_cmd_vel_topics = (
+            {topics.robot_topic(i + 1, topics.CMD_VEL): i for i in range(self.n)}
+            if self.team_transport else {})
+        """Team transport: each robot's cmd_vel, watched for a second robot of that id."""
+        self.expected_publishers.update(dict.fromkeys(self.team_cmd_vel_topics))
         self.diagnostics_pub = self.create_publisher(
             DiagnosticArray, topics.DIAGNOSTICS, qos.DIAGNOSTICS)
         period = RESEND_AFTER if self.lockstep else self.model.dt / settings.realtime_factor
@@ -699,7 +704,8 @@ class PlantNode(Node):
         for topic, names in shared.items():
             by_names.setdefault(names, []).append(topic)
         for names, listed in by_names.items():
-            hint = ('a second node with this robot_id?' if listed[0] in self.command_index
+            hint = ('a second node with this robot_id?'
+                    if listed[0] in self.command_index or listed[0] in self.team_cmd_vel_topics
                     else 'another team on this domain, or a node forging them?')
             self.once.start(f'publishers-{names}', f'{_some(listed)} more than one publisher: '
                                                    f'{names} ({hint})', 'error')
@@ -712,6 +718,8 @@ class PlantNode(Node):
         """Whether a same-named second publisher of ``topic`` is known to run."""
         now = time.monotonic()
         index = self.command_index.get(topic)
+        if topic in self.team_cmd_vel_topics:
+            return len(self.team.running(names[0], now)) >= 2
         if index is None:
             return bool(self.team.running(self.own_name, now))
         return (self.command_liveliness[index].alive >= 2

@@ -13,7 +13,7 @@ from formation_ros.core.params import load_config
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.ros import messages, qos
 from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
-from helpers import exe, node, SimClock, SQUARE, wait_exit, watch_commands
+from helpers import exe, node, SimClock, SQUARE, wait_exit, watch_commands, write_params
 from nav_msgs.msg import Odometry
 import numpy as np
 import pytest
@@ -148,14 +148,20 @@ def test_identity_comes_from_the_namespace(processes, install, probe):
         processes.log('robot_3')
 
 
-def test_two_publishers_on_one_cmd_vel_are_reported(processes, install, probe):
-    processes.start(node(install, 'plant', SQUARE))
+@pytest.mark.parametrize('transport', ['robot', 'team'])
+def test_two_publishers_on_one_cmd_vel_are_reported(processes, install, probe, tmp_path,
+                                                    transport):
+    """Two robot processes with robot_id 1: named by the plant, with either transport."""
+    params = write_params(tmp_path, 'square_4.yaml', {'transport': transport})
+    processes.start(node(install, 'plant', params))
     for name in ('robot_1', 'robot_1_again'):
-        processes.start(node(install, 'robot', SQUARE, '-r', '__ns:=/robot_1',
+        processes.start(node(install, 'robot', params, '-r', '__ns:=/robot_1',
                              '-p', 'use_sim_time:=true', process=name))
-    assert probe.spin_until(lambda: 'more than one publisher' in processes.log('plant'),
-                            START_UP), processes.log('plant')
-    assert processes.log('plant').count('more than one publisher') == 1
+    said = '/robot_1/cmd_vel has more than one publisher: /robot_1/robot'
+    assert probe.spin_until(lambda: said in processes.log('plant'), START_UP), \
+        processes.log('plant')
+    assert processes.log('plant').count('more than one publisher') == 1, processes.log('plant')
+    assert 'a second node with this robot_id?' in processes.log('plant')
     assert not math.isnan(BOUND)
 
 
