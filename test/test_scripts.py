@@ -146,7 +146,10 @@ def launch_fake(prefix, dies, *options, until=None):
                 if until is not None and until(out.read_text(), err.read_text()):
                     launcher.send_signal(signal.SIGINT)
                     break
-                time.sleep(0.05)
+                try:
+                    launcher.wait(timeout=0.05)
+                except subprocess.TimeoutExpired:
+                    pass
             launcher.wait(timeout=FAKE_RUN_LIMIT)
         finally:
             if launcher.poll() is None:
