@@ -151,6 +151,15 @@ class ReferenceTimeline:
         """Return the frame at t in s, from the reference in force then."""
         return self.at(int(round(t * NS_PER_S))).sample(t)
 
+    def frame_at(self, stamp_ns: int, epoch_ns: int = 0) -> FrameSample:
+        """
+        Return the frame of the reference in force at ``stamp_ns``, at t = stamp - epoch (s).
+
+        What the reference node publishes for a stamp, and what a robot with the team transport
+        evaluates itself for a state's stamp (``epoch_ns`` 0 on simulated time).
+        """
+        return self.at(stamp_ns).sample((stamp_ns - epoch_ns) / NS_PER_S)
+
 
 def named_shape(vertices: NDArray[np.float64],
                 shapes: Mapping[str, NDArray[np.float64]]) -> Shape:

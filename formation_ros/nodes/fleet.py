@@ -18,8 +18,10 @@ the fleet; a file's ``/robot_3/robot:`` section applies to robot 3 alone, as it 
 robot process. The namespace of each robot is set by the fleet: ``-r __ns:=...`` is refused,
 and a ``robot_id`` must match it. The robots share one ``/clock`` subscription, so their
 ``use_sim_time`` cannot be changed while they run. With ``transport: team`` they share one
-``/formation/states`` subscription and one ``/formation/commands`` publisher too, and their
-commands come from one call of the law per state.
+``/formation/states`` subscription and one ``/formation/commands`` publisher instead, their
+commands come from one call of the law per state, their clocks are set from the states' stamps
+(no ``/clock`` subscription), and the first robot alone hears ``/formation/reference``,
+``/formation/shape`` and ``/formation/status`` for all of them.
 """
 
 import re
@@ -28,11 +30,8 @@ from typing import List, Optional, Sequence
 
 from formation_ros.nodes.robot import RobotNode, TeamLink
 from formation_ros.ros.runner import run
+from formation_ros.ros.sim_clock import share_sim_clock
 from formation_ros.ros.topics import robot_namespace
-from rcl_interfaces.msg import SetParametersResult
-from rclpy.clock import ROSClock
-from rclpy.node import Node
-from rclpy.parameter import Parameter
 from rclpy.utilities import remove_ros_args
 
 PROG = 'fleet'
@@ -88,43 +87,6 @@ def parse_command_line(argv: Sequence[str]) -> Optional[List[int]]:
     return parse_ids(own[1])
 
 
-def share_sim_clock(nodes: Sequence[Node]) -> int:
-    """
-    Drive the clocks of all ``nodes`` from the first one's ``/clock``; return how many shared.
-
-    With ``use_sim_time`` every rclpy node subscribes to ``/clock`` and runs a Python callback
-    per tick (the plant publishes one per step, 100 Hz by default): K robots in a process would
-    take K callbacks per tick for one and the same time. The others' time sources are detached
-    from their nodes (their subscriptions destroyed) and their clocks attached to the first
-    node's time source, which then sets all of them at each tick. ``use_sim_time`` keeps its
-    value on every node. Nodes on wall time, and rclpy versions without the node's time source
-    attribute, are left as they are.
-    """
-    first = getattr(nodes[0], '_time_source', None) if nodes else None
-    if first is None or not first.ros_time_is_active:
-        return 0
-    shared = 0
-    for node in nodes[1:]:
-        source = getattr(node, '_time_source', None)
-        clock = node.get_clock()
-        if source is None or not source.ros_time_is_active or not isinstance(clock, ROSClock):
-            continue
-        source.detach_node()
-        first.attach_clock(clock)
-        shared += 1
-    for node in nodes:
-        node.add_on_set_parameters_callback(_keep_sim_time)
-    return shared
-
-
-def _keep_sim_time(parameters: List[Parameter]) -> SetParametersResult:
-    """Refuse to change ``use_sim_time`` of a fleet's robot: their clocks are shared."""
-    if any(parameter.name == 'use_sim_time' for parameter in parameters):
-        return SetParametersResult(successful=False, reason='use_sim_time of a fleet robot is '
-                                   'fixed at start (the fleet shares one /clock subscription)')
-    return SetParametersResult(successful=True)
-
-
 def make_fleet(ids: Sequence[int]) -> List[RobotNode]:
     """
     Build one robot node per id, robot i in ``/robot_<i>``, sharing one ``/clock`` subscription.
@@ -134,13 +96,21 @@ def make_fleet(ids: Sequence[int]) -> List[RobotNode]:
     fleet's robots hear the team's states and send their commands through one
     :class:`formation_ros.nodes.robot.TeamLink`: one message in and one out per state.
     """
-    nodes = [RobotNode(namespace=robot_namespace(i)) for i in ids]
-    shared = share_sim_clock(nodes)
-    if nodes and nodes[0].config.team_transport:
+    if not ids:
+        return []
+    first = RobotNode(namespace=robot_namespace(ids[0]))
+    team = first.config.team_transport
+    nodes = [first] + [RobotNode(namespace=robot_namespace(i), leader=first if team else None)
+                       for i in ids[1:]]
+    if team:
         TeamLink(nodes)
-    if nodes and nodes[0].sim_time:
-        nodes[0].get_logger().info(f'fleet of {len(nodes)} robots: {shared + 1} clocks driven '
-                                   'by one /clock subscription')
+        if first.sim_time:
+            first.get_logger().info(f'fleet of {len(nodes)} robots: their clocks set from the '
+                                    "states' stamps (no /clock subscription)")
+    elif first.sim_time:
+        shared = share_sim_clock(nodes)
+        first.get_logger().info(f'fleet of {len(nodes)} robots: {shared + 1} clocks driven by '
+                                'one /clock subscription')
     return nodes
 
 

@@ -50,7 +50,7 @@ from formation_ros.core.frames import frame_to_pose
 from formation_ros.core.params import check_shape, tracking_problem
 from formation_ros.core.reference import PERIODIC
 from formation_ros.core.team import team_values
-from formation_ros.core.timeline import Mode, Shape, TeamState, Timeline
+from formation_ros.core.timeline import Mode, ReferenceTimeline, Shape, TeamState, Timeline
 from formation_ros.core.units import NS_PER_S
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import encode_odometry
@@ -98,6 +98,7 @@ class ReferenceNode(Node):
         self.shapes: Timeline[Shape] = Timeline(self.shape)
         self.state = TeamState.of(Mode.RUNNING, config.shape_name, self.base)
         self.states: Timeline[TeamState] = Timeline(self.state)
+        self.reference = ReferenceTimeline(self.base, self.states)
         self.pending: List[Tuple[str, Change]] = []
         self.team = TeamCheck(self, REFERENCE_STATUS)
         self.pub = self.create_publisher(Odometry, topics.REFERENCE, qos.REFERENCE)
@@ -151,8 +152,7 @@ class ReferenceNode(Node):
 
     def _publish(self, stamp: int) -> None:
         self.last_stamp = stamp
-        reference = self.states.at(stamp).reference(self.base)
-        frame = reference.sample((stamp - self.epoch_ns) / NS_PER_S)
+        frame = self.reference.frame_at(stamp, self.epoch_ns)
         self.pub.publish(encode_odometry(stamp, self.world_frame, messages.FORMATION_FRAME,
                                          *frame_to_pose(frame, self.dim)))
         self.published += 1

@@ -40,7 +40,11 @@ then instead of advising ``use_sim_time``.
 With ``transport: team`` a robot hears no ``pose`` or ``neighbors``: its process reads the
 team's ``/formation/states`` once for all its robots and answers with one
 ``/formation/commands`` message (:class:`TeamLink`); its ``cmd_vel`` carries its command only
-while someone subscribes to it.
+while someone subscribes to it. The process evaluates the reference frame for each state's
+stamp itself from the reference's parameters and the changes the reference node announced;
+the reference node's samples, heard by the first robot of the process alone, are checked as
+always and against that frame, and in lockstep a state is answered once its sample is in. Its
+robots' simulated clocks follow the states' stamps instead of ``/clock``.
 
 Every state and reference message must be in ``world_frame`` (default ``world``). Commands for
 real bases: ``command.type: twist`` publishes a geometry_msgs/Twist (no stamp) instead of a
@@ -78,6 +82,7 @@ from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
 from formation_ros.ros.runner import run
+from formation_ros.ros.sim_clock import StateClock
 from formation_ros.ros.team import announced, PublisherWatch
 from formation_ros.ros.wake import Wake
 from geometry_msgs.msg import PoseArray, PoseStamped, Twist, TwistStamped
@@ -95,6 +100,9 @@ REFERENCE_BUFFER = 64
 LAST_WORD = 0.5
 """How long a stopping robot waits for its last (zero) command to be received, s."""
 RATE_TOLERANCE = 1e-3
+SAME_REFERENCE = 1e-6
+"""Team transport: how far (m, m/s, 1, 1/s) a heard reference sample may be from the frame a
+robot evaluates for its stamp (float rounding in the message is ~1e-15)."""
 INPUTS = ('pose', 'neighbour', 'reference')
 COPY_GAP_NS = 25_000_000
 """A copy of the state answered last that arrives sooner than this after the previous state is
@@ -122,14 +130,21 @@ class Reason(enum.Enum):
     TOO_MANY = 'more neighbours than there are robots'
     MALFORMED = 'bytes that are not a whole message of its type'
     TOO_FAST = 'a speed or turn rate its reference kind cannot have'
+    OTHER_REFERENCE = ('a frame other than the one its reference parameters and the announced '
+                       'changes give')
     CHANGE = 'a shape or team status that cannot hold'
 
 
 class RobotNode(Node):
     """One robot: stores what it hears in callbacks, computes and publishes in its timers."""
 
-    def __init__(self, **kwargs):
-        """Declare and check parameters, then set up topics and the control timer."""
+    def __init__(self, leader: Optional['RobotNode'] = None, **kwargs) -> None:
+        """
+        Declare and check parameters, then set up topics and the control timer.
+
+        ``leader``: with ``transport: team``, the first robot of this process; this robot then
+        hears the reference and the changes through it (one subscription per process).
+        """
         super().__init__('robot', **kwargs)
         config = declare_parameters(self, Exe.ROBOT)
         settings = config.robot
@@ -186,12 +201,17 @@ class RobotNode(Node):
 
         if not config.team_transport:
             self._subscribe_to_states(settings.pose_type)
-        reference = self.create_subscription(Odometry, topics.REFERENCE, self.on_reference,
-                                             qos.REFERENCE, raw=True)
-        self.expected_publishers: Dict[str, Optional[str]] = {reference.topic_name: None}
-        if self.sim_time:
-            self.expected_publishers[topics.CLOCK] = None
-        self.changes = Changes(self, config, self.steady, self._reject_change, self._new_state)
+        self.expected_publishers: Dict[str, Optional[str]] = {}
+        if leader is not None and config.team_transport:
+            self.changes = leader.changes
+        else:
+            reference = self.create_subscription(Odometry, topics.REFERENCE, self.on_reference,
+                                                 qos.REFERENCE, raw=True)
+            self.expected_publishers[reference.topic_name] = None
+            if self.sim_time:
+                self.expected_publishers[topics.CLOCK] = None
+            self.changes = Changes(self, config, self.steady, self._reject_change,
+                                   self._new_state)
         self.cmd_pub = self.create_publisher(TwistStamped if self.stamped else Twist,
                                              topics.CMD_VEL, qos.COMMAND)
         self.diagnostics_pub = self.create_publisher(DiagnosticArray, topics.DIAGNOSTICS,
@@ -342,7 +362,13 @@ class RobotNode(Node):
             self._reject('reference', Reason.NON_FINITE)
         elif not self._plausible(msg) and not (self.changes.take() and self._plausible(msg)):
             self._reject('reference', Reason.TOO_FAST)
+        elif self.team is not None and not self._same_reference(msg):
+            self._reject('reference', Reason.OTHER_REFERENCE, ' (another parameters file or '
+                                                              'reference.* on one of them?)')
         else:
+            if self.team is not None:
+                self.once.end(f'reference-{Reason.OTHER_REFERENCE.name}',
+                              'the reference is the one this robot evaluates again')
             self.references.append(msg)
             self.received_ns['reference'] = self._now_ns()
             if self.lockstep and (self.member_of is None or self.team is not None):
@@ -369,22 +395,51 @@ class RobotNode(Node):
         return (speed <= self.speed_limit * (1.0 + RATE_TOLERANCE) + RATE_TOLERANCE
                 and turn <= self.turn_limit * (1.0 + RATE_TOLERANCE) + RATE_TOLERANCE)
 
+    def _same_reference(self, msg: OdometryData) -> bool:
+        """
+        Team transport: whether a sample is the frame this robot evaluates for its stamp.
+
+        A sample far from this node's clock is let through (the states' clock check refuses
+        it where it is used); a mismatch is looked at again after taking changes not yet taken.
+        """
+        if abs(self._clock_gap_s(msg.stamp_ns)) * NS_PER_S > self.timeout_ns:
+            return True
+        heard = msg.frame(self.dim)
+
+        def close() -> bool:
+            mine = self.changes.reference.frame_at(msg.stamp_ns)
+            return all(np.allclose(a, b, rtol=0.0, atol=SAME_REFERENCE)
+                       for a, b in ((mine.q_od, heard.q_od), (mine.qdot_od, heard.qdot_od),
+                                    (mine.J, heard.J), (mine.Jdot, heard.Jdot)))
+
+        return close() or (bool(self.changes.take()) and close())
+
     def _reference_for(self, stamp_ns: int, exact: bool) -> Optional[FrameSample]:
-        """Return the reference frame at ``stamp_ns``: that sample, else the newest carried on."""
+        """
+        Return the reference frame at ``stamp_ns``: that sample, else the newest carried on.
+
+        Team transport: the frame this robot evaluates for ``stamp_ns`` from the reference's
+        parameters and the changes announced (``ReferenceTimeline.frame_at``, what the
+        reference node publishes), once a sample of that stamp (``exact``: lockstep) or a
+        recent sample on the states' clock shows the reference node runs on this team's time.
+        """
         for msg in reversed(self.references):
             if msg.stamp_ns == stamp_ns:
-                return msg.frame(self.dim)
+                return (msg.frame(self.dim) if self.team is None
+                        else self.changes.reference.frame_at(stamp_ns))
         if exact or not self.references:
             return None
-        newest = self.references[-1].frame(self.dim)
-        ahead = stamp_ns / NS_PER_S - newest.t
+        newest = self.references[-1]
+        ahead = (stamp_ns - newest.stamp_ns) / NS_PER_S
         if abs(ahead) * NS_PER_S > self.timeout_ns:
             advice = self._clock_advice('reference', 'the reference')
             self._reject('reference', Reason.CLOCK, f' ({-ahead:+.3g} s from the state: '
                                                     f'{advice})')
             return None
         self.once.end(f'reference-{Reason.CLOCK.name}', 'reference on the clock of the states')
-        return advance(newest, ahead)
+        if self.team is not None:
+            return self.changes.reference.frame_at(stamp_ns)
+        return advance(newest.frame(self.dim), ahead)
 
     def _command(self, stamp_ns: int, exact: bool) -> Optional[np.ndarray]:
         """Return the command for the state stamped ``stamp_ns`` (zero while stopped), or None."""
@@ -682,9 +737,12 @@ class TeamLink:
     state as a robot answers one (the leader's answer budget, watchdog and lockstep rules):
     every robot's command from one call of the law (``core.law.robot_commands``,
     :meth:`commands`), in one team command message (:meth:`publish`). Robot i's own
-    ``cmd_vel`` carries its command too while something subscribes to it. Each robot stays its
-    own node: namespace, parameters, diagnostics, its ``/formation/reference`` and changes
-    subscriptions.
+    ``cmd_vel`` carries its command too while something subscribes to it. The reference frame
+    is evaluated in the process for each state's stamp (:meth:`RobotNode._reference_for`); the
+    leader alone hears the reference node (its samples checked: on this clock, plausible, the
+    frame evaluated here) and the changes. The nodes' simulated clocks follow the states'
+    stamps (``ros.sim_clock.StateClock``): no ``/clock`` subscription. Each robot stays its own
+    node: namespace, parameters, diagnostics.
     """
 
     def __init__(self, nodes: Sequence[RobotNode]) -> None:
@@ -732,6 +790,7 @@ class TeamLink:
             if node is not leader and timer is not None:
                 node.destroy_timer(timer)
         leader.team = self
+        self.clock = StateClock(self.nodes)
         self.pub = leader.create_publisher(MultiDOFJointTrajectory, topics.TEAM_COMMANDS,
                                            qos.COMMAND)
         leader.create_subscription(PoseArray, topics.STATES, self.on_states, qos.STATE_INPUT,
@@ -784,6 +843,7 @@ class TeamLink:
         oriented = not needs_orientation or bool(np.all(valid_quaternions(orientations)))
         if not leader._check('states', state.frame_id, state.stamp_ns, finite, oriented):
             return
+        self.clock.advance(state.stamp_ns)
         observer, self.seen = sensed_pairs(positions, self.reach, observers=self.indices)
         self.observer = self.local[observer]
         if self.unicycle:
@@ -815,6 +875,7 @@ class TeamLink:
         node.neighbours = PoseArrayData(state.stamp_ns, state.frame_id, state.positions[seen],
                                         state.orientations[seen])
         node.received_ns['pose'] = node.received_ns['neighbour'] = self.taken_ns
+        node.received_ns['reference'] = self.leader.received_ns['reference']
         if self.command is not None:
             node.vertex = self.vertices[k]
             node.last = Command(u=self.command.u[k], u_hat=self.command.u_hat[k],

@@ -5,7 +5,9 @@
 
 import itertools
 
-from formation_ros.core.timeline import MAX_CHANGES, Mode, Shape, Timeline
+from formation_ros.core.reference import Reference
+from formation_ros.core.timeline import (MAX_CHANGES, Mode, ReferenceTimeline, Shape, TeamState,
+                                         Timeline)
 import numpy as np
 
 
@@ -50,3 +52,22 @@ def test_shapes_compare_by_vertices():
     square = Shape('square', np.array([[1.0, 1.0], [-1.0, 1.0]]))
     assert square.same_as(Shape('', square.vertices.copy()))
     assert not square.same_as(Shape('square', square.vertices + 1e-12))
+
+
+def test_the_reference_timeline_gives_each_stamp_the_frame_of_the_state_in_force():
+    base = Reference('circle', 2, origin=[1.0, -2.0], radius=1.5, speed=0.5)
+    states = Timeline(TeamState.of(Mode.RUNNING, '', base))
+    timeline = ReferenceTimeline(base, states)
+    states.add(2_000_000_000, TeamState(Mode.RUNNING, '', (0.0, 0.0), 1.0, 0.25))
+    epoch = 500_000_000
+    for stamp in (0, 1_999_999_999, 2_000_000_000, 3_250_000_000):
+        t = (stamp - epoch) / 1e9
+        centre = (np.array([1.0, -2.0]) if stamp < 2_000_000_000 else np.zeros(2))
+        frame = timeline.frame_at(stamp, epoch)
+        assert frame.t == t
+        expected = base.with_values(centre, 0.5 if stamp < 2_000_000_000 else 1.0,
+                                    0.0 if stamp < 2_000_000_000 else 0.25).sample(t)
+        assert np.array_equal(frame.q_od, expected.q_od)
+        assert np.array_equal(frame.J, expected.J)
+        assert abs(np.linalg.norm(frame.q_od - centre) - 1.5) < 1e-12
+        assert abs(np.linalg.norm(frame.qdot_od) - (0.5 if stamp < 2e9 else 1.0)) < 1e-12

@@ -7,7 +7,8 @@ The team transport (``transport: team``) over real DDS: one state message, one p
 Lockstep gives the robot transport's trajectory (and formation_sim's: unicycles, points that
 take body-frame commands); free-running, the team converges, a robot's own ``cmd_vel`` carries
 what its team message carries while someone listens (and only then), untrusted team command
-bytes are counted and dropped, and a dead robot process is reported and its body held still.
+bytes are counted and dropped, a dead robot process is reported and its body held still, and a
+reference node whose samples are not the frame the robots evaluate is refused, loudly.
 """
 
 import signal
@@ -20,29 +21,47 @@ from formation_ros.ros import fields, qos
 from formation_ros.ros.cdr import encode_header, encode_names, encode_team_commands
 from formation_ros.tools.sim import simulate
 from geometry_msgs.msg import PoseArray, TwistStamped
-from helpers import (launch, logged, SimClock, start_system, START_UP, stop_when,
-                     write_params)
+from helpers import (launch, logged, node, said_once, SimClock, start_system, START_UP,
+                     Statuses, stop_when, write_params)
 import numpy as np
 import pytest
 from trajectory_msgs.msg import MultiDOFJointTrajectory
 
 UNTIL = 2.0
 """Simulated seconds of each lockstep run (200 steps)."""
+SWITCH = 1.0
+"""When the lockstep runs switch to the wedge (formation.schedule), s."""
+WEDGE = [0.0, 1.5, -1.5, 0.0, 1.5, 0.0, 0.0, -1.5]
 NOTICE_WITHIN = 10.0
 """Bound (s) on kill -> the plant's status: lease 1 s + diagnostics period 1 s + a busy machine."""
+
+
+def distances(points):
+    """Return the pairwise distances of each row of points (T, N, dim): (T, N, N)."""
+    return np.linalg.norm(points[:, :, None, :] - points[:, None, :, :], axis=-1)
+
+
+def robot_subscribers(probe, topic):
+    """Return the namespaces of the robot nodes that subscribe to ``topic``, sorted."""
+    return sorted(info.node_namespace for info in probe.get_subscriptions_info_by_topic(topic)
+                  if info.node_namespace.startswith('/robot_'))
 
 
 def lockstep_run(processes, probe, install, tmp_path, transport):
     """
     Run square_4 on a moving reference in lockstep, two robots a fleet; return its trajectory.
 
-    With the team transport, run until every robot (the second of each fleet too) reports
-    'lockstep' with its neighbours in /diagnostics.
+    The shape switches to a wedge at SWITCH. With the team transport, run until every robot
+    (the second of each fleet too) reports 'lockstep' with its neighbours in /diagnostics, and
+    check that no robot subscribes to /clock and only the first of each fleet to the reference
+    and the changes.
     """
     out = tmp_path / transport
     params = write_params(tmp_path, 'square_4.yaml', {
         'plant.lockstep': True, 'plant.realtime_factor': 200.0, 'transport': transport,
         'reference.kind': 'circle', 'reference.radius': 1.0, 'reference.speed': 0.5,
+        'formations.names': ['wedge'], 'formations.wedge.vertices': WEDGE,
+        'formation.schedule.times': [SWITCH], 'formation.schedule.names': ['wedge'],
         'plant.output_dir': str(out)}, name=f'{transport}.yaml')
     clock = SimClock(probe)
     statuses = {}
@@ -56,6 +75,18 @@ def lockstep_run(processes, probe, install, tmp_path, transport):
                                            for name in robots)
 
     launch(processes, install, params, name=transport, options=('--robots-per-process', '2'))
+    leaders = ['/robot_1', '/robot_3']
+    if transport == 'team':
+        assert probe.spin_until(lambda: every_robot_reports()
+                                and robot_subscribers(probe, '/formation/reference') == leaders,
+                                START_UP), (statuses, processes.log(transport))
+        assert robot_subscribers(probe, '/clock') == []
+        assert robot_subscribers(probe, '/formation/shape') == leaders
+        assert robot_subscribers(probe, '/formation/status') == leaders
+    else:
+        assert probe.spin_until(
+            lambda: (len(robot_subscribers(probe, '/clock')) == 2
+                     and len(robot_subscribers(probe, '/formation/reference')) == 4), START_UP)
     info = stop_when(probe, processes, lambda: clock.seconds >= UNTIL and every_robot_reports(),
                      name=transport)
     probe.destroy_subscription(clock.subscription)
@@ -78,6 +109,11 @@ def test_team_and_robot_transports_give_one_trajectory_in_lockstep(processes, in
     assert np.max(np.abs(robot.q[:steps] - team.q[:steps])) < 1e-12
     assert np.max(np.abs(robot.u[:steps] - team.u[:steps])) < 1e-12
     assert np.ptp(team.q[:steps], axis=0).max() > 0.5
+    switched = team.t[:steps] >= SWITCH - 1e-9
+    assert 0 < np.count_nonzero(switched) < steps
+    square = load_config(str(tmp_path / 'team.yaml')).vertices
+    for rows, shape in ((~switched, square), (switched, np.reshape(WEDGE, (4, 2)))):
+        assert np.allclose(distances(team.q_desired[:steps][rows]), distances(shape[None]))
 
 
 @pytest.mark.parametrize('source, changes', [
@@ -199,3 +235,24 @@ def test_a_free_running_team_converges_and_shows_its_commands_per_robot(processe
     still = heard.poses(4)[reported:]
     assert still[-1][0] > still[0][0] and len({position for _, position in still}) == 1, still
     assert '4' in (heard.plant_value('robots with stale commands') or ''), heard.status[-1]
+
+
+def test_a_team_robot_refuses_a_reference_other_than_it_evaluates(processes, install, probe,
+                                                                  tmp_path):
+    circle = {'transport': 'team', 'reference.kind': 'circle', 'reference.speed': 0.5}
+    params = write_params(tmp_path, 'square_4.yaml', {**circle, 'reference.radius': 1.0})
+    other = write_params(tmp_path, 'square_4.yaml', {**circle, 'reference.radius': 2.0},
+                         name='other.yaml')
+    statuses = Statuses(probe)
+    processes.start(node(install, 'plant', params))
+    processes.start(node(install, 'reference', other, '-p', 'use_sim_time:=true'))
+    processes.start(node(install, 'robot', params, '-r', '__ns:=/robot_1', '-p', 'robot_id:=1',
+                         '-p', 'use_sim_time:=true', process='robot_1'))
+    text = 'ignoring reference messages with a frame other than the one its reference'
+    assert said_once(probe, processes, 'robot_1', text, statuses,
+                     'formation_ros/robot_1') == 1
+    values = {pair.key: pair.value for pair in statuses['formation_ros/robot_1'].values}
+    assert int(values['rejected reference messages (a frame other than the one its reference '
+                      'parameters and the announced changes give)']) > 1, values
+    assert values['reference message age [s]'] == 'never'
+    assert statuses['formation_ros/robot_1'].message == 'waiting for its first inputs'
