@@ -21,6 +21,9 @@ from numpy.typing import NDArray
 if TYPE_CHECKING:
     from scipy.spatial import cKDTree
 
+DIRECT_LIMIT = 1 << 18
+"""Up to this many (observer, body) pairs the few observers' pairs come from every distance,
+without a k-d tree (a fleet of 25 in a team of 10,000; no scipy import in a robot process)."""
 SEARCH_MARGIN = 1.0 + 1e-9
 """The ball search of a few observers reaches this much farther than their sensors; the strict
 test on squared distances then decides, as for the whole team."""
@@ -39,11 +42,13 @@ def sensed_pairs(q: NDArray[np.float64], reach: NDArray[np.float64],
     Who senses whom: arrays (observer, seen) of every ordered pair with ||q_o - q_s|| < reach_o.
 
     q: (N, dim) body positions, m; reach: (N,) sensor reach, m (:func:`sensor_radii`); tree: a
-    k-d tree of ``q`` when the caller has one (else one is built); observers: (K,) distinct
-    0-based indices of the only observers wanted (a fleet's robots: the pairs of the whole team
-    whose observer is one of them, the same pairs), None for every robot. Sorted by observer,
-    then seen; indices 0-based.
+    k-d tree of ``q`` when the caller has one (else one is built, but for few observers);
+    observers: (K,) distinct 0-based indices of the only observers wanted (a fleet's robots:
+    the pairs of the whole team whose observer is one of them, the same pairs), None for every
+    robot. Sorted by observer, then seen; indices 0-based.
     """
+    if observers is not None and tree is None and len(observers) * len(q) <= DIRECT_LIMIT:
+        return _pairs_direct(q, reach, np.asarray(observers, dtype=np.intp))
     if tree is None:
         from scipy.spatial import cKDTree  # here: a robot imports the plant model, not the tree
         tree = cKDTree(q)
@@ -57,6 +62,19 @@ def sensed_pairs(q: NDArray[np.float64], reach: NDArray[np.float64],
     both = np.concatenate([first, second])
     order = np.lexsort((both[:, 1], both[:, 0]))
     return both[order, 0], both[order, 1]
+
+
+def _pairs_direct(q: NDArray[np.float64], reach: NDArray[np.float64],
+                  observers: NDArray[np.intp]) -> Tuple[NDArray[np.intp], NDArray[np.intp]]:
+    """:func:`sensed_pairs` of the given observers only, from every (observer, body) distance."""
+    diff = q[observers][:, None, :] - q[None, :, :]
+    d2 = np.einsum('kjd,kjd->kj', diff, diff)
+    near = d2 < (reach[observers] ** 2)[:, None]
+    near[np.arange(len(observers)), observers] = False
+    rows, seen = np.nonzero(near)
+    observer = observers[rows]
+    order = np.lexsort((seen, observer))
+    return observer[order], seen[order].astype(np.intp)
 
 
 def _pairs_of(q: NDArray[np.float64], reach: NDArray[np.float64], tree: 'cKDTree',

@@ -100,6 +100,9 @@ RESEND_AFTER = 0.05
 PUBLISHES_TIMED = 256
 """States whose first publish time is kept for the answer latency; answers to older states are
 not timed."""
+GRAPH_LOOKS = 100
+"""Topics looked up in the graph per diagnostics period for a second publisher (of 3N + 2,
+in turn: ``ros.team.PublisherWatch``)."""
 PATH_LENGTH = 100
 CHUNK_PERIOD = 1.0
 LOOK_TIME = 2.0
@@ -142,7 +145,7 @@ class PlantNode(Node):
         self.next_look = 0.0
         self.created_wall = time.monotonic()
         self.clock_heard = 0
-        self.graph = PublisherWatch(self, self.team)
+        self.graph = PublisherWatch(self, self.team, GRAPH_LOOKS)
         self.own_name = self.get_fully_qualified_name()
         self.n, self.dim = config.num_robots, config.dim
         self.unicycles = config.body.is_unicycle

@@ -160,20 +160,27 @@ class PublisherWatch:
     """
     Publishers besides the expected one on some topics, looked up in the ROS graph on a timer.
 
-    :meth:`check` costs one ``count_publishers`` per topic (a lookup in the node's graph cache:
-    1.6 ms for the 151 topics of a 50-robot plant on the 2-core machine) and the publishers'
-    names only where there are more than one. A second publisher with another node name is
-    reported at once; one with the expected node's own name may be what is left of a process
-    killed a moment ago (DDS forgets it about 20 s later), so it is reported at once only with
-    evidence that it runs (``alive``), else after ``core.team.DUPLICATE_GRACE`` s.
+    A look costs one ``count_publishers`` per topic, a lookup in the node's graph cache that
+    grows with the graph (every endpoint of every node), and the publishers' names only where
+    there are more than one. A plant watches three topics per robot, so :meth:`check` looks at
+    ``limit`` topics at most per call, in turn (topics known to have several publishers at
+    every call): a second publisher on one of T topics is seen within ceil(T / limit) calls.
+    A second publisher with another node name is reported at once; one with the expected
+    node's own name may be what is left of a process killed a moment ago (DDS forgets it about
+    20 s later), so it is reported at once only with evidence that it runs (``alive``), else
+    after ``core.team.DUPLICATE_GRACE`` s.
     """
 
-    def __init__(self, node: Node, team: Optional[TeamCheck] = None) -> None:
-        """Look up the graph of ``node``; name hosts from what ``team`` heard (if given)."""
+    def __init__(self, node: Node, team: Optional[TeamCheck] = None,
+                 limit: Optional[int] = None) -> None:
+        """Look up the graph of ``node`` (``limit`` topics a call, None: all); name hosts."""
         self.node = node
         self.team = team
+        self.limit = limit
+        self.cursor = 0
         self.since: Dict[str, float] = {}
         self.listed: Dict[str, List[str]] = {}
+        """Every topic's publishers where there were several when it was looked at last."""
 
     def publishers(self, topic: str) -> List[str]:
         """Return the fully qualified names of the nodes publishing ``topic`` (one per writer)."""
@@ -181,6 +188,15 @@ class PublisherWatch:
             return []
         return sorted(full_name(info.node_namespace, info.node_name)
                       for info in self.node.get_publishers_info_by_topic(topic))
+
+    def _looked_at(self, topics: Sequence[str]) -> List[str]:
+        """Return the topics of this call: the next ``limit`` in turn, and those with several."""
+        if self.limit is None or self.limit >= len(topics):
+            return list(topics)
+        start = self.cursor % len(topics)
+        self.cursor = start + self.limit
+        turn = (list(topics[start:]) + list(topics[:start]))[:self.limit]
+        return turn + [topic for topic in self.listed if topic not in set(turn)]
 
     def check(self, expected: Mapping[str, Optional[str]], now: float,
               alive: Callable[[str, Sequence[str]], bool] = lambda topic, names: False
@@ -190,18 +206,22 @@ class PublisherWatch:
 
         expected: {topic: the one node that should publish it (fully qualified), or None for
         any one node}; alive(topic, names): whether a same-named second publisher is known to
-        run. :attr:`listed` keeps every topic's publishers when there are several, due or not.
+        run.
         """
-        due: Dict[str, str] = {}
-        self.listed = {}
-        for topic, own in expected.items():
-            names = self.publishers(topic)
-            if not names:
+        for topic in self._looked_at(list(expected)):
+            names = self.publishers(topic) if topic in expected else []
+            if names:
+                self.listed[topic] = names
+                self.since.setdefault(topic, now)
+            else:
+                self.listed.pop(topic, None)
                 self.since.pop(topic, None)
+        due: Dict[str, str] = {}
+        for topic, names in self.listed.items():
+            if topic not in expected:
                 continue
-            self.listed[topic] = names
-            since = self.since.setdefault(topic, now)
-            if duplicate_due(names, own, now - since, alive(topic, names)):
+            own = expected[topic]
+            if duplicate_due(names, own, now - self.since[topic], alive(topic, names)):
                 due[topic] = self.name_others(names, own, now)
         return due
 

@@ -8,7 +8,7 @@ import os
 import re
 
 from formation_ros.core.declarations import DECLARATIONS as SCHEMA, ParamError, REQUIRED
-from formation_ros.core.params import load_config, validate
+from formation_ros.core.params import load_config, shape_problem, validate
 from formation_ros.core.params_file import load_params_file
 import numpy as np
 import pytest
@@ -286,3 +286,15 @@ def test_a_formation_moving_faster_than_the_robots_can_is_refused():
     line.update({'reference.kind': 'line', 'reference.velocity': [0.3, 0.0]})
     with pytest.raises(ParamError, match='up to 0.3 m/s'):
         validate(line)
+
+
+@pytest.mark.parametrize('n', [2, 40, 1600])
+def test_the_closest_vertices_are_named_as_a_brute_force_finds_them(n):
+    rng = np.random.default_rng(n)
+    vertices = rng.uniform(-50.0, 50.0, (n, 3))
+    pairs = [(math.dist(vertices[i], vertices[j]), i + 1, j + 1)
+             for i in range(n) for j in range(i + 1, n)]
+    gap, i, j = min(pairs)
+    problem = shape_problem(vertices, gap * 1.5)
+    assert f'({i} and {j}: {gap:g} m)' in problem, problem
+    assert shape_problem(vertices, gap * 0.99) is None

@@ -11,6 +11,7 @@ from formation_ros.core.transport import (command_vectors, commands_of, robot_in
 from formation_ros.core.unicycle import quaternions_from_headings
 import numpy as np
 import pytest
+from scipy.spatial import cKDTree
 
 LAW = make_law(2.0, 1.0, 'arctan', 'poly', 2, 1.0)
 
@@ -63,6 +64,9 @@ def test_a_fleets_sensing_is_the_whole_teams_for_its_robots():
     fleet_observer, fleet_seen = sensed_pairs(q, only, observers=members)
     assert np.array_equal(fleet_observer, observer[mine])
     assert np.array_equal(fleet_seen, seen[mine])
+    searched = sensed_pairs(q, only, cKDTree(q), observers=members[::-1])
+    assert np.array_equal(searched[0], fleet_observer)
+    assert np.array_equal(searched[1], fleet_seen)
     assert len(fleet_seen) > 3 * len(members)
     empty = sensed_pairs(q, only, observers=np.zeros(0, dtype=np.intp))
     assert len(empty[0]) == len(empty[1]) == 0
