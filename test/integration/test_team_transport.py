@@ -20,7 +20,7 @@ from formation_ros.core.trajectory import Trajectory
 from formation_ros.ros import fields, qos
 from formation_ros.ros.cdr import encode_header, encode_names, encode_team_commands
 from formation_ros.tools.sim import simulate
-from geometry_msgs.msg import PoseArray, TwistStamped
+from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
 from helpers import (launch, logged, node, said_once, SimClock, start_system, START_UP,
                      Statuses, stop_when, write_params)
 import numpy as np
@@ -208,6 +208,30 @@ def test_a_free_running_team_converges_and_shows_its_commands_per_robot(processe
     assert heard.plant_value('robots with pose and neighbors published') == 'none'
     assert heard.plant_value('cmd_vel published', name='formation_ros/robot_2') == 'yes'
     assert heard.plant_value('cmd_vel published', name='formation_ros/robot_1') == 'no'
+
+    own_poses, own_neighbours = {}, {}
+    probe.create_subscription(PoseStamped, '/robot_3/pose', lambda message: own_poses.update(
+        {fields.stamp_to_ns(message.header.stamp): message.pose.position}), qos.STATE_INPUT)
+    probe.create_subscription(PoseArray, '/robot_3/neighbors', lambda message: (
+        own_neighbours.update({fields.stamp_to_ns(message.header.stamp): message.poses})),
+        qos.STATE_INPUT)
+    assert probe.spin_until(
+        lambda: (heard.plant_value('robots with pose and neighbors published') == '3'
+                 and len(set(own_poses) & set(own_neighbours)) >= 10), NOTICE_WITHIN), \
+        heard.plant_value('robots with pose and neighbors published')
+    states = {fields.stamp_to_ns(state.header.stamp): state for state in heard.states}
+    radius = load_config(params).sensing_radii[2]
+    compared = 0
+    for stamp in sorted(set(own_poses) & set(own_neighbours) & set(states)):
+        team = np.array([(pose.position.x, pose.position.y) for pose in states[stamp].poses])
+        position = own_poses[stamp]
+        assert (position.x, position.y) == tuple(team[2])
+        near = sorted(tuple(row) for k, row in enumerate(team)
+                      if k != 2 and np.hypot(*(row - team[2])) < radius)
+        assert sorted((pose.position.x, pose.position.y)
+                      for pose in own_neighbours[stamp]) == near
+        compared += 1
+    assert compared >= 5
 
     publisher = probe.create_publisher(MultiDOFJointTrajectory, '/formation/commands',
                                        qos.COMMAND)
