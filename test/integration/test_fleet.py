@@ -16,7 +16,7 @@ import signal
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.tools.supervise import ProcessSpec
 from helpers import (exe, launch, project_processes, SimClock, SQUARE, START_UP,
-                     stop_when, TWICE_REAL_TIME, watch_commands, write_params)
+                     stop_when, TWICE_REAL_TIME, wait_exit, watch_commands, write_params)
 import numpy as np
 from rcl_interfaces.srv import GetParameters, SetParameters
 from rclpy.parameter import Parameter
@@ -117,3 +117,21 @@ def test_killing_one_fleet_process_stops_only_its_robots(processes, install, pro
         assert np.all(trajectory.q[after, robot] == trajectory.q[after, robot][0]), robot
     alive = trajectory.u[after][:, [0, 1]]
     assert np.all(np.any(alive != 0.0, axis=(0, 2))), 'robots 1, 2 were not controlled'
+
+
+def test_a_team_fleet_whose_robots_differ_in_the_law_is_refused_in_one_line(
+        processes, install, probe, tmp_path):
+    own = tmp_path / 'robot_2.yaml'
+    own.write_text(yaml.safe_dump({'/robot_2/robot': {'ros__parameters': {
+        'controller': {'gain': 3.0}}}}))
+    team = tmp_path / 'team.yaml'
+    team.write_text(yaml.safe_dump({'/**': {'ros__parameters': {'transport': 'team'}}}))
+    processes.start(ProcessSpec('fleet', [exe(install, 'fleet'), '--robots', '1-3', '--ros-args',
+                                          '--params-file', SQUARE, '--params-file', str(team),
+                                          '--params-file', str(own), '-p', 'use_sim_time:=true']))
+    info = wait_exit(probe, processes, 'fleet', START_UP)
+    log = processes.log('fleet')
+    assert info is not None and info.returncode == 2, log
+    errors = [line for line in log.splitlines() if '[ERROR]' in line]
+    assert len(errors) == 1 and "'controller.gain': must be the same for every robot" in errors[0]
+    assert 'Traceback' not in log
