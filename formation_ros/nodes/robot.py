@@ -584,7 +584,10 @@ class RobotNode(Node):
                 self._flooding(stamp)
             elif (self.last_message is not None
                   and now - self.resent_ns >= max(COPY_GAP_NS, self.budget.period_ns)):
-                (self.cmd_pub if self.team is None else self.team.pub).publish(self.last_message)
+                if self.team is None:
+                    self.cmd_pub.publish(self.last_message)
+                else:
+                    self.team.resend()
                 self.resent_ns = now
             self.copy_arrived_ns = now
             self.answered_count = self.pose_count
@@ -784,6 +787,9 @@ class TeamLink:
         self.observer = np.zeros(0, dtype=np.intp)
         self.seen = np.zeros(0, dtype=np.intp)
         self.listening = np.zeros(len(self.nodes), dtype=bool)
+        self.last_sent: Optional[bytes] = None
+        self.sent: List[Tuple[RobotNode, bytes]] = []
+        """The cmd_vel messages that went with the latest team command, by robot."""
         for node in self.nodes:
             node.member_of = self
             timer = getattr(node, 'timer', None)
@@ -916,12 +922,22 @@ class TeamLink:
         message = encode_team_commands(stamp_ns, self.leader.world_frame, self.names, linear,
                                        angular)
         self.pub.publish(message)
-        for k in np.flatnonzero(self.listening).tolist():
-            node = self.nodes[k]
-            node.cmd_pub.publish(
-                encode_twist_stamped(stamp_ns, node.command_frame, linear[k], angular[k])
-                if node.stamped else encode_twist(linear[k], angular[k]))
+        self.sent = [(self.nodes[k], encode_twist_stamped(stamp_ns, self.nodes[k].command_frame,
+                                                          linear[k], angular[k])
+                      if self.nodes[k].stamped else encode_twist(linear[k], angular[k]))
+                     for k in np.flatnonzero(self.listening).tolist()]
+        for node, own in self.sent:
+            node.cmd_pub.publish(own)
+        self.last_sent = message
         return message
+
+    def resend(self) -> None:
+        """Publish the latest team command again, and each listened robot's cmd_vel with it."""
+        if self.last_sent is None:
+            return
+        self.pub.publish(self.last_sent)
+        for node, own in self.sent:
+            node.cmd_pub.publish(own)
 
 
 def make_robot() -> RobotNode:
