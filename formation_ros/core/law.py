@@ -231,14 +231,18 @@ def neighbour_pairs(q: ArrayLike, radius: float,
     """
     Pairs (i, j), i < j, with ||q_i - q_j|| <= radius, from a k-d tree: (P, 2) int array.
 
-    tree: a k-d tree of ``q`` already built (the plant model keeps one per step), else one is
-    built here (scipy.spatial is imported then: a robot, which never calls this, does not load
-    it).
+    Sorted by i, then j, whatever the tree's own order: the law sums each robot's terms in this
+    order, so any search that finds the same pairs gives the same numbers. tree: a k-d tree of
+    ``q`` already built (the plant model keeps one), else one is built here (scipy.spatial is
+    imported then: a robot, which never calls this, does not load it).
     """
     if tree is None:
         from scipy.spatial import cKDTree
         tree = cKDTree(np.asarray(q, dtype=float))
-    pairs: NDArray[np.intp] = tree.query_pairs(r=radius, output_type='ndarray').reshape(-1, 2)
+    found = tree.query_pairs(r=radius, output_type='ndarray').reshape(-1, 2)
+    n = max(int(tree.n), 1)
+    key = np.sort(found[:, 0].astype(np.int64) * n + found[:, 1])
+    pairs: NDArray[np.intp] = np.stack([key // n, key % n], axis=1).astype(np.intp)
     return pairs
 
 
