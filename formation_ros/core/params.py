@@ -29,6 +29,7 @@ from formation_ros.core.dynamics import IDEAL, Imperfections
 from formation_ros.core.frames import desired_positions, from_frame_velocity
 from formation_ros.core.jump import JumpKind
 from formation_ros.core.law import LawParams, make_law, PSI_FUNCTIONS, PsiKind
+from formation_ros.core.pairs import closest_pair
 from formation_ros.core.params_file import load_params_file, PathText
 from formation_ros.core.plant import start_positions, StartSpec
 from formation_ros.core.reference import dimension_problem, PERIODIC, Reference
@@ -254,11 +255,8 @@ def _points(values: Mapping[str, Any], name: str, n: int, dim: int,
 
 def _closest_pair(points: NDArray[np.float64]) -> Tuple[float, int, int]:
     """Return (distance, i, j) of the closest pair, 1-based i < j."""
-    from scipy.spatial import cKDTree
-    distance, index = cKDTree(points).query(points, k=2)
-    i = int(np.argmin(distance[:, 1]))
-    j = int(index[i, 1]) if int(index[i, 1]) != i else int(index[i, 0])
-    return math.dist(points[i], points[j]), min(i, j) + 1, max(i, j) + 1
+    distance, i, j = closest_pair(points)
+    return distance, i + 1, j + 1
 
 
 def _start(values: Mapping[str, Any], n: int, dim: int,

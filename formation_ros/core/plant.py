@@ -57,7 +57,8 @@ from typing import Dict, List, Optional, Set, Tuple, TYPE_CHECKING
 from formation_ros.core.bodies import Bodies, PointBodies
 from formation_ros.core.dynamics import IDEAL, Imperfections
 from formation_ros.core.frames import from_frame_velocity, to_frame_velocity
-from formation_ros.core.law import LawParams, neighbour_pairs
+from formation_ros.core.law import LawParams
+from formation_ros.core.pairs import pairs_within, row_differences, squared_norms
 from formation_ros.core.reference import Reference
 from formation_ros.core.sensing import neighbour_lists, sensed_pairs, sensor_radii
 from formation_ros.core.units import NS_PER_S
@@ -365,6 +366,12 @@ def _row_max(values: NDArray[np.float64]) -> NDArray[np.float64]:
     return largest
 
 
+def _kd_tree(points: NDArray[np.float64]) -> 'cKDTree':
+    """A k-d tree of ``points`` (scipy is loaded here: a --dt run of formation_sim needs none)."""
+    from scipy.spatial import cKDTree
+    return cKDTree(points)
+
+
 class PlantModel:
     """
     Every robot's body and range sensor, stepped with zero-order hold.
@@ -418,8 +425,6 @@ class PlantModel:
         self.bound_tolerance = (BOUND_TOLERANCE_FIXED if reference.is_stationary
                                 else BOUND_TOLERANCE_MOVING)
         self.t_ns = 0
-        from scipy.spatial import cKDTree  # here: a robot imports this module, not the tree
-        self._tree_type = cKDTree
         self._tree: Optional['cKDTree'] = None
         self._body_tree: Optional['cKDTree'] = None
         self._moved()
@@ -466,7 +471,7 @@ class PlantModel:
     def tree(self) -> 'cKDTree':
         """A k-d tree of the control points now."""
         if self._tree is None:
-            self._tree = self._tree_type(self.points)
+            self._tree = _kd_tree(self.points)
         return self._tree
 
     @property
@@ -475,7 +480,7 @@ class PlantModel:
         if self.points is self.q:
             return self.tree
         if self._body_tree is None:
-            self._body_tree = self._tree_type(self.q)
+            self._body_tree = _kd_tree(self.q)
         return self._body_tree
 
     @property
@@ -695,7 +700,7 @@ class PlantModel:
             self.pairs, d2 = self._pairs_within_radius()
         if (self.pairs is not None and self.points is self.q
                 and self.pair_radius >= self.contact_distance):
-            close = self.pairs[d2 <= self.contact_distance ** 2].tolist()
+            close = np.compress(d2 <= self.contact_distance ** 2, self.pairs, axis=0).tolist()
         else:
             close = self.body_tree.query_pairs(self.contact_distance,
                                                output_type='ndarray').tolist()
@@ -710,13 +715,12 @@ class PlantModel:
             if not float(np.max(np.einsum('kd,kd->k', moved, moved))) <= (0.5 * skin) ** 2:
                 self._candidates = None
         if self._candidates is None:
-            self._candidates = neighbour_pairs(points, self.pair_radius + skin, self.tree)
+            self._candidates = pairs_within(points, self.pair_radius + skin)
             self._searched_at = points.copy()
         candidates = self._candidates
-        diff = points[candidates[:, 0]] - points[candidates[:, 1]]
-        d2 = np.einsum('kd,kd->k', diff, diff)
+        d2 = squared_norms(row_differences(points, candidates[:, 0], candidates[:, 1]))
         within = d2 <= self.pair_radius ** 2
-        return candidates[within], d2[within]
+        return np.compress(within, candidates, axis=0), d2[within]
 
     def _new_collisions(self) -> List[Tuple[int, int, float]]:
         pairs = self._close_pairs()
