@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 def squared_norms(v: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Squared norms (K,) of the rows of v (K, dim), summed axis after axis (as einsum does)."""
+    """Squared norms (K,) of the rows of v (K, dim), summed axis after axis."""
     total: NDArray[np.float64] = v[:, 0] * v[:, 0]
     for axis in range(1, v.shape[1]):
         total = total + v[:, axis] * v[:, axis]
@@ -63,10 +63,13 @@ def pairs_within(points: ArrayLike, radius: float) -> NDArray[np.intp]:
         return np.zeros((0, 2), dtype=np.intp)
     low = np.min(q, axis=0)
     cell = radius * CELL_MARGIN if radius > 0.0 else 1.0
-    cells = np.floor((q - low) / cell).astype(np.int64)
-    sizes = np.max(cells, axis=0) + 3
-    if float(np.prod(sizes.astype(float))) > MAX_CELLS:
+    with np.errstate(over='ignore'):
+        scaled = np.floor((q - low) / cell)
+        cells_needed = float(np.prod(np.max(scaled, axis=0) + 3.0))
+    if not cells_needed <= MAX_CELLS:
         return _tree_pairs(q, radius)
+    cells = scaled.astype(np.int64)
+    sizes = np.max(cells, axis=0) + 3
     strides = np.concatenate([[1], np.cumprod(sizes[:-1])]).astype(np.int64)
     key = (cells + 1) @ strides
     order = np.argsort(key, kind='stable')
@@ -87,7 +90,8 @@ def pairs_within(points: ArrayLike, radius: float) -> NDArray[np.intp]:
     if not firsts:
         return np.zeros((0, 2), dtype=np.intp)
     a, b = order[np.concatenate(firsts)], order[np.concatenate(seconds)]
-    near = squared_norms(row_differences(q, a, b)) <= radius * radius
+    with np.errstate(over='ignore'):
+        near = squared_norms(row_differences(q, a, b)) <= radius * radius
     a, b = a[near], b[near]
     return sorted_pairs(np.minimum(a, b), np.maximum(a, b), n)
 
