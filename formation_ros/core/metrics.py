@@ -21,6 +21,8 @@ from numpy.typing import ArrayLike, NDArray
 SETTLE_TOLERANCE = 0.05
 DIS_ALL_MAX_SAMPLES = 400
 DIS_ALL_BLOCK = 128
+DIS_MIN_GUESS = 1.5
+"""dis_min of a sample is searched first within this many times the sample's before."""
 DIS_ALL_MAX_ROBOTS = 2000
 
 
@@ -53,7 +55,12 @@ def closest_pair_distance(points: ArrayLike) -> float:
 
 def dis_min_series(q: ArrayLike) -> NDArray[np.float64]:
     """dis_min of Section 5 at each sample: the closest pair distance, (T,) in m."""
-    return np.array([closest_pair_distance(sample) for sample in np.asarray(q)])
+    series = np.asarray(q, dtype=float)
+    distances = np.empty(len(series))
+    previous = 0.0
+    for k, sample in enumerate(series):
+        distances[k] = previous = closest_pair(sample, DIS_MIN_GUESS * previous)[0]
+    return distances
 
 
 def dis_all(points: ArrayLike) -> float:

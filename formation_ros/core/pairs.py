@@ -110,13 +110,14 @@ def _tree_pairs(q: NDArray[np.float64], radius: float) -> NDArray[np.intp]:
     return sorted_pairs(found[:, 0], found[:, 1], len(q))
 
 
-def closest_pair(points: ArrayLike) -> Tuple[float, int, int]:
+def closest_pair(points: ArrayLike, guess: float = 0.0) -> Tuple[float, int, int]:
     """
     Return (distance in m, i, j) of the closest two of the points (N, dim), 0-based i < j.
 
     Of several closest pairs, the first by i, then j. (inf, -1, -1) for fewer than 2 points.
-    The search radius starts at the spacing N points would have spread evenly over their
-    bounding box and doubles until some pair is found.
+    The search radius starts at ``guess`` (m) when it is > 0 (e.g. a little more than the
+    distance of the sample before), else at the spacing N points would have spread evenly over
+    their bounding box, and doubles until some pair is found.
     """
     q = np.asarray(points, dtype=float)
     n, dim = q.shape
@@ -125,7 +126,7 @@ def closest_pair(points: ArrayLike) -> Tuple[float, int, int]:
     largest = float(np.max(np.max(q, axis=0) - np.min(q, axis=0)))
     if largest == 0.0:
         return 0.0, 0, 1
-    radius = largest / n ** (1.0 / dim)
+    radius = guess if 0.0 < guess < math.inf else largest / n ** (1.0 / dim)
     while True:
         pairs = pairs_within(q, radius)
         if len(pairs):
