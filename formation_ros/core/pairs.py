@@ -16,6 +16,7 @@ from typing import Tuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+
 def squared_norms(v: NDArray[np.float64]) -> NDArray[np.float64]:
     """Squared norms (K,) of the rows of v (K, dim), summed axis after axis."""
     total: NDArray[np.float64] = v[:, 0] * v[:, 0]

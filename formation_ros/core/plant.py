@@ -367,7 +367,7 @@ def _row_max(values: NDArray[np.float64]) -> NDArray[np.float64]:
 
 
 def _kd_tree(points: NDArray[np.float64]) -> 'cKDTree':
-    """A k-d tree of ``points`` (scipy is loaded here: a --dt run of formation_sim needs none)."""
+    """Build a k-d tree of ``points`` (scipy loads here: formation_sim --dt needs none)."""
     from scipy.spatial import cKDTree
     return cKDTree(points)
 
@@ -469,14 +469,14 @@ class PlantModel:
 
     @property
     def tree(self) -> 'cKDTree':
-        """A k-d tree of the control points now."""
+        """Return a k-d tree of the control points now."""
         if self._tree is None:
             self._tree = _kd_tree(self.points)
         return self._tree
 
     @property
     def body_tree(self) -> 'cKDTree':
-        """A k-d tree of the body positions now (:attr:`tree` itself for points)."""
+        """Return a k-d tree of the body positions now (:attr:`tree` itself for points)."""
         if self.points is self.q:
             return self.tree
         if self._body_tree is None:
@@ -707,7 +707,7 @@ class PlantModel:
         return {(int(i), int(j)) for i, j in close}
 
     def _pairs_within_radius(self) -> Tuple[NDArray[np.intp], NDArray[np.float64]]:
-        """The pairs of control points within ``pair_radius`` now and their squared distances."""
+        """Return the pairs of control points within ``pair_radius`` now, and their d**2."""
         skin = PAIR_SKIN * self.pair_radius
         points = self.points
         if self._searched_at is not None:

@@ -23,7 +23,7 @@ MS = 10_000_000
 
 
 def tree_pairs(q, radius):
-    """The pairs a k-d tree finds, as sorted (i, j) tuples."""
+    """Return the pairs a k-d tree finds, as sorted (i, j) tuples."""
     found = cKDTree(q).query_pairs(radius, output_type='ndarray').reshape(-1, 2)
     return sorted(map(tuple, found.tolist()))
 
@@ -83,8 +83,8 @@ def test_the_plant_models_kept_pairs_are_a_fresh_search_at_every_step():
     for _ in range(120):
         fresh = pairs_within(model.points, LAW.repulsion_radius)
         assert np.array_equal(model.pairs, fresh)
-        assert list(map(tuple, model.pairs.tolist())) == tree_pairs(model.points,
-                                                                  LAW.repulsion_radius)
+        tree = tree_pairs(model.points, LAW.repulsion_radius)
+        assert list(map(tuple, model.pairs.tolist())) == tree
         kept = team_command(model.points, vertices, model.radii, LAW, None, None, model.pairs)
         searched = team_command(model.points, vertices, model.radii, LAW)
         assert np.array_equal(kept.u, searched.u)
