@@ -123,6 +123,16 @@ def test_importing_formation_sim_or_asking_for_help_loads_no_scipy_or_matplotlib
     assert loaded_by('from formation_ros.tools.sim import main\nmain(["--help"])') == '[]'
 
 
+def test_a_fixed_step_run_without_figures_loads_no_scipy_or_matplotlib(tmp_path):
+    """The grid of core.pairs searches every pair a --dt run needs: scipy stays unloaded."""
+    out = str(tmp_path / 'run')
+    code = ('from formation_ros.tools.sim import main\n'
+            f"assert main([{SECTION5!r}, '--out', {out!r}, '--duration', '1', '--dt', '0.01', "
+            "'--no-plots', '--quiet']) == 0")
+    assert loaded_by(code) == '[]'
+    assert Trajectory.load(os.path.join(out, sim.TRAJECTORY_FILE)).q.shape == (101, 10, 2)
+
+
 def test_the_command_gives_the_numbers_of_the_library_call(tmp_path):
     """The lazily importing command and an in-process run (scipy loaded first) agree exactly."""
     out = tmp_path / 'cli'

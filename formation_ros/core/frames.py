@@ -44,7 +44,9 @@ class FrameSample:
     The reference at one time.
 
     t: time in s; q_od: (dim,) centre of the formation, m; qdot_od: (dim,) its velocity, m/s;
-    J: (dim, dim) rotation world -> formation frame; Jdot: (dim, dim) its time derivative, 1/s.
+    J: (dim, dim) rotation world -> formation frame; Jdot: (dim, dim) its time derivative, 1/s;
+    still: True when J = I, Jdot = 0 and qdot_od = 0 (:func:`stationary_frame`), so that eqs.
+    (21) and (25) are a translation and the identity, computed as such.
     """
 
     t: float
@@ -52,12 +54,13 @@ class FrameSample:
     qdot_od: NDArray[np.float64]
     J: NDArray[np.float64]
     Jdot: NDArray[np.float64]
+    still: bool = False
 
 
 def stationary_frame(dim: int, origin: Optional[ArrayLike] = None, t: float = 0.0) -> FrameSample:
     """Frame of a fixed reference at ``origin`` (default 0): J = I, Jdot = 0."""
     q_od = np.zeros(dim) if origin is None else np.asarray(origin, dtype=float).copy()
-    return FrameSample(float(t), q_od, np.zeros(dim), np.eye(dim), np.zeros((dim, dim)))
+    return FrameSample(float(t), q_od, np.zeros(dim), np.eye(dim), np.zeros((dim, dim)), True)
 
 
 def to_frame(q: ArrayLike, frame: Optional[FrameSample]) -> NDArray[np.float64]:
@@ -65,6 +68,8 @@ def to_frame(q: ArrayLike, frame: Optional[FrameSample]) -> NDArray[np.float64]:
     q = np.asarray(q, dtype=float)
     if frame is None:
         return q.copy()
+    if frame.still:
+        return q - frame.q_od
     return (q - frame.q_od) @ frame.J.T
 
 
@@ -87,6 +92,8 @@ def from_frame_velocity(u_hat: ArrayLike, q: ArrayLike,
     u_hat = np.asarray(u_hat, dtype=float)
     if frame is None:
         return u_hat.copy()
+    if frame.still:
+        return u_hat + frame.qdot_od
     offset = np.asarray(q, dtype=float) - frame.q_od
     return frame.qdot_od + (u_hat - offset @ frame.Jdot.T) @ frame.J
 

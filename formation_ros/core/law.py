@@ -22,6 +22,7 @@ from formation_ros.core.choice import Choice
 from formation_ros.core.frames import (FrameSample, from_frame_velocity, STATIONARY, to_frame,
                                        to_frame_vectors)
 from formation_ros.core.jump import JumpFunction, JumpKind, make_jump
+from formation_ros.core.pairs import pairs_within, row_differences, sorted_pairs, squared_norms
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -231,15 +232,14 @@ def neighbour_pairs(q: ArrayLike, radius: float,
     """
     Pairs (i, j), i < j, with ||q_i - q_j|| <= radius, from a k-d tree: (P, 2) int array.
 
-    tree: a k-d tree of ``q`` already built (the plant model keeps one per step), else one is
-    built here (scipy.spatial is imported then: a robot, which never calls this, does not load
-    it).
+    Sorted by i, then j, whatever the search: the law sums each robot's terms in this order, so
+    any search that finds the same pairs gives the same numbers. tree: a k-d tree of ``q``
+    already built (e.g. the plant model's), else the grid of ``core.pairs`` searches.
     """
     if tree is None:
-        from scipy.spatial import cKDTree
-        tree = cKDTree(np.asarray(q, dtype=float))
-    pairs: NDArray[np.intp] = tree.query_pairs(r=radius, output_type='ndarray').reshape(-1, 2)
-    return pairs
+        return pairs_within(q, radius)
+    found = tree.query_pairs(r=radius, output_type='ndarray').reshape(-1, 2)
+    return sorted_pairs(found[:, 0], found[:, 1], int(tree.n))
 
 
 def team_command(q: ArrayLike, vertices: ArrayLike, sensing_radii: ArrayLike, law: LawParams,
@@ -265,8 +265,8 @@ def team_command(q: ArrayLike, vertices: ArrayLike, sensing_radii: ArrayLike, la
     if pairs is None:
         pairs = neighbour_pairs(q, law.repulsion_radius, tree)
     i, j = pairs[:, 0], pairs[:, 1]
-    q_hat_ij = q_hat[i] - q_hat[j]
-    d2 = np.einsum('kd,kd->k', q_hat_ij, q_hat_ij)
+    q_hat_ij = row_differences(q_hat, i, j)
+    d2 = squared_norms(q_hat_ij)
     terms = _repulsion_terms(q_hat_ij, d2, law)
     radii_sq = radii ** 2
     heard_by_i, heard_by_j = (_within(terms, d2, radii_sq[k]) for k in (i, j))

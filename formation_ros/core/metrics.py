@@ -12,6 +12,7 @@ import math
 from typing import Any, List, Mapping, Optional, Sequence
 
 from formation_ros.core.events import Event, segments
+from formation_ros.core.pairs import closest_pair
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.core.unicycle import command_bounds
 import numpy as np
@@ -19,6 +20,9 @@ from numpy.typing import ArrayLike, NDArray
 
 SETTLE_TOLERANCE = 0.05
 DIS_ALL_MAX_SAMPLES = 400
+DIS_ALL_BLOCK = 128
+DIS_MIN_GUESS = 1.5
+"""dis_min of a sample is searched first within this many times the sample's before."""
 DIS_ALL_MAX_ROBOTS = 2000
 
 
@@ -45,25 +49,39 @@ def settle_time(t: ArrayLike, errors: ArrayLike,
 
 
 def closest_pair_distance(points: ArrayLike) -> float:
-    """Smallest distance between two of the points (N, dim), by k-d tree; inf for N < 2."""
-    array = np.asarray(points, dtype=float)
-    if len(array) < 2:
-        return math.inf
-    from scipy.spatial import cKDTree  # here: importing formation_sim need not load scipy
-    dist, _ = cKDTree(array).query(array, k=2)
-    return float(np.min(dist[:, 1]))
+    """Smallest distance between two of the points (N, dim) (``core.pairs``); inf for N < 2."""
+    return closest_pair(points)[0]
 
 
 def dis_min_series(q: ArrayLike) -> NDArray[np.float64]:
     """dis_min of Section 5 at each sample: the closest pair distance, (T,) in m."""
-    return np.array([closest_pair_distance(sample) for sample in np.asarray(q)])
+    series = np.asarray(q, dtype=float)
+    distances = np.empty(len(series))
+    previous = 0.0
+    for k, sample in enumerate(series):
+        distances[k] = previous = closest_pair(sample, DIS_MIN_GUESS * previous)[0]
+    return distances
 
 
 def dis_all(points: ArrayLike) -> float:
-    """Return dis_all of Section 5, the geometric mean of ||q_ij|| (docs/equations.md, slip 7)."""
-    from scipy.spatial.distance import pdist
+    """
+    Return dis_all of Section 5, the geometric mean of ||q_ij|| (docs/equations.md, slip 7).
+
+    Over every pair i < j, log ||q_ij|| = log(||q_ij||**2) / 2, DIS_ALL_BLOCK rows of pairs at a
+    time (numpy only); NaN for N < 2.
+    """
+    q = np.asarray(points, dtype=float)
+    n = len(q)
+    if n < 2:
+        return math.nan
+    total = 0.0
     with np.errstate(divide='ignore'):
-        return float(np.exp(np.mean(np.log(pdist(np.asarray(points, dtype=float))))))
+        for first in range(0, n - 1, DIS_ALL_BLOCK):
+            rows = np.arange(first, min(first + DIS_ALL_BLOCK, n - 1))
+            diff = q[rows, None, :] - q[None, first + 1:, :]
+            later = np.arange(first + 1, n)[None, :] > rows[:, None]
+            total += 0.5 * float(np.sum(np.log(np.einsum('ikd,ikd->ik', diff, diff)[later])))
+    return float(np.exp(total / (0.5 * n * (n - 1))))
 
 
 def dis_all_series(t: ArrayLike,

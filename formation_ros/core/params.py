@@ -29,6 +29,7 @@ from formation_ros.core.dynamics import IDEAL, Imperfections
 from formation_ros.core.frames import desired_positions, from_frame_velocity
 from formation_ros.core.jump import JumpKind
 from formation_ros.core.law import LawParams, make_law, PSI_FUNCTIONS, PsiKind
+from formation_ros.core.pairs import closest_pair
 from formation_ros.core.params_file import load_params_file, PathText
 from formation_ros.core.plant import start_positions, StartSpec
 from formation_ros.core.reference import dimension_problem, PERIODIC, Reference
@@ -252,25 +253,10 @@ def _points(values: Mapping[str, Any], name: str, n: int, dim: int,
     return np.array(flat, dtype=float).reshape(n, dim)
 
 
-DIRECT_PAIRS = 1500
-"""Up to this many points the closest pair is found from every distance (no k-d tree: a robot
-process need not import scipy to check its parameters)."""
-
-
 def _closest_pair(points: NDArray[np.float64]) -> Tuple[float, int, int]:
-    """Return (distance, i, j) of the closest pair, 1-based i < j (first such pair in a tie)."""
-    if len(points) <= DIRECT_PAIRS:
-        diff = points[:, None, :] - points[None, :, :]
-        d2 = np.einsum('ijd,ijd->ij', diff, diff)
-        d2[np.tril_indices(len(points))] = np.inf
-        first, second = np.unravel_index(int(np.argmin(d2)), d2.shape)
-        i, j = int(first), int(second)
-    else:
-        from scipy.spatial import cKDTree
-        distance, index = cKDTree(points).query(points, k=2)
-        i = int(np.argmin(distance[:, 1]))
-        j = int(index[i, 1]) if int(index[i, 1]) != i else int(index[i, 0])
-    return math.dist(points[i], points[j]), min(i, j) + 1, max(i, j) + 1
+    """Return (distance, i, j) of the closest pair, 1-based i < j."""
+    distance, i, j = closest_pair(points)
+    return distance, i + 1, j + 1
 
 
 def _start(values: Mapping[str, Any], n: int, dim: int,

@@ -58,6 +58,7 @@ from formation_ros.core.bodies import Bodies, PointBodies
 from formation_ros.core.dynamics import IDEAL, Imperfections
 from formation_ros.core.frames import from_frame_velocity, to_frame_velocity
 from formation_ros.core.law import LawParams
+from formation_ros.core.pairs import pairs_within, row_differences, squared_norms
 from formation_ros.core.reference import Reference
 from formation_ros.core.sensing import neighbour_lists, sensed_pairs, sensor_radii
 from formation_ros.core.units import NS_PER_S
@@ -76,6 +77,11 @@ GRID_FROM = 64
 many, with the points of the neighbouring grid cells after."""
 PLANT_STATS_FILE = 'plant_stats.json'
 AGE_BINS = 64
+PAIR_SKIN = 0.25
+"""With ``pair_radius`` the model searches the pairs within (1 + PAIR_SKIN) times it and keeps
+them as candidates until some control point has moved half the difference since (a Verlet
+list): each step's pairs are the candidates within ``pair_radius``, the very pairs a search of
+its own would find, in the same order (``law.neighbour_pairs``), with fewer searches."""
 """Command ages counted step by step in :attr:`PlantCounts.age_steps` (one more bin: none)."""
 
 
@@ -360,6 +366,12 @@ def _row_max(values: NDArray[np.float64]) -> NDArray[np.float64]:
     return largest
 
 
+def _kd_tree(points: NDArray[np.float64]) -> 'cKDTree':
+    """Build a k-d tree of ``points`` (scipy loads here: formation_sim --dt needs none)."""
+    from scipy.spatial import cKDTree
+    return cKDTree(points)
+
+
 class PlantModel:
     """
     Every robot's body and range sensor, stepped with zero-order hold.
@@ -378,8 +390,8 @@ class PlantModel:
 
     Public state: ``q`` (N, dim) body positions, ``heading`` (N,), ``points`` (N, dim) the
     control points the law acts on, ``tree`` a k-d tree of ``points`` and ``body_tree`` one of
-    ``q`` (the same object for points), all true; ``velocity`` the bodies' velocity (None for
-    ideal bodies, whose velocity is their command).
+    ``q`` (the same object for points; both built when first asked for after a step), all true;
+    ``velocity`` the bodies' velocity (None for ideal bodies, whose velocity is their command).
     """
 
     def __init__(self, start: ArrayLike, sensing_radii: ArrayLike, step_ns: int,
@@ -405,13 +417,16 @@ class PlantModel:
         self.sensor_radii = sensor_radii(self.radii, self.body.sensing_margin)
         self.pair_radius = float(pair_radius)
         self.pairs: Optional[NDArray[np.intp]] = None
-        """(P, 2) pairs i < j of control points within ``pair_radius`` now (None without it)."""
+        """(P, 2) pairs i < j of control points within ``pair_radius`` now (None without it),
+        sorted by i, then j."""
+        self._candidates: Optional[NDArray[np.intp]] = None
+        self._searched_at: Optional[NDArray[np.float64]] = None
         self.max_speed = float(max_speed)
         self.bound_tolerance = (BOUND_TOLERANCE_FIXED if reference.is_stationary
                                 else BOUND_TOLERANCE_MOVING)
         self.t_ns = 0
-        from scipy.spatial import cKDTree  # here: a robot imports this module, not the tree
-        self._tree_type = cKDTree
+        self._tree: Optional['cKDTree'] = None
+        self._body_tree: Optional['cKDTree'] = None
         self._moved()
         self.counts = PlantCounts(status_steps=np.zeros((len(CommandStatus), self.num_robots),
                                                         dtype=np.int64))
@@ -447,10 +462,26 @@ class PlantModel:
         self._headings[self.t_ns] = self.heading
 
     def _moved(self) -> None:
-        """Update the control points and the k-d trees after the bodies moved."""
+        """Update the control points after the bodies moved; the k-d trees are built anew."""
         self.points = self.body.control_points(self.q, self.heading)
-        self.tree = self._tree_type(self.points)
-        self.body_tree = self.tree if self.points is self.q else self._tree_type(self.q)
+        self._tree = None
+        self._body_tree = None
+
+    @property
+    def tree(self) -> 'cKDTree':
+        """Return a k-d tree of the control points now."""
+        if self._tree is None:
+            self._tree = _kd_tree(self.points)
+        return self._tree
+
+    @property
+    def body_tree(self) -> 'cKDTree':
+        """Return a k-d tree of the body positions now (:attr:`tree` itself for points)."""
+        if self.points is self.q:
+            return self.tree
+        if self._body_tree is None:
+            self._body_tree = _kd_tree(self.q)
+        return self._body_tree
 
     @property
     def t(self) -> float:
@@ -608,15 +639,19 @@ class PlantModel:
         counts.collisions += len(collisions)
         return StepReport(t_ns, q, admission, violations, collisions, points, heading, velocity)
 
-    def sensed(self) -> SensedState:
+    def sensed(self, trees: bool = True) -> SensedState:
         """
         Return what the robots receive now: the state measured ``delay_steps`` steps ago.
 
         Its stamp is when it was measured (0, the start, while the delay has not passed); its
         positions carry that state's noise. Ideal sensing: the present state itself, with the
-        model's trees and pairs.
+        model's pairs and, unless ``trees`` is False (a caller that needs only the pairs), its
+        trees.
         """
         if self._positions is None:
+            if not trees:
+                return SensedState(self.t_ns, self.q, self.heading, self.points,
+                                   pairs=self.pairs)
             return SensedState(self.t_ns, self.q, self.heading, self.points, self.tree,
                                self.body_tree, self.pairs)
         stamp = max(self.t_ns - self.delay_steps * self.step_ns, 0)
@@ -662,17 +697,30 @@ class PlantModel:
         contact distance.
         """
         if self.pair_radius > 0.0:
-            self.pairs = self.tree.query_pairs(self.pair_radius,
-                                               output_type='ndarray').reshape(-1, 2)
-        if (self.pairs is not None and self.body_tree is self.tree
+            self.pairs, d2 = self._pairs_within_radius()
+        if (self.pairs is not None and self.points is self.q
                 and self.pair_radius >= self.contact_distance):
-            diff = self.q[self.pairs[:, 0]] - self.q[self.pairs[:, 1]]
-            close = self.pairs[np.einsum('kd,kd->k', diff, diff)
-                               <= self.contact_distance ** 2].tolist()
+            close = np.compress(d2 <= self.contact_distance ** 2, self.pairs, axis=0).tolist()
         else:
             close = self.body_tree.query_pairs(self.contact_distance,
                                                output_type='ndarray').tolist()
         return {(int(i), int(j)) for i, j in close}
+
+    def _pairs_within_radius(self) -> Tuple[NDArray[np.intp], NDArray[np.float64]]:
+        """Return the pairs of control points within ``pair_radius`` now, and their d**2."""
+        skin = PAIR_SKIN * self.pair_radius
+        points = self.points
+        if self._searched_at is not None:
+            moved = points - self._searched_at
+            if not float(np.max(np.einsum('kd,kd->k', moved, moved))) <= (0.5 * skin) ** 2:
+                self._candidates = None
+        if self._candidates is None:
+            self._candidates = pairs_within(points, self.pair_radius + skin)
+            self._searched_at = points.copy()
+        candidates = self._candidates
+        d2 = squared_norms(row_differences(points, candidates[:, 0], candidates[:, 1]))
+        within = d2 <= self.pair_radius ** 2
+        return np.compress(within, candidates, axis=0), d2[within]
 
     def _new_collisions(self) -> List[Tuple[int, int, float]]:
         pairs = self._close_pairs()

@@ -354,7 +354,7 @@ def run_fixed_step(config: FormationConfig, duration: float, dt: float, sample_d
     times, states, applied, frames, headings, q_body, held = [], [], [], [], [], [], []
     for k in range(steps + 1):
         frame = reference.sample(model.t)
-        sensed = model.sensed()
+        sensed = model.sensed(trees=False)
         seen_frame = (frame if sensed.stamp_ns == model.t_ns
                       else reference.sample(sensed.stamp_ns / NS_PER_S))
         u = team_command(sensed.points, shapes.at(sensed.stamp_ns).vertices,
