@@ -6,9 +6,11 @@ Run one node as a process: rclpy start-up, spinning, and a clean stop on SIGINT 
 
 Signals are handled in Python (rclpy's own handlers would invalidate the context before the
 node could log its summary): the handler only records the signal, and the spin loop, which
-wakes at least every :data:`SIGNAL_LATENCY` s even when no timer fires (a sim-time timer whose
-/clock stopped), ends between two callbacks. Then the node's ``finish()`` (if it has one) runs
-while ROS is still up, the node is destroyed and rclpy shut down.
+hands the executor slices of :data:`SIGNAL_LATENCY` s (one call per slice, however many
+callbacks run in it: a call per callback was a tenth of a robot process's time) and so looks
+at least that often even when no timer fires (a sim-time timer whose /clock stopped), ends
+after the slice it came in. Then the node's ``finish()`` (if it has one) runs while ROS is
+still up, the node is destroyed and rclpy shut down.
 
 A node started by the launcher also watches the launcher (:class:`LauncherWatch`): the launcher
 puts its process id and start time into the environment (``formation_ros.ros.watch``, its
@@ -39,6 +41,7 @@ import rclpy
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
+from rclpy.task import Future
 
 SIGNAL_LATENCY = 0.1
 TEARDOWN_LIMIT = 5.0
@@ -62,7 +65,7 @@ def make_executor() -> Executor:
 
 
 class _StopRequest:
-    """Set by the SIGINT/SIGTERM handler; the spin loop checks it between callbacks."""
+    """Set by the SIGINT/SIGTERM handler; the spin loop checks it between slices."""
 
     signal_name: Optional[str] = None
 
@@ -232,6 +235,7 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
         for node in nodes:
             executor.add_node(node)
         requests = _ExitRequests(nodes)
+        never = Future()
         gc.collect()
         gc.freeze()
         while rclpy.ok() and _StopRequest.signal_name is None:
@@ -239,7 +243,7 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
             if requested is not None:
                 code = requested
                 break
-            executor.spin_once(timeout_sec=SIGNAL_LATENCY)
+            executor.spin_until_future_complete(never, timeout_sec=SIGNAL_LATENCY)
             if launcher is not None and launcher.gone():
                 nodes[0].get_logger().warning(
                     f'the launcher (process {launcher.pid}) is gone; stopping')
