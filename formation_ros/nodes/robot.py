@@ -17,8 +17,9 @@ callbacks store them and arm a one-shot timer (``formation_ros.ros.wake``) that 
 publishes; a pose whose neighbours are lost is answered one period of ``control_rate`` after
 it. The watchdog, another one-shot timer, looks when the oldest input is due to turn stale
 (states arriving keep it away: no wake-up per state) and then publishes zero at
-``control_rate`` while the inputs stay stale. The command is stamped with the stamp of the state it was
-computed from, so the plant can tell how old it is (and, in lockstep, which state it answers).
+``control_rate`` while the inputs stay stale. The command is stamped with the stamp of the
+state it was computed from, so the plant can tell how old it is (and, in lockstep, which state
+it answers).
 Every input is read from its serialized bytes and the command written as bytes
 (``formation_ros.ros.cdr``): rclpy's own conversions were most of a robot's time.
 
