@@ -289,8 +289,9 @@ DECLARATIONS = (
     Param('robot_id', Kind.INT, REQUIRED, 'This robot: 1..num_robots (robot node only).',
           low=at_least(1), users=frozenset({Exe.ROBOT})),
     Param('control_rate', Kind.DOUBLE, 50.0,
-          'Rate of the robot watchdog timer, Hz (wall clock): zero when an input is stale, '
-          'answers a state whose neighbours were lost (states are answered as they arrive).',
+          'Rate of the robot watchdog, Hz (wall clock): it publishes zero at this rate while '
+          'an input is stale, and answers a pose whose neighbours were lost one period after '
+          'it (states are answered as they arrive).',
           low=above(0.0), high=at_least(10000.0), users=ROBOT),
     Param('input_timeout', Kind.DOUBLE, 0.5,
           'A robot publishes zero when no new pose, neighbours or reference arrived for this '

@@ -14,9 +14,12 @@ one per robot, each in its namespace::
 
 A robot answers each state as soon as its pose and neighbours (same stamp) are both in: the
 callbacks store them and arm a one-shot timer (``formation_ros.ros.wake``) that computes and
-publishes. A timer at ``control_rate`` is the watchdog (zero when an input is stale) and answers
-a state whose neighbours were lost. The command is stamped with the stamp of the state it was
-computed from, so the plant can tell how old it is (and, in lockstep, which state it answers).
+publishes; a pose whose neighbours are lost is answered one period of ``control_rate`` after
+it. The watchdog, another one-shot timer, looks when the oldest input is due to turn stale
+(states arriving keep it away: no wake-up per state) and then publishes zero at
+``control_rate`` while the inputs stay stale. The command is stamped with the stamp of the
+state it was computed from, so the plant can tell how old it is (and, in lockstep, which state
+it answers).
 Every input is read from its serialized bytes and the command written as bytes
 (``formation_ros.ros.cdr``): rclpy's own conversions were most of a robot's time.
 
@@ -109,6 +112,8 @@ COPY_GAP_NS = 25_000_000
 a fast copy (the plant sends a state again 0.05 s after the last while it waits, and once more
 when it starts its clock); more than FAST_COPIES of them in a row count as flooding."""
 FAST_COPIES = 3
+STALE_MARGIN_NS = 1_000_000
+"""How long after the oldest input is due to turn stale the watchdog looks, ns."""
 LISTENERS_PERIOD = 0.5
 """Team transport: seconds between looks at who subscribes to each robot's cmd_vel."""
 TEAM_VALUES = ('num_robots', 'dim', 'world_frame', 'repulsion_radius', 'controller.gain',
@@ -219,9 +224,12 @@ class RobotNode(Node):
         self.diagnostics_timer = self.create_timer(PERIOD, self.on_diagnostics,
                                                    clock=self.steady)
         self.answer = Wake(self, self.on_state, self.steady)
+        self.watch_period_ns = max(1, int(round(NS_PER_S / settings.control_rate)))
+        self.awaiting_neighbours = False
+        self.watchdog: Optional[Wake] = None
         if not self.lockstep:
-            self.timer = self.create_timer(1.0 / settings.control_rate, self.on_timer,
-                                           clock=self.steady)
+            self.watchdog = Wake(self, self.on_timer, self.steady)
+            self.watchdog.arm(self.watch_period_ns / NS_PER_S)
         self.get_logger().info(
             f'robot {self.index + 1}/{config.num_robots}: vertex {np.round(self.vertex, 4)}, '
             f'R_i = {self.sensing_radius:g} m, b = {config.repulsion_radius:g} m, '
@@ -332,7 +340,12 @@ class RobotNode(Node):
             self.pose = pose
             self.pose_count += 1
             self.received_ns['pose'] = self._now_ns()
-            self.answer.arm()
+            if self._paired():
+                self.awaiting_neighbours = False
+                self.answer.arm()
+            elif not self.lockstep:
+                self.awaiting_neighbours = True
+                self.answer.arm(self.watch_period_ns / NS_PER_S)
 
     def _read_neighbours(self, data: bytes) -> PoseArrayData:
         return read_pose_array(data, self.num_robots - 1)
@@ -348,7 +361,14 @@ class RobotNode(Node):
         if self._check('neighbour', heard.frame_id, heard.stamp_ns, finite, oriented):
             self.neighbours = heard
             self.received_ns['neighbour'] = self._now_ns()
-            self.answer.arm()
+            if self._paired():
+                self.awaiting_neighbours = False
+                self.answer.arm()
+
+    def _paired(self) -> bool:
+        """Whether the pose and the neighbours stored are of one state (same stamp)."""
+        return (self.pose is not None and self.neighbours is not None
+                and self.neighbours.stamp_ns == self.pose.stamp_ns)
 
     def on_reference(self, data: bytes) -> None:
         """Store a reference sample (a few are kept to match state stamps in lockstep)."""
@@ -521,7 +541,9 @@ class RobotNode(Node):
         Answer a state as soon as its pose and neighbours are both in (armed by the callbacks).
 
         In lockstep the reference sample of the state's stamp is needed too; otherwise the
-        newest sample is carried forward to the state's time.
+        newest sample is carried forward to the state's time. A pose whose neighbours have not
+        arrived one watchdog period (``control_rate``) after it (best effort: lost) is answered
+        then with the latest neighbours.
         """
         if self.member_of is not None and self.team is None:
             return
@@ -529,19 +551,36 @@ class RobotNode(Node):
             self.team.take()
         if self.lockstep:
             self._lockstep_answer()
-        elif (self.pose is not None and self.neighbours is not None
-              and self.neighbours.stamp_ns == self.pose.stamp_ns):
+        elif self._paired() or (self.awaiting_neighbours and self.neighbours is not None):
+            self.awaiting_neighbours = False
             self._answer_newest()
 
     def on_timer(self) -> None:
         """
-        Watchdog at ``control_rate``: zero when an input is stale, else answer a state left over.
+        Watchdog: zero when an input is stale, else answer a state left over; then re-armed.
 
-        A state whose neighbours did not arrive (best effort) is answered here with the latest
-        neighbours; a tick that finds no new pose since the last answer publishes nothing: the
-        plant holds the last command until it is ``plant.input_timeout`` old.
+        A one-shot timer, not a free-running one: it looks again one period of
+        ``control_rate`` on while the robot waits for its first inputs, while its inputs are
+        stale (it publishes zero at that rate) and while a state is left unanswered, else
+        only when the oldest input is due to turn stale (states arriving keep it away). A look
+        that finds no new pose since the last answer publishes nothing: the plant holds the
+        last command until it is ``plant.input_timeout`` old.
         """
+        if self.member_of is not None and self.team is None:
+            return
         self._answer_newest()
+        self._arm_watchdog()
+
+    def _arm_watchdog(self) -> None:
+        """Arm the watchdog for its next look (see :meth:`on_timer`)."""
+        if self.watchdog is None:
+            return
+        delay_ns = self.watch_period_ns
+        if not (self.waiting or self.once.is_active('stale')
+                or self.pose_count != self.answered_count):
+            oldest = min(ns for ns in self.received_ns.values() if ns is not None)
+            delay_ns = max(delay_ns, oldest + self.timeout_ns + STALE_MARGIN_NS - self._now_ns())
+        self.watchdog.arm(delay_ns / NS_PER_S)
 
     def _answer_newest(self) -> None:
         """Answer the newest state once: compute and publish its command (zero if stale)."""
@@ -560,6 +599,8 @@ class RobotNode(Node):
             return
         stamp = self.pose.stamp_ns
         if not self._may_answer(stamp):
+            if self.pose_count != self.answered_count:
+                self._arm_watchdog()
             return
         self._publish_command(self._command(stamp, False), stamp)
         self.answered_count = self.pose_count
