@@ -833,9 +833,6 @@ class TeamLink:
         """The cmd_vel messages that went with the latest team command, by robot."""
         for node in self.nodes:
             node.member_of = self
-            timer = getattr(node, 'timer', None)
-            if node is not leader and timer is not None:
-                node.destroy_timer(timer)
         leader.team = self
         self.clock = StateClock(self.nodes)
         self.pub = leader.create_publisher(MultiDOFJointTrajectory, topics.TEAM_COMMANDS,
