@@ -45,7 +45,8 @@ ROOT = os.path.dirname(DOCS)
 LOG = logging.getLogger(__name__)
 ROBOT_PLACEHOLDER = '/robot_<i>'
 BENCH_FILES = {
-    'capacity': ('capacity_process.json', 'capacity_fleet.json', 'capacity_lockstep.json'),
+    'capacity': ('capacity_process.json', 'capacity_fleet.json', 'capacity_lockstep.json',
+                 'capacity_transports.json', 'capacity_lockstep_transports.json'),
     'offline': ('offline.json',),
     'robustness': ('robustness.json',),
     'switch': ('switch.json',),
