@@ -5,12 +5,10 @@
 Run one node as a process: rclpy start-up, spinning, and a clean stop on SIGINT or SIGTERM.
 
 Signals are handled in Python (rclpy's own handlers would invalidate the context before the
-node could log its summary): the handler records the signal and ends the spin loop after the
-callback it came in (:class:`_StopRequest`). The loop hands the executor slices of
-:data:`SIGNAL_LATENCY` s (one call per slice, however many callbacks run in it: a call per
-callback was about a tenth of a robot process's time) and so looks at least that often even
-when no timer fires (a sim-time timer whose /clock stopped). Then the node's ``finish()`` (if
-it has one) runs while ROS is still up, the node is destroyed and rclpy shut down.
+node could log its summary): the handler only records the signal, and the spin loop, which
+wakes at least every :data:`SIGNAL_LATENCY` s even when no timer fires (a sim-time timer whose
+/clock stopped), ends between two callbacks. Then the node's ``finish()`` (if it has one) runs
+while ROS is still up, the node is destroyed and rclpy shut down.
 
 A node started by the launcher also watches the launcher (:class:`LauncherWatch`): the launcher
 puts its process id and start time into the environment (``formation_ros.ros.watch``, its
@@ -41,7 +39,6 @@ import rclpy
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
-from rclpy.task import Future
 
 SIGNAL_LATENCY = 0.1
 TEARDOWN_LIMIT = 5.0
@@ -65,21 +62,13 @@ def make_executor() -> Executor:
 
 
 class _StopRequest:
-    """
-    Set by the SIGINT/SIGTERM handler, which also completes ``future``: the spin slice ends.
-
-    The handler runs in the main thread at the next Python callback (or when the slice ends),
-    so the executor stops after that callback, as it did with one ``spin_once`` per callback.
-    """
+    """Set by the SIGINT/SIGTERM handler; the spin loop checks it between callbacks."""
 
     signal_name: Optional[str] = None
-    future: Optional[Future] = None
 
     @classmethod
     def handler(cls, signum: int, frame: Any) -> None:
         cls.signal_name = signal.Signals(signum).name
-        if cls.future is not None and not cls.future.done():
-            cls.future.set_result(None)
 
 
 class LauncherWatch:
@@ -243,7 +232,6 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
         for node in nodes:
             executor.add_node(node)
         requests = _ExitRequests(nodes)
-        stop = _StopRequest.future = Future()
         gc.collect()
         gc.freeze()
         while rclpy.ok() and _StopRequest.signal_name is None:
@@ -251,7 +239,7 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
             if requested is not None:
                 code = requested
                 break
-            executor.spin_until_future_complete(stop, timeout_sec=SIGNAL_LATENCY)
+            executor.spin_once(timeout_sec=SIGNAL_LATENCY)
             if launcher is not None and launcher.gone():
                 nodes[0].get_logger().warning(
                     f'the launcher (process {launcher.pid}) is gone; stopping')
