@@ -221,12 +221,16 @@ class PlantCounts:
     k - 1); the last bin the steps at which some robot's command was older than AGE_BINS - 1
     steps or did not count at all (missing, stale, future, non-finite)."""
 
+    def fresh_steps(self, max_age_steps: int) -> int:
+        """Return the steps at which every robot's command answered a state <= that old."""
+        kept = int(np.clip(max_age_steps, -1, AGE_BINS - 1))
+        return int(self.age_steps[:kept + 1].sum())
+
     def fresh_fraction(self, max_age_steps: int) -> float:
         """Fraction of steps at which every robot's command answered a state <= that old."""
         if self.steps == 0:
             return 0.0
-        kept = int(np.clip(max_age_steps, -1, AGE_BINS - 1))
-        return float(self.age_steps[:kept + 1].sum()) / self.steps
+        return self.fresh_steps(max_age_steps) / self.steps
 
     def steps_with(self, status: CommandStatus) -> int:
         """Robot-steps whose command had ``status`` (e.g. STALE), summed over robots."""

@@ -90,6 +90,7 @@ from formation_ros.ros.wake import Wake
 from geometry_msgs.msg import PoseArray, PoseStamped, Twist, TwistStamped
 import numpy as np
 from rclpy.clock import Clock, ClockType
+from rclpy.duration import Duration
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock as ClockMsg
 from trajectory_msgs.msg import MultiDOFJointTrajectory
@@ -116,6 +117,11 @@ LOOK_LIMIT = 5.0
 /diagnostics before refusing without it, s."""
 LOOK_PERIOD = 0.5
 """Seconds between looks at the graph while the clock waits for the robots."""
+REFUSAL_HEARD = 2.0
+"""How long a refusing plant waits for its last status to be acknowledged, s."""
+FRESH_PERIODS = 2
+"""A command is fresh (diagnostics' ``steps with fresh commands``) while the state it answers
+is at most this many state periods old (as bench_capacity's fresh share)."""
 LISTENERS_PERIOD = 0.5
 """Team transport: seconds between looks at who subscribes to each robot's pose and neighbors
 (published only while someone does)."""
@@ -448,6 +454,21 @@ class PlantNode(Node):
         self.get_logger().error(self.refusal)
         self.exit_code = REFUSED
 
+    def _announce_refusal(self) -> None:
+        """
+        Publish this plant's refusal as its last status, and wait a moment for it to be heard.
+
+        The other plant names this one from its status; one that refuses within its first
+        seconds may not have sent a status the other has heard yet (discovery on a busy
+        machine), so the last one is waited for (reliable: acknowledged, at most
+        REFUSAL_HEARD s).
+        """
+        shape = self._vertices_at(self.model.t_ns)
+        self.diagnostics_pub.publish(diagnostics(
+            PLANT_STATUS, 'error', self.refusal,
+            announced(team_values(self.config, shape), self)))
+        self.diagnostics_pub.wait_for_all_acked(Duration(seconds=REFUSAL_HEARD))
+
     def _looked(self) -> bool:
         self.looked = True
         self.destroy_subscription(self.clock_sub)
@@ -610,7 +631,9 @@ class PlantNode(Node):
                   **({'min body distance [m]': self.model.closest_body_distance()}
                      if self.unicycles else {}),
                   'bound c*M1 [m/s]': self.law.u_bound,
-                  'oldest command counted [s]': counts.oldest_counted_ns / NS_PER_S}
+                  'oldest command counted [s]': counts.oldest_counted_ns / NS_PER_S,
+                  'steps with fresh commands': counts.fresh_steps(
+                      FRESH_PERIODS * self.publish_every)}
         values.update({name.replace('_', ' '): count for name, count in counts.totals().items()})
         if np.any(self.wrong_frame):
             values['robots with cmd_vel in a frame other than their command frame'] = ', '.join(
@@ -785,6 +808,7 @@ class PlantNode(Node):
     def finish(self) -> None:
         """Log a summary of the run; with ``plant.output_dir`` write trajectory and counters."""
         if self.refusal:
+            self._announce_refusal()
             return
         if self.started_wall is None or self.model.counts.steps == 0:
             self.get_logger().info('plant: stopped before the first step')

@@ -15,7 +15,7 @@ import subprocess
 
 from formation_ros.core.params import load_config
 from formation_ros.core.trajectory import Trajectory
-from formation_ros.ros import qos
+from formation_ros.ros import fields, qos
 from geometry_msgs.msg import PoseStamped, TwistStamped
 from helpers import exe, launch, SimClock, stop_when, TWICE_REAL_TIME, write_params
 import numpy as np
@@ -81,6 +81,15 @@ class Poses:
         return float(np.max(np.linalg.norm(q - np.reshape(vertices, (4, 2)), axis=1)))
 
 
+def all_zero(commands):
+    """Tell whether each of the four robots' latest command among (robot, stamp, x, y) is 0."""
+    latest = {}
+    for robot, stamp, x, y in commands:
+        if stamp >= latest.get(robot, (-1, None))[0]:
+            latest[robot] = (stamp, (x, y))
+    return len(latest) == 4 and all(u == (0.0, 0.0) for _, u in latest.values())
+
+
 def test_shapes_switch_and_the_team_stops_and_goes(processes, install, probe, tmp_path):
     params = write_params(tmp_path, 'square_4.yaml', {**SHAPES, **TWICE_REAL_TIME})
     config = load_config(params, 'plant')
@@ -90,7 +99,8 @@ def test_shapes_switch_and_the_team_stops_and_goes(processes, install, probe, tm
     for i in range(1, 5):
         probe.create_subscription(
             TwistStamped, f'/robot_{i}/cmd_vel', lambda m, i=i: commands.append(
-                (i, clock.seconds, m.twist.linear.x, m.twist.linear.y)), qos.COMMAND)
+                (i, fields.stamp_to_ns(m.header.stamp), m.twist.linear.x, m.twist.linear.y)),
+            qos.COMMAND)
     parameters = probe.create_client(SetParameters, '/reference/set_parameters')
     stop = probe.create_client(Trigger, '/formation/stop')
     start = probe.create_client(Trigger, '/formation/start')
@@ -117,14 +127,19 @@ def test_shapes_switch_and_the_team_stops_and_goes(processes, install, probe, tm
     assert set_parameter(probe, parameters, 'formation.name', 'line').successful
     moving_from = clock.seconds
     assert probe.spin_until(lambda: clock.seconds > moving_from + 0.3, 30)
+    before = len(commands)
     response = call(probe, stop, Trigger.Request())
     assert response.success and 'team stopped' in response.message
-    stopped_at = clock.seconds
-    assert probe.spin_until(lambda: clock.seconds > stopped_at + 0.2, 30)
+    # Each robot hears the stop on /formation/status after its own delay: wait until every
+    # robot's latest command is zero, then for the poses in flight.
+    assert probe.spin_until(lambda: all_zero(commands[before:]), 30), commands[-8:]
+    holding = clock.seconds
+    assert probe.spin_until(lambda: clock.seconds > holding + 0.2, 30)
     held = dict(poses.latest)
-    assert probe.spin_until(lambda: clock.seconds > stopped_at + 2.0, 30)
-    late = [(x, y) for _, t, x, y in commands if t > stopped_at + 0.1]
-    assert late and all(x == 0.0 and y == 0.0 for x, y in late), late[:5]
+    assert probe.spin_until(lambda: clock.seconds > holding + 2.0, 30)
+    late = [(i, x, y) for i, stamp, x, y in commands if stamp >= holding * 1e9]
+    assert {i for i, _, _ in late} == {1, 2, 3, 4}
+    assert all(x == 0.0 and y == 0.0 for _, x, y in late), late[:5]
     drift = max(np.hypot(poses.latest[i][0] - held[i][0], poses.latest[i][1] - held[i][1])
                 for i in held)
     assert drift < 1e-9, drift

@@ -193,9 +193,18 @@ def stamp_of(message):
     return message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
 
 
-def between(stamps, first, last):
-    """Return how many of ``stamps`` lie in [first, last]."""
-    return sum(first <= stamp <= last for stamp in stamps)
+def delivered(arrived, sent, first, last):
+    """
+    Return the share of the stamps sent in [first, last] that arrived.
+
+    A stamp counts as sent when the sender's side heard it or the far side did: a listener on
+    the sender's host is itself a subscriber on a busy machine and may miss a sample that still
+    crossed the link, so the far side's stamps complete the count instead of pushing the share
+    past one.
+    """
+    arrived = {stamp for stamp in arrived if first <= stamp <= last}
+    sent = {stamp for stamp in sent if first <= stamp <= last} | arrived
+    return len(arrived) / len(sent)
 
 
 def assert_completed(metrics, config_path):
@@ -246,8 +255,8 @@ def test_formation_converges_with_20_percent_loss_on_every_robot_link(net, insta
             arrived = [stamp_of(m) for _, m in topics[f'/robot_{i}/cmd_vel']]
             # From 2 s (every subscription has matched) to 0.5 s before the end (in flight).
             first, last = 2.0, min(heard[-1], published[-1], sent[-1], arrived[-1]) - 0.5
-            poses.append(between(heard, first, last) / between(sent, first, last))
-            commands.append(between(arrived, first, last) / between(published, first, last))
+            poses.append(delivered(heard, sent, first, last))
+            commands.append(delivered(arrived, published, first, last))
     print(f'delivered across a 20 % loss link: pose (best effort) {min(poses):.3f} to '
           f'{max(poses):.3f}, cmd_vel (reliable) {min(commands):.3f} to {max(commands):.3f}; '
           f"settle time {metrics['settle_time']} s")
@@ -265,7 +274,8 @@ def test_formation_converges_with_20_percent_loss_on_every_robot_link(net, insta
     # Delivered fractions are measured, not promised: a reliable keep-last-10 writer replaces a
     # lost command whose repair takes longer than ten newer ones (0.5 s at 20 Hz), so cmd_vel
     # may deliver fewer than the best-effort poses on a bad stretch (0.70 against 0.80 seen).
-    assert all(0.0 < share <= 1.05 for share in poses + commands), (poses, commands)
+    # The floor only says that most samples still cross: 0.57 is the lowest share seen.
+    assert all(0.3 < share for share in poses + commands), (poses, commands)
 
 
 def test_a_cut_robot_host_stops_and_rejoins(net, install, tmp_path):
