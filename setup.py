@@ -30,12 +30,12 @@ setup(
         'console_scripts': [
             'formation_sim = formation_ros.tools.sim:main',
             'formation_report = formation_ros.tools.report:main',
-            'robot = formation_ros.nodes.robot:main',
-            'plant = formation_ros.nodes.plant:main',
-            'reference = formation_ros.nodes.reference:main',
-            'record = formation_ros.nodes.recorder:main',
-            'fleet = formation_ros.nodes.fleet:main',
-            'relay = formation_ros.nodes.relay:main',
+            'robot = formation_ros.nodes.entry:robot',
+            'plant = formation_ros.nodes.entry:plant',
+            'reference = formation_ros.nodes.entry:reference',
+            'record = formation_ros.nodes.entry:record',
+            'fleet = formation_ros.nodes.entry:fleet',
+            'relay = formation_ros.nodes.entry:relay',
         ],
     },
 )

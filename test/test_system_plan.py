@@ -246,9 +246,7 @@ def test_the_lab_executables_are_console_scripts(lab_launch_file, named):
                for entry in setup_data['entry_points']['console_scripts']}
     executables = {node.kwargs['executable']
                    for node in launched_nodes(lab_launch_file, params_file=named)}
-    assert executables - scripts <= {'relay'}, executables - scripts
-    if 'relay' not in scripts:
-        pytest.xfail("no 'relay' console script yet: it comes with the relay branch")
+    assert executables <= scripts, executables - scripts
 
 
 @pytest.mark.faults

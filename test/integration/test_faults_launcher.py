@@ -219,3 +219,33 @@ def test_a_respawned_robot_rejoins_the_formation(processes, install, probe, tmp_
     metrics = json.loads((out / 'metrics.json').read_text())
     assert metrics['final_max_error'] < 0.05, metrics
     assert metrics['collisions'] == 0
+
+
+def mapped(pid, fragment):
+    """Tell whether process ``pid`` has a file whose path holds ``fragment`` mapped."""
+    try:
+        with open(f'/proc/{pid}/maps', encoding='utf-8') as stream:
+            return fragment in stream.read()
+    except OSError:
+        return False
+
+
+@pytest.mark.parametrize('sig', [signal.SIGINT, signal.SIGTERM])
+@pytest.mark.parametrize('name', ['robot', 'plant'])
+def test_a_node_stopped_while_it_still_loads_ends_quietly(install, name, sig):
+    """A Ctrl-C in a node's first second (numpy loaded, rclpy not yet) exits 0, no traceback."""
+    for _ in range(20):
+        process = subprocess.Popen([exe(install, name), '--ros-args', '--params-file', SQUARE],
+                                   stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        deadline = time.monotonic() + 60.0
+        while not mapped(process.pid, '_multiarray_umath') and process.poll() is None:
+            assert time.monotonic() < deadline, 'numpy never loaded'
+            time.sleep(0.002)
+        loading = not mapped(process.pid, '_rclpy_pybind11')
+        process.send_signal(sig)
+        out, _ = process.communicate(timeout=60)
+        assert process.returncode == 0, out
+        assert 'Traceback' not in out and 'KeyboardInterrupt' not in out, out
+        if loading:
+            return
+    pytest.fail('the signal never came while the node was loading')
