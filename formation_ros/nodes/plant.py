@@ -719,13 +719,18 @@ class PlantNode(Node):
         """
         Return {topic: its other publishers} of /clock and the robots' topics; log each once.
 
-        Only once the plant has looked (before, a second plant is the look's to refuse).
+        Only once the plant has looked, and /clock only once the clock runs: before, a second
+        /clock publisher is the look's to refuse (:meth:`_look_while_waiting`), in one line.
         A second publisher with the expected name runs for sure when it announces itself
         from another process, or (cmd_vel) when DDS liveliness counts two alive.
         """
-        if not self.looked:
+        if not self.looked or self.refusal:
             return {}
-        shared = self.graph.check(self.expected_publishers, now, self._alive)
+        expected = self.expected_publishers
+        if self.waiting:
+            expected = {topic: name for topic, name in expected.items()
+                        if topic != self.clock_pub.topic_name}
+        shared = self.graph.check(expected, now, self._alive)
         by_names: Dict[str, List[str]] = {}
         for topic, names in shared.items():
             by_names.setdefault(names, []).append(topic)

@@ -416,6 +416,7 @@ class Launch:
             if self.interrupted:
                 say(f'stopping ({self.interrupted})')
             self.stop()
+            self._note_recording_failed_at_stop()
             if self.failure is not None:
                 say(f'{self.failure}; stopped the others')
                 return 1
@@ -534,14 +535,24 @@ class Launch:
             self.failure = (f'the recorder could not begin to write {self.options.record} '
                             f'(exit code {RECORDING_FAILED}, see its line above)')
             return True
-        self.record_failure = ('the recording stopped early: the recorder could not write '
-                               f'{self.options.record}')
+        self.record_failure = self._recording_failure()
         said = f'{self.record_failure} (exit code {RECORDING_FAILED})'
         if self.options.on_record_failure == 'stop':
             say(f'{said}; stopping the others (--on-record-failure stop)')
             return True
         say(f'{said}; the others go on (--on-record-failure continue)')
         return False
+
+    def _note_recording_failed_at_stop(self) -> None:
+        """Say so, once, if the recorder could not write while the run was being stopped."""
+        if self.record_failure is not None or not any(
+                _recording_failed(info) for info in self.supervisor.exits()):
+            return
+        self.record_failure = self._recording_failure()
+        say(f'{self.record_failure} (exit code {RECORDING_FAILED}), as the run was stopping')
+
+    def _recording_failure(self) -> str:
+        return f'the recording stopped early: the recorder could not write {self.options.record}'
 
     def _wait_for_recorder(self) -> bool:
         """Wait until the recorder has created its bag directory; False if it did not."""

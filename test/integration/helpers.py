@@ -117,6 +117,13 @@ class Statuses(dict):
             self.heard[status.name] = self.heard.get(status.name, 0) + 1
 
 
+def plant_value(statuses, key, default=0):
+    """Return value ``key`` of the plant's latest status as a number (``default`` before any)."""
+    status = statuses.get('formation_ros/plant')
+    values = {kv.key: kv.value for kv in status.values} if status is not None else {}
+    return float(values.get(key, default))
+
+
 def said_once(probe, processes, name, text, statuses, status):
     """
     Wait until process ``name`` has logged ``text``, then for two more ``status`` reports.

@@ -14,8 +14,8 @@ from formation_ros.core.unicycle import (command_bounds, hand_points, headings_f
 from formation_ros.ros import fields, messages, qos
 from formation_ros.tools.sim import simulate
 from geometry_msgs.msg import Pose, PoseArray, PoseStamped, TwistStamped
-from helpers import (launch, node, SimClock, Statuses, stop_when, TWICE_REAL_TIME,
-                     write_params)
+from helpers import (launch, node, plant_value, SimClock, Statuses, stop_when,
+                     TWICE_REAL_TIME, write_params)
 from nav_msgs.msg import Odometry
 import numpy as np
 import pytest
@@ -113,14 +113,10 @@ def test_free_running_unicycles_move_towards_the_formation(processes, install, p
     out = tmp_path / 'free'
     launch(processes, install, params, out=out)
 
-    def fresh_steps():
-        status = statuses.get('formation_ros/plant')
-        values = {kv.key: kv.value for kv in status.values} if status is not None else {}
-        return int(values.get('steps with fresh commands', 0))
-
     # Free running, robots starved by a busy machine answer late or not at all: what is
     # claimed needs 8 s of steps with fresh commands (at 100 Hz), however long the run takes.
-    info = stop_when(probe, processes, lambda: fresh_steps() >= FRESH_STEPS, timeout=300)
+    info = stop_when(probe, processes, lambda: plant_value(
+        statuses, 'steps with fresh commands') >= FRESH_STEPS, timeout=300)
     assert info.returncode == 0, processes.log('launcher')
     check_body_frame_commands(commands, config)
     metrics = json.loads((out / 'metrics.json').read_text())
