@@ -18,7 +18,8 @@ from formation_ros.core.params import load_config
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.ros import qos
 from geometry_msgs.msg import PoseStamped, Twist
-from helpers import launch, logged, node, SimClock, stop_when, TWICE_REAL_TIME, write_params
+from helpers import (launch, logged, node, plant_value, Statuses, stop_when,
+                     TWICE_REAL_TIME, write_params)
 import numpy as np
 
 HEADINGS = [0.5, 2.0, -1.0, 3.0]
@@ -37,10 +38,11 @@ def test_points_taking_twists_in_their_own_frames_reach_the_formation(
                                   lambda m, i=i: commands.append((i, m.linear.x, m.linear.y)),
                                   qos.COMMAND)
     probe.create_subscription(PoseStamped, '/robot_2/pose', poses.append, qos.STATE_INPUT)
-    clock = SimClock(probe)
+    statuses = Statuses(probe)
     out, bag = tmp_path / 'out', tmp_path / 'bag'
     launch(processes, install, params, out=out, record=bag)
-    info = stop_when(probe, processes, lambda: clock.seconds >= 8.0 and len(commands) > 400)
+    info = stop_when(probe, processes, lambda: plant_value(
+        statuses, 'steps with fresh commands') >= 800 and len(commands) > 400, timeout=300)
     assert info.returncode == 0, processes.log('launcher')
 
     assert poses and all(pose.header.frame_id == 'map' for pose in poses)

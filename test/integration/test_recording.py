@@ -12,7 +12,8 @@ from formation_ros.ros import fields, qos
 from formation_ros.tools.bag import read_messages
 from formation_ros.tools.sim import simulate
 from geometry_msgs.msg import PoseArray, PoseStamped
-from helpers import launch, node, SimClock, SQUARE, stop_when, write_params
+from helpers import (launch, node, plant_value, SimClock, SQUARE, Statuses, stop_when,
+                     write_params)
 import numpy as np
 from visualization_msgs.msg import MarkerArray
 
@@ -21,10 +22,11 @@ def test_recorded_run_reads_back_and_agrees_with_the_plant(processes, install, p
                                                            tmp_path):
     markers = []
     probe.create_subscription(MarkerArray, '/formation/markers', markers.append, qos.MARKERS)
-    clock = SimClock(probe)
+    statuses = Statuses(probe)
     bag, out = tmp_path / 'bag', tmp_path / 'run'
     launch(processes, install, SQUARE, out=out, record=bag)
-    info = stop_when(probe, processes, lambda: clock.seconds >= 5.0 and bool(markers))
+    info = stop_when(probe, processes, lambda: plant_value(
+        statuses, 'steps with fresh commands') >= 500 and bool(markers), timeout=300)
     assert info.returncode == 0, processes.log('launcher')
     topics, counts = read_messages(str(bag))
     assert counts == {topic: len(messages) for topic, messages in topics.items()}
