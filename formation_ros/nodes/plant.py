@@ -403,7 +403,9 @@ class PlantNode(Node):
         waited = now - self.created_wall
         if waited < LOOK_TIME or self.refusal:
             return False
-        others = self._other_clock_publishers()
+        others = self._other_clock_publishers(now)
+        if others is None:
+            return False
         if not others:
             return self._looked()
         running = any(self.team.running(name, now) for name in others)
@@ -419,9 +421,15 @@ class PlantNode(Node):
         self._refuse(others, now)
         return False
 
-    def _other_clock_publishers(self) -> List[str]:
-        """Return the /clock publishers of the graph other than this node (one per writer)."""
-        others = self.graph.publishers(self.clock_pub.topic_name)
+    def _other_clock_publishers(self, now: float) -> Optional[List[str]]:
+        """
+        Return the /clock publishers of the graph other than this node (one per writer).
+
+        None while the graph has not named them all yet (at most ``ros.team.NAMES_WAIT`` s).
+        """
+        others = self.graph.named_publishers(self.clock_pub.topic_name, now)
+        if others is None:
+            return None
         if self.own_name in others:
             others.remove(self.own_name)
         return others
@@ -438,8 +446,9 @@ class PlantNode(Node):
         if now < self.next_look or self.refusal:
             return
         self.next_look = now + LOOK_PERIOD
-        others = self._other_clock_publishers()
-        if any(name != self.own_name or self.team.running(name, now) for name in others):
+        others = self._other_clock_publishers(now)
+        if others is not None and any(name != self.own_name or self.team.running(name, now)
+                                      for name in others):
             self._refuse(others, now)
 
     def _refuse(self, others: List[str], now: float) -> None:

@@ -258,13 +258,14 @@ class RobotNode(Node):
         """Steady time, ns: the clock of the timers (CLOCK_MONOTONIC), read without rclpy."""
         return time.monotonic_ns()
 
-    def _reject(self, name: str, reason: Reason, detail: str = '') -> bool:
-        """Count and (once per input and reason) log a message ignored; return False."""
+    def _reject(self, name: str, reason: Reason, detail: str = '', log: bool = True) -> bool:
+        """Count and (once per input and reason; not yet without ``log``) log a message ignored."""
         key = (name, reason)
         self.rejected[key] = self.rejected.get(key, 0) + 1
-        self.once.start(f'{name}-{reason.name}', f'ignoring {name} messages with '
-                                                 f'{reason.value}{detail} (logged once; '
-                                                 'diagnostics count them)', 'error')
+        if log:
+            self.once.start(f'{name}-{reason.name}', f'ignoring {name} messages with '
+                                                     f'{reason.value}{detail} (logged once; '
+                                                     'diagnostics count them)', 'error')
         return False
 
     def _clock_gap_s(self, stamp_ns: int) -> float:
@@ -291,21 +292,27 @@ class RobotNode(Node):
             clock = 'simulated' if self.sim_time else 'wall-clock'
             advice = self._clock_advice(name, 'the robots and the reference')
             return self._reject(name, Reason.CLOCK, f' ({gap:+.3g} s from the {clock} time '
-                                                    f'of this node: {advice})')
+                                                    f'of this node: {advice})',
+                                log=advice is not None)
         self.once.end(f'{name}-{Reason.CLOCK.name}', f'{name} messages on this clock again')
         return True
 
-    def _clock_advice(self, name: str, nodes: str) -> str:
+    def _clock_advice(self, name: str, nodes: str) -> Optional[str]:
         """
         Say what to do about stamps from another clock: the graph's answer, else use_sim_time.
 
         Two publishers of /clock or of the reference are two teams on one domain (looked up
-        here only when the refusal is about to be logged).
+        here only when the refusal is about to be logged). None while the graph has not yet
+        named every one (``PublisherWatch.named_publishers``): the line waits for the names.
         """
         if self.once.is_active(f'{name}-{Reason.CLOCK.name}'):
             return ''
-        doubled = {topic: names for topic in self.expected_publishers
-                   for names in [self.graph.publishers(topic)] if names}
+        now = time.monotonic()
+        found = {topic: self.graph.named_publishers(topic, now)
+                 for topic in self.expected_publishers}
+        if any(names is None for names in found.values()):
+            return None
+        doubled = {topic: names for topic, names in found.items() if names}
         if doubled:
             return ('; '.join(f"{topic} has {len(names)} publishers ({', '.join(names)})"
                               for topic, names in doubled.items())
@@ -454,7 +461,7 @@ class RobotNode(Node):
         if abs(ahead) * NS_PER_S > self.timeout_ns:
             advice = self._clock_advice('reference', 'the reference')
             self._reject('reference', Reason.CLOCK, f' ({-ahead:+.3g} s from the state: '
-                                                    f'{advice})')
+                                                    f'{advice})', log=advice is not None)
             return None
         self.once.end(f'reference-{Reason.CLOCK.name}', 'reference on the clock of the states')
         if self.team is not None:

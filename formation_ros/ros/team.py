@@ -44,6 +44,13 @@ Process = Tuple[str, str]
 """(host name, process id) as a node announces them."""
 
 
+UNKNOWN_NAME = '_NODE_NAME_UNKNOWN_'
+"""What rmw calls a node whose ROS name has not reached this participant yet."""
+UNNAMED = 'a node not yet named in the ROS graph'
+NAMES_WAIT = 5.0
+"""How long a line naming publishers waits for their ROS names, s (steady clock)."""
+
+
 def full_name(namespace: str, name: str) -> str:
     """Return a node's fully qualified name: ``/plant``, ``/robot_1/robot``."""
     return namespace.rstrip('/') + '/' + name
@@ -181,6 +188,7 @@ class PublisherWatch:
         self.since: Dict[str, float] = {}
         self.listed: Dict[str, List[str]] = {}
         """Every topic's publishers where there were several when it was looked at last."""
+        self.unnamed_since: Dict[str, float] = {}
 
     def publishers(self, topic: str) -> List[str]:
         """Return the fully qualified names of the nodes publishing ``topic`` (one per writer)."""
@@ -188,6 +196,23 @@ class PublisherWatch:
             return []
         return sorted(full_name(info.node_namespace, info.node_name)
                       for info in self.node.get_publishers_info_by_topic(topic))
+
+    def named_publishers(self, topic: str, now: float) -> Optional[List[str]]:
+        """
+        Return :meth:`publishers` once the graph knows every one's ROS name; None until then.
+
+        DDS announces a writer before its participant's ROS node names arrive (a moment, or
+        seconds on a busy machine), and rmw names such a writer ``_NODE_NAME_UNKNOWN_``. A line
+        that names the publishers waits for the names, at most NAMES_WAIT s (``now``: steady
+        clock, s), then calls the nameless ones so.
+        """
+        names = self.publishers(topic)
+        if not any(UNKNOWN_NAME in name for name in names):
+            self.unnamed_since.pop(topic, None)
+            return names
+        if now - self.unnamed_since.setdefault(topic, now) < NAMES_WAIT:
+            return None
+        return [UNNAMED if UNKNOWN_NAME in name else name for name in names]
 
     def _looked_at(self, topics: Sequence[str]) -> List[str]:
         """Return the topics of this call: the next ``limit`` in turn, and those with several."""
@@ -209,7 +234,9 @@ class PublisherWatch:
         run.
         """
         for topic in self._looked_at(list(expected)):
-            names = self.publishers(topic) if topic in expected else []
+            names = self.named_publishers(topic, now) if topic in expected else []
+            if names is None:
+                continue
             if names:
                 self.listed[topic] = names
                 self.since.setdefault(topic, now)

@@ -5,7 +5,7 @@
 
 from types import SimpleNamespace
 
-from formation_ros.ros.team import PublisherWatch
+from formation_ros.ros.team import NAMES_WAIT, PublisherWatch, UNNAMED
 
 OWN = '/plant'
 
@@ -59,3 +59,23 @@ def test_every_topic_is_looked_at_in_turn_and_all_without_a_limit():
     graph.looks.clear()
     PublisherWatch(graph).check(dict.fromkeys(topics, OWN), 0.0)
     assert graph.looks == topics
+
+
+def test_a_publisher_without_a_ros_name_yet_is_named_once_the_graph_has_it():
+    graph = Graph(['/clock'])
+    watch = PublisherWatch(graph)
+    graph.publishers['/clock'].append(('_NODE_NAMESPACE_UNKNOWN_', '_NODE_NAME_UNKNOWN_'))
+    assert watch.named_publishers('/clock', 10.0) is None
+    assert watch.check({'/clock': OWN}, 10.0) == {}
+    assert watch.named_publishers('/clock', 10.0 + NAMES_WAIT / 2) is None
+    graph.publishers['/clock'][-1] = ('/', 'probe')
+    assert watch.named_publishers('/clock', 11.0) == ['/plant', '/probe']
+    assert watch.check({'/clock': OWN}, 11.0) == {'/clock': '/probe'}
+
+
+def test_a_publisher_never_named_is_called_so_after_the_wait():
+    graph = Graph(['/clock'])
+    watch = PublisherWatch(graph)
+    graph.publishers['/clock'].append(('_NODE_NAMESPACE_UNKNOWN_', '_NODE_NAME_UNKNOWN_'))
+    assert watch.named_publishers('/clock', 3.0) is None
+    assert watch.named_publishers('/clock', 3.0 + NAMES_WAIT) == ['/plant', UNNAMED]
