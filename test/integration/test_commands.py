@@ -18,8 +18,7 @@ from formation_ros.core.params import load_config
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.ros import qos
 from geometry_msgs.msg import PoseStamped, Twist
-from helpers import (launch, logged, node, plant_value, Statuses, stop_when,
-                     TWICE_REAL_TIME, write_params)
+from helpers import launch, logged, node, plant_value, Statuses, stop_when, write_params
 import numpy as np
 
 HEADINGS = [0.5, 2.0, -1.0, 3.0]
@@ -29,7 +28,7 @@ LAB = {'world_frame': 'map', 'command.type': 'twist', 'command.frame': 'body',
 
 def test_points_taking_twists_in_their_own_frames_reach_the_formation(
         processes, install, probe, tmp_path):
-    params = write_params(tmp_path, 'square_4.yaml', {**LAB, **TWICE_REAL_TIME})
+    params = write_params(tmp_path, 'square_4.yaml', LAB)
     config = load_config(params, 'plant')
     bound = config.law().u_bound
     commands, poses = [], []

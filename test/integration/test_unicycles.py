@@ -14,8 +14,7 @@ from formation_ros.core.unicycle import (command_bounds, hand_points, headings_f
 from formation_ros.ros import fields, messages, qos
 from formation_ros.tools.sim import simulate
 from geometry_msgs.msg import Pose, PoseArray, PoseStamped, TwistStamped
-from helpers import (launch, node, plant_value, SimClock, Statuses, stop_when,
-                     TWICE_REAL_TIME, write_params)
+from helpers import launch, node, plant_value, SimClock, Statuses, stop_when, write_params
 from nav_msgs.msg import Odometry
 import numpy as np
 import pytest
@@ -106,7 +105,7 @@ def test_four_unicycles_converge_in_lockstep_as_formation_sim(processes, install
 
 def test_free_running_unicycles_move_towards_the_formation(processes, install, probe,
                                                            tmp_path):
-    params = four_unicycles(tmp_path, **SLOW_TURNS, **TWICE_REAL_TIME)
+    params = four_unicycles(tmp_path, **SLOW_TURNS)
     config = load_config(params)
     commands, _, _ = watch(probe)
     statuses = Statuses(probe)
