@@ -92,6 +92,7 @@ import numpy as np
 from rclpy.clock import Clock, ClockType
 from rclpy.duration import Duration
 from rclpy.node import Node
+from rclpy.publisher import Publisher
 from rosgraph_msgs.msg import Clock as ClockMsg
 from trajectory_msgs.msg import MultiDOFJointTrajectory
 from visualization_msgs.msg import MarkerArray
@@ -125,6 +126,9 @@ is at most this many state periods old (as bench_capacity's fresh share)."""
 LISTENERS_PERIOD = 0.5
 """Team transport: seconds between looks at who subscribes to each robot's pose and neighbors
 (published only while someone does)."""
+LISTENER_LOOKS = 50
+"""Team transport: robots whose pose and neighbors subscribers are looked up in the graph per
+LISTENERS_PERIOD while the plant has no publishers of theirs (two lookups each)."""
 
 
 class PlantNode(Node):
@@ -192,15 +196,22 @@ class PlantNode(Node):
 
         self.state_encoder = StateEncoder(self.n, self.dim, config.world_frame)
         self.malformed = np.zeros(self.n, dtype=np.int64)
-        self.pose_pubs, self.neighbour_pubs = [], []
         self.command_liveliness: List[PeerLiveliness] = []
         self.team_transport = config.team_transport
         self.listened = np.ones(self.n, dtype=bool)
+        self.pose_topics = [topics.robot_topic(i, topics.POSE) for i in range(1, self.n + 1)]
+        self.neighbour_topics = [topics.robot_topic(i, topics.NEIGHBOURS)
+                                 for i in range(1, self.n + 1)]
+        self.pose_pubs: List[Optional[Publisher]] = [None] * self.n
+        self.neighbour_pubs: List[Optional[Publisher]] = [None] * self.n
+        self.lazy_robot_topics = (self.team_transport
+                                  and self.settings.wait_for_subscribers <= 1)
+        """Team transport with nobody else awaited: a robot's pose and neighbors publishers
+        are made once someone subscribes to either (looked up in the graph in turn)."""
+        self.listener_cursor = 0
         for i in range(1, self.n + 1):
-            self.pose_pubs.append(self.create_publisher(
-                PoseStamped, topics.robot_topic(i, topics.POSE), qos.STATE))
-            self.neighbour_pubs.append(self.create_publisher(
-                PoseArray, topics.robot_topic(i, topics.NEIGHBOURS), qos.STATE))
+            if not self.lazy_robot_topics:
+                self._make_robot_publishers(i - 1)
             if self.team_transport:
                 continue
             self.command_liveliness.append(PeerLiveliness())
@@ -217,9 +228,9 @@ class PlantNode(Node):
                                                   qos.CLOCK, raw=True)
         self.expected_publishers: Dict[str, Optional[str]] = {self.clock_pub.topic_name:
                                                               self.own_name}
-        for pose, neighbours in zip(self.pose_pubs, self.neighbour_pubs):
-            self.expected_publishers[pose.topic_name] = self.own_name
-            self.expected_publishers[neighbours.topic_name] = self.own_name
+        for pose, neighbours in zip(self.pose_topics, self.neighbour_topics):
+            self.expected_publishers[pose] = self.own_name
+            self.expected_publishers[neighbours] = self.own_name
         if self.team_transport:
             self.expected_publishers[self.states_pub.topic_name] = self.own_name
         self.command_index = {sub.topic_name: i for i, sub in enumerate(self.command_subs)}
@@ -271,10 +282,32 @@ class PlantNode(Node):
                                                  clock=self.steady)
         self._look_at_listeners()
 
+    def _make_robot_publishers(self, index: int) -> None:
+        """Create the ``pose`` and ``neighbors`` publishers of robot ``index`` (0-based)."""
+        self.pose_pubs[index] = self.create_publisher(PoseStamped, self.pose_topics[index],
+                                                      qos.STATE)
+        self.neighbour_pubs[index] = self.create_publisher(
+            PoseArray, self.neighbour_topics[index], qos.STATE)
+
     def _look_at_listeners(self) -> None:
-        """Team transport: note which robots' pose or neighbors someone subscribes to."""
-        self.listened = np.array([pose.get_subscription_count() > 0
-                                  or neighbours.get_subscription_count() > 0
+        """
+        Team transport: note which robots' pose or neighbors someone subscribes to.
+
+        With lazy robot topics, LISTENER_LOOKS robots a call (in turn) without publishers are
+        looked up in the graph, and get theirs once a subscriber shows: a ``ros2 topic echo``
+        of one of N robots is served within about N / LISTENER_LOOKS calls.
+        """
+        if self.lazy_robot_topics:
+            for _ in range(min(LISTENER_LOOKS, self.n)):
+                i = self.listener_cursor
+                self.listener_cursor = (i + 1) % self.n
+                if self.pose_pubs[i] is None and (
+                        self.count_subscribers(self.pose_topics[i]) > 0
+                        or self.count_subscribers(self.neighbour_topics[i]) > 0):
+                    self._make_robot_publishers(i)
+        self.listened = np.array([pose is not None and neighbours is not None
+                                  and (pose.get_subscription_count() > 0
+                                       or neighbours.get_subscription_count() > 0)
                                   for pose, neighbours in zip(self.pose_pubs,
                                                               self.neighbour_pubs)], dtype=bool)
 
@@ -585,8 +618,10 @@ class PlantNode(Node):
             poses, arrays = self.state_encoder.encode(state.q, observer, seen, state.stamp_ns,
                                                       headings)
             for i in np.flatnonzero(self.listened).tolist():
-                self.pose_pubs[i].publish(poses[i])
-                self.neighbour_pubs[i].publish(arrays[i])
+                pose, neighbours = self.pose_pubs[i], self.neighbour_pubs[i]
+                assert pose is not None and neighbours is not None
+                pose.publish(poses[i])
+                neighbours.publish(arrays[i])
         self.last_publish_wall = time.monotonic()
 
     def _resend_if_due(self) -> None:
@@ -597,7 +632,8 @@ class PlantNode(Node):
         """While waiting: start the clock once every robot has sent a command."""
         missing = (np.flatnonzero(~self.commands.present) + 1).tolist()
         wanted = self.settings.wait_for_subscribers - (1 if self.team_transport else 0)
-        unheard = ([pub for pub in self.pose_pubs if pub.get_subscription_count() < wanted]
+        unheard = ([pub for pub in self.pose_pubs
+                    if pub is None or pub.get_subscription_count() < wanted]
                    if wanted > 0 else [])
         if self.team_transport and self.states_pub.get_subscription_count() < 1:
             unheard.append(self.states_pub)
