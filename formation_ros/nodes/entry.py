@@ -16,7 +16,7 @@ its ``main()``, which installs the runner's own handlers. This module loads noth
 import importlib
 import signal
 from types import FrameType
-from typing import Optional
+from typing import Callable, Optional
 
 
 def _stopped_while_loading(signum: int, frame: Optional[FrameType]) -> None:
@@ -33,31 +33,18 @@ def _run(module: str) -> int:
     return code
 
 
-def robot() -> int:
-    """``ros2 run formation_ros robot``."""
-    return _run('robot')
+def _entry(executable: str, module: str) -> Callable[[], int]:
+    """Return the entry point of ``ros2 run formation_ros <executable>``."""
+    def entry() -> int:
+        return _run(module)
+    entry.__name__ = entry.__qualname__ = executable
+    entry.__doc__ = f'``ros2 run formation_ros {executable}``.'
+    return entry
 
 
-def fleet() -> int:
-    """``ros2 run formation_ros fleet``."""
-    return _run('fleet')
-
-
-def plant() -> int:
-    """``ros2 run formation_ros plant``."""
-    return _run('plant')
-
-
-def reference() -> int:
-    """``ros2 run formation_ros reference``."""
-    return _run('reference')
-
-
-def record() -> int:
-    """``ros2 run formation_ros record``."""
-    return _run('recorder')
-
-
-def relay() -> int:
-    """``ros2 run formation_ros relay``."""
-    return _run('relay')
+robot = _entry('robot', 'robot')
+fleet = _entry('fleet', 'fleet')
+plant = _entry('plant', 'plant')
+reference = _entry('reference', 'reference')
+record = _entry('record', 'recorder')
+relay = _entry('relay', 'relay')
