@@ -31,12 +31,18 @@ def test_a_robot_with_another_file_is_named_by_plant_and_reference(
 
     assert probe.spin_until(lambda: 'formation_ros/robot_4' in named('formation_ros/plant')
                             and 'formation_ros/robot_4' in named('formation_ros/reference'), 60)
+    # Robot 3 announces its own file's shape until it hears the reference's: wait until it
+    # follows it and has said so in two statuses, and plant and reference have spoken since.
+    assert probe.spin_until(lambda: "following the reference's shape"
+                            in processes.log('robot_3'), 60), processes.log('robot_3')
+    for status_name in ('formation_ros/robot_3', 'formation_ros/plant',
+                        'formation_ros/reference'):
+        after = statuses.heard.get(status_name, 0) + 2
+        assert probe.spin_until(lambda: statuses.heard.get(status_name, 0) >= after, 30)
     for status_name in ('formation_ros/plant', 'formation_ros/reference'):
         text = named(status_name)
         assert 'c=1.0' in text and 'c=2.0' in text, text
         assert all(f'formation_ros/robot_{i}' not in text for i in (1, 2, 3)), text
-    assert probe.spin_until(lambda: "following the reference's shape"
-                            in processes.log('robot_3'), 60), processes.log('robot_3')
     assert said_once(probe, processes, 'plant', 'formation_ros/robot_4: law', statuses,
                      'formation_ros/plant') == 1, processes.log('plant')
     logged(probe, processes, 'reference', 'formation_ros/robot_4: law')
