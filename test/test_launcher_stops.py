@@ -9,13 +9,14 @@ import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PARAMS = os.path.join(ROOT, 'config', 'square_4.yaml')
-NODE = '#!/usr/bin/env bash\ntrap "exit 0" INT TERM\nwhile true; do sleep 0.05; done\n'
+NODE = '#!/usr/bin/env bash\ntrap "exit 0" INT TERM\nsleep infinity &\nwait\n'
 RECORDER_THAT_FAILS_AT_STOP = (
     '#!/usr/bin/env bash\n'
     'for arg in "$@"; do case "$arg" in record.path:=*) bag="${arg#record.path:=}" ;; esac; done\n'
     'mkdir -p "$bag"\n'
     'trap \'echo "recording stopped: cannot write $bag"; exit 74\' INT TERM\n'
-    'while true; do sleep 0.05; done\n')
+    'sleep infinity &\n'
+    'wait\n')
 """A recorder whose last write fails when it is asked to stop (a disk that fills then)."""
 
 

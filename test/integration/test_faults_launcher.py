@@ -238,9 +238,13 @@ def test_a_node_stopped_while_it_still_loads_ends_quietly(install, name, sig):
         process = subprocess.Popen([exe(install, name), '--ros-args', '--params-file', SQUARE],
                                    stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         deadline = time.monotonic() + 60.0
-        while not mapped(process.pid, '_multiarray_umath') and process.poll() is None:
+        while not mapped(process.pid, '_multiarray_umath'):
             assert time.monotonic() < deadline, 'numpy never loaded'
-            time.sleep(0.002)
+            try:
+                process.wait(timeout=0.002)
+            except subprocess.TimeoutExpired:
+                continue
+            pytest.fail(f'{name} ended before it loaded numpy')
         loading = not mapped(process.pid, '_rclpy_pybind11')
         process.send_signal(sig)
         out, _ = process.communicate(timeout=60)
