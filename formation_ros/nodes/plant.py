@@ -662,7 +662,15 @@ class PlantNode(Node):
         return True
 
     def on_diagnostics(self) -> None:
-        """Publish the plant's status: step rate, counters, closest pair, bound."""
+        """
+        Publish the plant's status: step rate, counters, closest pair, bound.
+
+        Before the first step another team is the look's to refuse, in one line: the look runs
+        first, and a refusing plant names no shared topic or other plant besides.
+        """
+        if self.waiting and self.looked:
+            self.next_look = 0.0
+            self._look_while_waiting()
         now = time.monotonic()
         since, steps = self.rate_window
         counts = self.model.counts
@@ -713,7 +721,8 @@ class PlantNode(Node):
         if others:
             values['nodes with other team values'] = ' | '.join(others)
         shared = self._shared_topics(now)
-        plants = self.team.running(self.own_name, now) if self.looked else []
+        plants = (self.team.running(self.own_name, now) if self.looked and not self.refusal
+                  else [])
         if plants:
             self.once.start('other-plant', 'another plant runs on this domain: '
                                            f'{self.team.describe(self.own_name, now)} (another '
