@@ -467,16 +467,17 @@ class PlantNode(Node):
             others.remove(self.own_name)
         return others
 
-    def _look_while_waiting(self) -> None:
+    def _look_while_waiting(self, at_once: bool = False) -> None:
         """
         While the clock waits for the robots: refuse another team's /clock publisher found late.
 
-        Discovery on a busy machine can take longer than LOOK_TIME; until the first step a
-        publisher with another name, or one that announces itself from another process, still
-        means another team, and this plant has not moved a body yet.
+        Every LOOK_PERIOD s (``at_once``: now). Discovery on a busy machine can take longer
+        than LOOK_TIME; until the first step a publisher with another name, or one that
+        announces itself from another process, still means another team, and this plant has
+        not moved a body yet.
         """
         now = time.monotonic()
-        if now < self.next_look or self.refusal:
+        if (now < self.next_look and not at_once) or self.refusal:
             return
         self.next_look = now + LOOK_PERIOD
         others = self._other_clock_publishers(now)
@@ -669,8 +670,7 @@ class PlantNode(Node):
         first, and a refusing plant names no shared topic or other plant besides.
         """
         if self.waiting and self.looked:
-            self.next_look = 0.0
-            self._look_while_waiting()
+            self._look_while_waiting(at_once=True)
         now = time.monotonic()
         since, steps = self.rate_window
         counts = self.model.counts
