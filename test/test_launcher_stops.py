@@ -47,3 +47,22 @@ def test_a_recording_that_fails_as_the_run_stops_is_exit_74_and_said_once(tmp_pa
         '(exit code 74), as the run was stopping',
         f'launch_formation.sh: exit code 74: the recording stopped early: the recorder could '
         f'not write {bag}; the others ran to the end of the run'], done.stderr
+
+
+def test_no_plots_asks_the_report_for_the_metrics_alone(tmp_path):
+    install = fake_install(tmp_path / 'install')
+    (install / 'lib' / 'formation_ros' / 'record').write_text(
+        RECORDER_THAT_FAILS_AT_STOP.replace('exit 74', 'exit 0').replace(
+            'echo "recording stopped: cannot write $bag"; ', ''))
+    env = dict(os.environ, ROS_DOMAIN_ID='13')
+    reports = []
+    for extra in ((), ('--no-plots',)):
+        bag = tmp_path / f'bag{len(reports)}'
+        done = subprocess.run([sys.executable, '-m', 'formation_ros.tools.launcher', PARAMS,
+                               '--prefix', str(install), '--duration', '0.5',
+                               '--record', str(bag), *extra],
+                              capture_output=True, text=True, env=env, timeout=120)
+        assert done.returncode == 0, done.stdout + done.stderr
+        reports.append([line for line in done.stdout.splitlines() if line.startswith('report')])
+    assert reports == [[f'report {tmp_path}/bag0 --out {tmp_path}/bag0'],
+                       [f'report {tmp_path}/bag1 --out {tmp_path}/bag1 --no-plots']]

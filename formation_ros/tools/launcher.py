@@ -55,7 +55,7 @@ USAGE = """\
 Usage: scripts/launch_formation.sh PARAMS.yaml [--duration S] [--out DIR] [--record DIR]
                                    [--on-exit continue|stop|respawn]
                                    [--on-record-failure continue|stop]
-                                   [--robots-per-process K] [--prefix DIR]
+                                   [--robots-per-process K] [--prefix DIR] [--no-plots]
                                    [--discovery localhost|subnet] [--domain-id N]
                                    [--no-plant [--cmd-topic TEMPLATE] [--source-topic TEMPLATE]]
 
@@ -106,6 +106,7 @@ Options:
                  fleet_2, ...; each robot still its own node in /robot_<i>): ceil(N/K)
                  processes instead of N (default 1: one 'robot' process per robot). With
                  --on-exit, a fleet process counts as its robots: respawn restarts all of them
+  --no-plots     the report at the end writes metrics.json without the figures (quicker)
   --prefix DIR   install space of formation_ros (default: found from 'ros2', AMENT_PREFIX_PATH
                  or ./install/formation_ros)
   --discovery RANGE
@@ -190,6 +191,7 @@ class Options:
     discovery: Optional[str] = None
     domain_id: Optional[int] = None
     no_plant: bool = False
+    plots: bool = True
     cmd_topic: Optional[str] = None
     source_topic: Optional[str] = None
     cmd_topics: tuple[str, ...] = ()
@@ -207,6 +209,7 @@ def parse_args(argv: Sequence[str]) -> Optional[Options]:
     values: dict[str, Optional[str]] = dict.fromkeys(needs)
     params = None
     no_plant = False
+    plots = True
     args = list(argv)
     while args:
         arg = args.pop(0)
@@ -215,6 +218,8 @@ def parse_args(argv: Sequence[str]) -> Optional[Options]:
             return None
         if arg == '--no-plant':
             no_plant = True
+        elif arg == '--no-plots':
+            plots = False
         elif arg.startswith('--') and name in values:
             value = args.pop(0) if args else ''
             if not value:
@@ -253,7 +258,7 @@ def parse_args(argv: Sequence[str]) -> Optional[Options]:
     return Options(params, None if duration is None else float(duration), values['out'],
                    values['record'], prefix, on_exit, on_record_failure, int(per_process),
                    discovery, None if domain_id is None else int(domain_id), no_plant,
-                   values['cmd-topic'], values['source-topic'])
+                   plots, values['cmd-topic'], values['source-topic'])
 
 
 def _check_lab_options(no_plant: bool, values: Mapping[str, Optional[str]]) -> None:
@@ -585,8 +590,9 @@ class Launch:
         else:
             return 0
         sys.stdout.flush()
-        code = subprocess.call(self.install.command('formation_report') +
-                               [source, '--out', target], env=self.env)
+        code = subprocess.call(self.install.command('formation_report')
+                               + [source, '--out', target]
+                               + ([] if options.plots else ['--no-plots']), env=self.env)
         if code != 0:
             say(f'formation_report failed ({describe_returncode(code)})')
             return 1

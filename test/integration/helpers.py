@@ -51,15 +51,23 @@ def write_params(folder, source, changes, name='params.yaml'):
 
 
 def launch(processes, install, params, out=None, record=None, duration=0, env=None,
-           name='launcher', options=()):
+           name='launcher', options=(), plots=False, per_process=None):
     """
     Start ``scripts/launch_formation.sh`` as process ``name``; return its Popen.
 
     install: passed as ``--prefix`` (None: the launcher finds the executables itself).
     duration: the launcher's ``--duration``; the default 0 runs until :func:`stop_when`.
     options: more launcher options, e.g. ``('--on-exit', 'respawn')``.
+    plots: whether the report at the end draws its figures (``--no-plots`` unless a test
+    looks at them: they cost seconds of CPU that other tests' nodes need).
+    per_process: ``--robots-per-process``, for a test of what the robots do rather than of
+    how they are spread over processes (each process costs its start-up and a participant).
     """
     args = ['bash', LAUNCHER, str(params), '--duration', str(duration), *options]
+    if not plots:
+        args.append('--no-plots')
+    if per_process is not None:
+        args += ['--robots-per-process', str(per_process)]
     if install is not None:
         args += ['--prefix', str(install)]
     if out is not None:

@@ -105,7 +105,7 @@ def test_shapes_switch_and_the_team_stops_and_goes(processes, install, probe, tm
     stop = probe.create_client(Trigger, '/formation/stop')
     start = probe.create_client(Trigger, '/formation/start')
     out, bag = tmp_path / 'out', tmp_path / 'bag'
-    launch(processes, install, params, out=out, record=bag)
+    launch(processes, install, params, out=out, record=bag, per_process=4)
     square = config.vertices.ravel().tolist()
     assert probe.spin_until(lambda: poses.error(square) < 0.01, 90), processes.log('launcher')
 

@@ -39,7 +39,7 @@ def test_points_taking_twists_in_their_own_frames_reach_the_formation(
     probe.create_subscription(PoseStamped, '/robot_2/pose', poses.append, qos.STATE_INPUT)
     statuses = Statuses(probe)
     out, bag = tmp_path / 'out', tmp_path / 'bag'
-    launch(processes, install, params, out=out, record=bag)
+    launch(processes, install, params, out=out, record=bag, per_process=4)
     info = stop_when(probe, processes, lambda: plant_value(
         statuses, 'steps with fresh commands') >= 800 and len(commands) > 400, timeout=300)
     assert info.returncode == 0, processes.log('launcher')
@@ -48,7 +48,7 @@ def test_points_taking_twists_in_their_own_frames_reach_the_formation(
     o = poses[-1].pose.orientation
     assert math.isclose(2.0 * math.atan2(o.z, o.w), HEADINGS[1], abs_tol=1e-9)
     moving = [(i, x, y) for i, x, y in commands if x or y]
-    assert moving, processes.log('robot_1')
+    assert moving, processes.log('launcher')
     for i, x, y in moving:
         c, s = math.cos(HEADINGS[i - 1]), math.sin(HEADINGS[i - 1])
         world = (c * x - s * y, s * x + c * y)

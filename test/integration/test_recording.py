@@ -24,7 +24,7 @@ def test_recorded_run_reads_back_and_agrees_with_the_plant(processes, install, p
     probe.create_subscription(MarkerArray, '/formation/markers', markers.append, qos.MARKERS)
     statuses = Statuses(probe)
     bag, out = tmp_path / 'bag', tmp_path / 'run'
-    launch(processes, install, SQUARE, out=out, record=bag)
+    launch(processes, install, SQUARE, out=out, record=bag, plots=True, per_process=4)
     info = stop_when(probe, processes, lambda: plant_value(
         statuses, 'steps with fresh commands') >= 500 and bool(markers), timeout=300)
     assert info.returncode == 0, processes.log('launcher')
@@ -64,7 +64,7 @@ def test_lockstep_bag_reproduces_formation_sim(processes, install, probe, tmp_pa
     params = write_params(tmp_path, 'circle_2d.yaml', changes)
     clock = SimClock(probe)
     bag = tmp_path / 'bag'
-    launch(processes, install, params, record=bag)
+    launch(processes, install, params, record=bag, per_process=4)
     info = stop_when(probe, processes, lambda: clock.seconds >= 1.5)
     assert info.returncode == 0, processes.log('launcher')
     topics, _ = read_messages(str(bag))
@@ -87,7 +87,7 @@ def test_lockstep_bag_reproduces_formation_sim(processes, install, probe, tmp_pa
 def test_bag_of_a_run_stopped_with_sigint_is_complete(processes, install, probe, tmp_path):
     clock = SimClock(probe)
     bag = tmp_path / 'bag'
-    launch(processes, install, SQUARE, record=bag)
+    launch(processes, install, SQUARE, record=bag, per_process=4)
     info = stop_when(probe, processes, lambda: clock.seconds >= 2.0)
     assert info.returncode == 0, processes.log('launcher')
     topics, counts = read_messages(str(bag))

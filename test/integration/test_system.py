@@ -19,7 +19,7 @@ def test_formation_converges_bounded_without_collision(processes, install, probe
     heard, subscriptions = watch_commands(probe, 4)
     statuses = Statuses(probe)
     out = tmp_path / 'run'
-    launch(processes, install, SQUARE, out=out)
+    launch(processes, install, SQUARE, out=out, plots=True)
     expected = {'/formation/reference', '/clock'} | {
         f'/robot_{i}/{topic}' for i in range(1, 5) for topic in ('pose', 'neighbors', 'cmd_vel')}
     assert probe.spin_until(
@@ -45,7 +45,8 @@ def test_formation_converges_bounded_without_collision(processes, install, probe
 def test_tracking_follows_a_circle(processes, install, probe, tmp_path):
     statuses = Statuses(probe)
     out = tmp_path / 'circle'
-    launch(processes, install, write_params(tmp_path, 'circle_2d.yaml', {}), out=out)
+    launch(processes, install, write_params(tmp_path, 'circle_2d.yaml', {}), out=out,
+           per_process=6)
     # 10 s of steps with fresh commands (100 Hz), however long starved robots make the run.
     info = stop_when(probe, processes, lambda: plant_value(
         statuses, 'steps with fresh commands') >= 1000, timeout=300)
@@ -84,15 +85,15 @@ def lockstep_matches_simulation(processes, install, probe, tmp_path, source, cha
     """
     params = write_params(tmp_path, source, {'plant.lockstep': True,
                                              'plant.realtime_factor': 200.0, **dict(changes)})
+    config = load_config(params)
     clock = SimClock(probe)
     out = tmp_path / 'lockstep'
-    launch(processes, install, params, out=out)
+    launch(processes, install, params, out=out, per_process=config.num_robots)
     info = stop_when(probe, processes, lambda: clock.seconds >= until)
     assert info.returncode == 0, processes.log('launcher')
     plant = Trajectory.load(str(out / 'trajectory.npz'))
     assert len(plant.t) >= 100 * until  # 0.01 s steps: a sample per step before it
     assert np.allclose(np.diff(plant.t), 0.01)
-    config = load_config(params)
     sim = simulate(config, duration=plant.t[-1], dt=0.01, sample_dt=0.01)
     assert len(sim.t) == len(plant.t)
     assert np.max(np.abs(sim.q - plant.q)) < 1e-9

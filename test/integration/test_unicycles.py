@@ -77,7 +77,7 @@ def test_four_unicycles_converge_in_lockstep_as_formation_sim(processes, install
     commands, poses, neighbours = watch(probe)
     clock = SimClock(probe)
     out = tmp_path / 'run'
-    launch(processes, install, params, out=out)
+    launch(processes, install, params, out=out, per_process=ROBOTS)
     info = stop_when(probe, processes, lambda: clock.seconds >= 12.0, timeout=400)
     assert info.returncode == 0, processes.log('launcher')
     check_body_frame_commands(commands, config)
@@ -110,7 +110,7 @@ def test_free_running_unicycles_move_towards_the_formation(processes, install, p
     commands, _, _ = watch(probe)
     statuses = Statuses(probe)
     out = tmp_path / 'free'
-    launch(processes, install, params, out=out)
+    launch(processes, install, params, out=out, per_process=ROBOTS)
 
     # Free running, robots starved by a busy machine answer late or not at all: what is
     # claimed needs 8 s of steps with fresh commands (at 100 Hz), however long the run takes.
