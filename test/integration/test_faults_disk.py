@@ -80,7 +80,7 @@ def test_a_full_disk_stops_the_recording_alone_and_leaves_a_readable_bag(
     params = write_params(tmp_path, 'square_4.yaml', {'duration': duration})
     started = time.monotonic()
     launch(processes, install, params, out=out, record=bag, duration=duration,
-           options=('--on-record-failure', mode))
+           options=('--on-record-failure', mode), per_process=4)
     info, log = run_until_exit(probe, processes, duration + 4 * START_UP)
     elapsed = time.monotonic() - started
 
@@ -122,7 +122,7 @@ def test_a_full_output_directory_stops_the_plant_output_alone(
     out = tiny_disk / 'out'
     params = write_params(tmp_path, 'square_4.yaml', {'duration': RUN})
     started = time.monotonic()
-    launch(processes, install, params, out=out, duration=RUN)
+    launch(processes, install, params, out=out, duration=RUN, per_process=4, plots=True)
     info, log = run_until_exit(probe, processes, RUN + 4 * START_UP)
     elapsed = time.monotonic() - started
 

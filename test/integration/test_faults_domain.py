@@ -158,7 +158,7 @@ def test_the_launcher_runs_on_a_free_domain_of_its_own(processes, install, probe
         env = dict(processes.env)
         env.pop('ROS_DOMAIN_ID')
         params = write_params(tmp_path, 'square_4.yaml', {})
-        launch(processes, install, params, env=env)
+        launch(processes, install, params, env=env, per_process=4)
         found = []
 
         def said():

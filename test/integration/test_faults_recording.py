@@ -42,7 +42,7 @@ def test_bag_of_a_recorder_killed_with_sigkill_is_recovered_and_repaired(
     assert probe.spin_until(lambda: probe.count_subscribers('/robot_1/pose') == 1, START_UP), \
         processes.log('record')
     clock = SimClock(probe)
-    launch(processes, install, SQUARE)
+    launch(processes, install, SQUARE, per_process=4)
     assert probe.spin_until(lambda: clock.seconds >= 3.0, START_UP), processes.log('launcher')
     assert probe.spin_until(lambda: commands_on_disk(bag) >= RECORDED_COMMANDS, START_UP), \
         processes.log('record')

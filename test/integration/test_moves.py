@@ -23,7 +23,7 @@ def test_a_fixed_reference_moves_and_the_team_follows(processes, install, probe,
     params = write_params(tmp_path, 'square_4.yaml', {})
     poses = Poses(probe, 4)
     client = probe.create_client(SetParameters, '/reference/set_parameters')
-    launch(processes, install, params)
+    launch(processes, install, params, per_process=4)
     square = np.array([1.0, 1.0, -1.0, 1.0, -1.0, -1.0, 1.0, -1.0])
     assert probe.spin_until(lambda: poses.error(square) < 0.01, 90), processes.log('launcher')
     refused = set_parameter(probe, client, 'reference.speed', 1.0)
