@@ -13,7 +13,9 @@ import json
 import os
 import signal
 
+from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.trajectory import Trajectory
+from formation_ros.ros import qos
 from formation_ros.tools.supervise import ProcessSpec
 from helpers import (exe, launch, project_processes, SimClock, SQUARE, START_UP,
                      stop_when, TWICE_REAL_TIME, wait_exit, watch_commands, write_params)
@@ -82,6 +84,18 @@ def test_each_robot_of_a_fleet_is_its_own_node_with_its_parameters(
     assert probe.spin_until(lambda: clock_readers() and all(
         probe.count_publishers(f'/robot_{i}/cmd_vel') == 1 for i in (1, 2, 3)), START_UP)
     assert len(clock_readers()) == 1, clock_readers()
+    [pid] = fleet_pids(install, '--robots 1-3')
+    arrays = []
+    probe.create_subscription(DiagnosticArray, '/diagnostics', arrays.append, qos.DIAGNOSTICS)
+    assert probe.spin_until(lambda: len(arrays) >= 2, 30)
+    assert [[status.name for status in array.status] for array in arrays] == [
+        [f'formation_ros/robot_{i}' for i in (1, 2, 3)]] * len(arrays)
+    for array in arrays:
+        for i, status in enumerate(array.status, 1):
+            values = {pair.key: pair.value for pair in status.values}
+            assert (values['process'], values['node']) == (str(pid), f'/robot_{i}/robot')
+    assert [info.node_namespace for info in probe.get_publishers_info_by_topic('/diagnostics')
+            if info.node_namespace.startswith('/robot_')] == ['/robot_1']
     refused = call(probe, probe.create_client(SetParameters, '/robot_2/robot/set_parameters'),
                    SetParameters.Request(parameters=[
                        Parameter('use_sim_time', value=False).to_parameter_msg()]))
@@ -135,3 +149,4 @@ def test_a_team_fleet_whose_robots_differ_in_the_law_is_refused_in_one_line(
     errors = [line for line in log.splitlines() if '[ERROR]' in line]
     assert len(errors) == 1 and "'controller.gain': must be the same for every robot" in errors[0]
     assert 'Traceback' not in log
+
