@@ -72,6 +72,7 @@ from formation_ros.core.sensing import sensed_pairs, sensor_radii
 from formation_ros.core.team import team_values
 from formation_ros.core.timeline import Mode, Shape, TeamState
 from formation_ros.core.transport import command_vectors, robot_name
+from formation_ros.core.turns import Turns
 from formation_ros.core.unicycle import (hand_points, headings_from_quaternions,
                                          unicycle_commands)
 from formation_ros.core.units import NS_PER_S
@@ -115,7 +116,11 @@ FAST_COPIES = 3
 STALE_MARGIN_NS = 1_000_000
 """How long after the oldest input is due to turn stale the watchdog looks, ns."""
 LISTENERS_PERIOD = 0.5
-"""Team transport: seconds between looks at who subscribes to each robot's cmd_vel."""
+"""Team transport: seconds between looks at who subscribes to the robots' cmd_vel."""
+LISTENER_LOOKS = 10
+"""Team transport: robots of a process whose cmd_vel subscribers are looked up per look (in
+turn; those with subscribers at every look): a subscriber to one of K robots' cmd_vel gets
+data within ceil(K / LISTENER_LOOKS) looks of its discovery, 1.5 s in a fleet of 25."""
 TEAM_VALUES = ('num_robots', 'dim', 'world_frame', 'repulsion_radius', 'controller.gain',
                'controller.kappa', 'controller.psi', 'jump.kind', 'jump.order', 'body.kind',
                'body.hand_distance', 'command.type', 'command.frame', 'plant.lockstep',
@@ -852,6 +857,7 @@ class TeamLink:
         self.observer = np.zeros(0, dtype=np.intp)
         self.seen = np.zeros(0, dtype=np.intp)
         self.listening = np.zeros(len(self.nodes), dtype=bool)
+        self.turns = Turns(LISTENER_LOOKS)
         self.last_sent: Optional[bytes] = None
         self.sent: List[Tuple[RobotNode, bytes]] = []
         """The cmd_vel messages that went with the latest team command, by robot."""
@@ -872,9 +878,16 @@ class TeamLink:
         self.leader.answer.arm()
 
     def look_at_listeners(self) -> None:
-        """Note which robots' cmd_vel someone subscribes to (published only then)."""
-        self.listening = np.array([node.cmd_pub.get_subscription_count() > 0
-                                   for node in self.nodes], dtype=bool)
+        """
+        Note which robots' cmd_vel someone subscribes to (published only then).
+
+        LISTENER_LOOKS robots a look, in turn, and every robot whose cmd_vel had subscribers:
+        each lookup costs more as the graph grows.
+        """
+        looked = set(self.turns.due(len(self.nodes)))
+        looked.update(np.flatnonzero(self.listening).tolist())
+        for k in looked:
+            self.listening[k] = self.nodes[k].cmd_pub.get_subscription_count() > 0
 
     def publishes_cmd_vel(self, node: RobotNode) -> str:
         """Return 'yes' while robot ``node``'s own cmd_vel is published (someone listens)."""
