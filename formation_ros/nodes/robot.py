@@ -447,7 +447,7 @@ class RobotNode(Node):
 
         def close() -> bool:
             mine = self.changes.reference.frame_at(msg.stamp_ns)
-            return all(np.allclose(a, b, rtol=0.0, atol=SAME_REFERENCE)
+            return all(bool(np.all(np.abs(a - b) <= SAME_REFERENCE))
                        for a, b in ((mine.q_od, heard.q_od), (mine.qdot_od, heard.qdot_od),
                                     (mine.J, heard.J), (mine.Jdot, heard.Jdot)))
 
