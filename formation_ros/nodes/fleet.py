@@ -21,7 +21,9 @@ and a ``robot_id`` must match it. The robots share one ``/clock`` subscription, 
 ``/formation/states`` subscription and one ``/formation/commands`` publisher instead, their
 commands come from one call of the law per state, their clocks are set from the states' stamps
 (no ``/clock`` subscription), and the first robot alone hears ``/formation/reference``,
-``/formation/shape`` and ``/formation/status`` for all of them.
+``/formation/shape`` and ``/formation/status`` for all of them. Either way the first robot
+publishes the fleet's ``/diagnostics``: one DiagnosticArray a second holding one status per
+robot, each named ``formation_ros/robot_<i>`` as a robot process names its own.
 """
 
 import re
@@ -92,16 +94,20 @@ def make_fleet(ids: Sequence[int]) -> List[RobotNode]:
     Build one robot node per id, robot i in ``/robot_<i>``, sharing one ``/clock`` subscription.
 
     Each node checks its parameters as a robot process does (a ``robot_id`` given to the fleet
-    disagrees with every namespace but one and is refused there). With ``transport: team`` the
-    fleet's robots hear the team's states and send their commands through one
-    :class:`formation_ros.nodes.robot.TeamLink`: one message in and one out per state.
+    disagrees with every namespace but one and is refused there). The first robot publishes
+    every robot's status on /diagnostics, one DiagnosticArray a period for the whole fleet.
+    With ``transport: team`` the fleet's robots hear the team's states and send their commands
+    through one :class:`formation_ros.nodes.robot.TeamLink`: one message in and one out per
+    state.
     """
     if not ids:
         return []
     first = RobotNode(namespace=robot_namespace(ids[0]))
     team = first.config.team_transport
-    nodes = [first] + [RobotNode(namespace=robot_namespace(i), leader=first if team else None)
+    nodes = [first] + [RobotNode(namespace=robot_namespace(i), leader=first if team else None,
+                                 reports=False)
                        for i in ids[1:]]
+    first.reported = nodes
     if team:
         TeamLink(nodes)
         if first.sim_time:

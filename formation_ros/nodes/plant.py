@@ -74,6 +74,7 @@ from formation_ros.core.trajectory import (CHUNKS_DIR, ChunkWriter, read_body_ch
                                            read_chunks, save_atomically, Trajectory,
                                            TRAJECTORY_FILE)
 from formation_ros.core.transport import commands_of
+from formation_ros.core.turns import Turns
 from formation_ros.core.units import NS_PER_S
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import (CdrError, encode_clock, read_twist, read_twist_stamped,
@@ -208,7 +209,7 @@ class PlantNode(Node):
                                   and self.settings.wait_for_subscribers <= 1)
         """Team transport with nobody else awaited: a robot's pose and neighbors publishers
         are made once someone subscribes to either (looked up in the graph in turn)."""
-        self.listener_cursor = 0
+        self.listener_turns = Turns(LISTENER_LOOKS)
         for i in range(1, self.n + 1):
             if not self.lazy_robot_topics:
                 self._make_robot_publishers(i - 1)
@@ -298,9 +299,7 @@ class PlantNode(Node):
         of one of N robots is served within about N / LISTENER_LOOKS calls.
         """
         if self.lazy_robot_topics:
-            for _ in range(min(LISTENER_LOOKS, self.n)):
-                i = self.listener_cursor
-                self.listener_cursor = (i + 1) % self.n
+            for i in self.listener_turns.due(self.n):
                 if self.pose_pubs[i] is None and (
                         self.count_subscribers(self.pose_topics[i]) > 0
                         or self.count_subscribers(self.neighbour_topics[i]) > 0):

@@ -70,8 +70,9 @@ from formation_ros.core.frames import advance, FrameSample, to_body_frame, valid
 from formation_ros.core.law import Command, robot_command, robot_commands
 from formation_ros.core.sensing import sensed_pairs, sensor_radii
 from formation_ros.core.team import team_values
-from formation_ros.core.timeline import Mode, TeamState
+from formation_ros.core.timeline import Mode, Shape, TeamState
 from formation_ros.core.transport import command_vectors, robot_name
+from formation_ros.core.turns import Turns
 from formation_ros.core.unicycle import (hand_points, headings_from_quaternions,
                                          unicycle_commands)
 from formation_ros.core.units import NS_PER_S
@@ -79,9 +80,9 @@ from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import (CdrError, encode_names, encode_team_commands, encode_twist,
                                    encode_twist_stamped, OdometryData, PoseArrayData, PoseData,
                                    read_odometry, read_pose_array, read_pose_stamped,
-                                   TooManyPoses)
+                                   StatusData, TooManyPoses)
 from formation_ros.ros.changes import Changes
-from formation_ros.ros.diagnostics import diagnostics, PERIOD
+from formation_ros.ros.diagnostics import encode_statuses, make_status, PERIOD
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
 from formation_ros.ros.runner import run
@@ -115,7 +116,11 @@ FAST_COPIES = 3
 STALE_MARGIN_NS = 1_000_000
 """How long after the oldest input is due to turn stale the watchdog looks, ns."""
 LISTENERS_PERIOD = 0.5
-"""Team transport: seconds between looks at who subscribes to each robot's cmd_vel."""
+"""Team transport: seconds between looks at who subscribes to the robots' cmd_vel."""
+LISTENER_LOOKS = 10
+"""Team transport: robots of a process whose cmd_vel subscribers are looked up per look (in
+turn; those with subscribers at every look): a subscriber to one of K robots' cmd_vel gets
+data within ceil(K / LISTENER_LOOKS) looks of its discovery, 1.5 s in a fleet of 25."""
 TEAM_VALUES = ('num_robots', 'dim', 'world_frame', 'repulsion_radius', 'controller.gain',
                'controller.kappa', 'controller.psi', 'jump.kind', 'jump.order', 'body.kind',
                'body.hand_distance', 'command.type', 'command.frame', 'plant.lockstep',
@@ -143,12 +148,15 @@ class Reason(enum.Enum):
 class RobotNode(Node):
     """One robot: stores what it hears in callbacks, computes and publishes in its timers."""
 
-    def __init__(self, leader: Optional['RobotNode'] = None, **kwargs) -> None:
+    def __init__(self, leader: Optional['RobotNode'] = None, reports: bool = True,
+                 **kwargs) -> None:
         """
         Declare and check parameters, then set up topics and the control timer.
 
         ``leader``: with ``transport: team``, the first robot of this process; this robot then
         hears the reference and the changes through it (one subscription per process).
+        ``reports``: whether this node publishes on /diagnostics itself; a fleet's other robots
+        do not, its first robot publishes their statuses with its own (:attr:`reported`).
         """
         super().__init__('robot', **kwargs)
         config = declare_parameters(self, Exe.ROBOT)
@@ -219,10 +227,14 @@ class RobotNode(Node):
                                    self._new_state)
         self.cmd_pub = self.create_publisher(TwistStamped if self.stamped else Twist,
                                              topics.CMD_VEL, qos.COMMAND)
-        self.diagnostics_pub = self.create_publisher(DiagnosticArray, topics.DIAGNOSTICS,
-                                                     qos.DIAGNOSTICS)
-        self.diagnostics_timer = self.create_timer(PERIOD, self.on_diagnostics,
-                                                   clock=self.steady)
+        self.reported: List[RobotNode] = [self]
+        """The robots whose statuses this node publishes (a fleet's first robot: all of its)."""
+        self.announcing: Optional[Tuple[Shape, Dict[str, str]]] = None
+        if reports:
+            self.diagnostics_pub = self.create_publisher(DiagnosticArray, topics.DIAGNOSTICS,
+                                                         qos.DIAGNOSTICS)
+            self.diagnostics_timer = self.create_timer(PERIOD, self.on_diagnostics,
+                                                       clock=self.steady)
         self.answer = Wake(self, self.on_state, self.steady)
         self.watch_period_ns = max(1, int(round(NS_PER_S / settings.control_rate)))
         self.awaiting_neighbours = False
@@ -435,7 +447,7 @@ class RobotNode(Node):
 
         def close() -> bool:
             mine = self.changes.reference.frame_at(msg.stamp_ns)
-            return all(np.allclose(a, b, rtol=0.0, atol=SAME_REFERENCE)
+            return all(bool(np.all(np.abs(a - b) <= SAME_REFERENCE))
                        for a, b in ((mine.q_od, heard.q_od), (mine.qdot_od, heard.qdot_od),
                                     (mine.J, heard.J), (mine.Jdot, heard.Jdot)))
 
@@ -707,11 +719,23 @@ class RobotNode(Node):
             Duration(seconds=LAST_WORD))
 
     def on_diagnostics(self) -> None:
+        """Publish one DiagnosticArray with the status of each robot this node reports."""
+        self.diagnostics_pub.publish(encode_statuses([node.status() for node in self.reported]))
+
+    def _announcement(self, stamp_ns: int) -> Dict[str, str]:
+        """Return the team values and identity this robot announces, made again on a new shape."""
+        shape = self.changes.shapes.at(stamp_ns)
+        if self.announcing is None or self.announcing[0] is not shape:
+            self.announcing = (shape, announced(team_values(self.config, shape.vertices), self))
+        return self.announcing[1]
+
+    def status(self) -> StatusData:
         """
-        Publish this robot's status: input ages, neighbours in range, command size.
+        Return this robot's status: input ages, neighbours in range, command size.
 
         Team transport: what the robot's link last gave it, and the link's state (waiting,
-        stale, flooding, the look at who publishes /clock and the reference: its leader's).
+        stale, flooding, the look at who publishes /clock and the reference: its leader's,
+        whose status comes first in its process's array).
         """
         if self.member_of is not None:
             self.member_of.give(self)
@@ -730,8 +754,7 @@ class RobotNode(Node):
             values['max |u_hat| component [m/s]'] = float(np.max(np.abs(self.last.u_hat)))
         values['bound c*M1 [m/s]'] = self.law.u_bound
         now = self.pose.stamp_ns if self.pose is not None else 0
-        values.update(announced(team_values(self.config, self.changes.shapes.at(now).vertices),
-                                self))
+        values.update(self._announcement(now))
         if self.last_body_command is not None and self.unicycle:
             values['|v| [m/s]'] = abs(float(self.last_body_command[0]))
             values['|w| [rad/s]'] = abs(float(self.last_body_command[1]))
@@ -759,8 +782,7 @@ class RobotNode(Node):
             level, message = 'warn', 'flooding: states beyond the state rate dropped'
         else:
             level, message = 'ok', 'lockstep' if self.lockstep else 'controlling'
-        self.diagnostics_pub.publish(diagnostics(f'formation_ros/robot_{self.index + 1}', level,
-                                                 message, values))
+        return make_status(f'formation_ros/robot_{self.index + 1}', level, message, values)
 
     def _shared_topics(self) -> Dict[str, str]:
         """Return {topic: its publishers} of /clock and the reference with several; log once."""
@@ -835,6 +857,7 @@ class TeamLink:
         self.observer = np.zeros(0, dtype=np.intp)
         self.seen = np.zeros(0, dtype=np.intp)
         self.listening = np.zeros(len(self.nodes), dtype=bool)
+        self.turns = Turns(LISTENER_LOOKS)
         self.last_sent: Optional[bytes] = None
         self.sent: List[Tuple[RobotNode, bytes]] = []
         """The cmd_vel messages that went with the latest team command, by robot."""
@@ -855,9 +878,16 @@ class TeamLink:
         self.leader.answer.arm()
 
     def look_at_listeners(self) -> None:
-        """Note which robots' cmd_vel someone subscribes to (published only then)."""
-        self.listening = np.array([node.cmd_pub.get_subscription_count() > 0
-                                   for node in self.nodes], dtype=bool)
+        """
+        Note which robots' cmd_vel someone subscribes to (published only then).
+
+        LISTENER_LOOKS robots a look, in turn, and every robot whose cmd_vel had subscribers:
+        each lookup costs more as the graph grows.
+        """
+        looked = set(self.turns.due(len(self.nodes)))
+        looked.update(np.flatnonzero(self.listening).tolist())
+        for k in looked:
+            self.listening[k] = self.nodes[k].cmd_pub.get_subscription_count() > 0
 
     def publishes_cmd_vel(self, node: RobotNode) -> str:
         """Return 'yes' while robot ``node``'s own cmd_vel is published (someone listens)."""

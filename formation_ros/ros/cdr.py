@@ -530,3 +530,50 @@ def encode_team_states(stamp_ns: int, frame_id: str, rows: ArrayLike) -> bytes:
     if len(values):
         head += _pad(len(head), 8)
     return head + values.tobytes()
+
+
+@dataclass(frozen=True)
+class StatusData:
+    """One diagnostic_msgs/DiagnosticStatus: level (0 OK, 1 WARN, 2 ERROR, 3 STALE), texts."""
+
+    level: int
+    name: str
+    message: str
+    hardware_id: str
+    values: Sequence[Tuple[str, str]]
+
+
+def _put_string(out: bytearray, text: str) -> None:
+    """Append a CDR string to ``out`` (from the encapsulation header on): length 4-aligned."""
+    raw = text.encode('utf-8')
+    out += _ZEROS[-len(out) % 4]
+    out += struct.pack('<I', len(raw) + 1)
+    out += raw
+    out += b'\x00'
+
+
+_ZEROS = (b'', b'\x00', b'\x00\x00', b'\x00\x00\x00')
+
+
+def encode_diagnostics(stamp_ns: int, statuses: Sequence[StatusData]) -> bytes:
+    """
+    Return a serialized diagnostic_msgs/DiagnosticArray stamped ``stamp_ns`` (no frame).
+
+    A status's ``level`` is one byte; each string's length and each sequence's count that
+    follows it is aligned to 4 (the header is 4 bytes long, so offsets from the start of
+    ``out`` align as offsets from the end of the header do).
+    """
+    out = bytearray(encode_header(stamp_ns, ''))
+    out += _ZEROS[-len(out) % 4]
+    out += struct.pack('<I', len(statuses))
+    for status in statuses:
+        out.append(status.level)
+        _put_string(out, status.name)
+        _put_string(out, status.message)
+        _put_string(out, status.hardware_id)
+        out += _ZEROS[-len(out) % 4]
+        out += struct.pack('<I', len(status.values))
+        for key, value in status.values:
+            _put_string(out, key)
+            _put_string(out, value)
+    return bytes(out)

@@ -27,6 +27,7 @@ from typing import Callable, Dict, List, Mapping, Optional, Sequence, Tuple
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.params import FormationConfig
 from formation_ros.core.team import differences, duplicate_due, team_values
+from formation_ros.core.turns import Turns
 from formation_ros.ros import qos, topics
 from formation_ros.ros.once import OnceLog
 import numpy as np
@@ -183,8 +184,7 @@ class PublisherWatch:
         """Look up the graph of ``node`` (``limit`` topics a call, None: all); name hosts."""
         self.node = node
         self.team = team
-        self.limit = limit
-        self.cursor = 0
+        self.turns = Turns(limit)
         self.since: Dict[str, float] = {}
         self.listed: Dict[str, List[str]] = {}
         """Every topic's publishers where there were several when it was looked at last."""
@@ -216,12 +216,9 @@ class PublisherWatch:
 
     def _looked_at(self, topics: Sequence[str]) -> List[str]:
         """Return the topics of this call: the next ``limit`` in turn, and those with several."""
-        if self.limit is None or self.limit >= len(topics):
-            return list(topics)
-        start = self.cursor % len(topics)
-        self.cursor = start + self.limit
-        turn = (list(topics[start:]) + list(topics[:start]))[:self.limit]
-        return turn + [topic for topic in self.listed if topic not in set(turn)]
+        turn = [topics[i] for i in self.turns.due(len(topics))]
+        chosen = set(turn)
+        return turn + [topic for topic in self.listed if topic not in chosen]
 
     def check(self, expected: Mapping[str, Optional[str]], now: float,
               alive: Callable[[str, Sequence[str]], bool] = lambda topic, names: False

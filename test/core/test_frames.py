@@ -6,7 +6,7 @@
 import math
 import os
 
-from formation_ros.core.frames import (advance, desired_positions, frame_from_pose,
+from formation_ros.core.frames import (_rotations, advance, desired_positions, frame_from_pose,
                                        frame_to_pose, from_frame_velocity,
                                        matrix_from_quaternion, quaternion_from_matrix,
                                        rotation_of_vector, to_frame)
@@ -320,3 +320,10 @@ def test_rotation_of_a_vector_matches_axis_angle_down_to_tiny_angles():
                            atol=1e-14), (axis, angle)
         assert np.array_equal(rotvec, before)
     assert np.array_equal(rotation_of_vector(np.zeros(3)), np.eye(3))
+
+
+def test_one_quaternions_matrix_has_the_bits_of_the_vectorised_one():
+    rng = np.random.default_rng(5)
+    quats = np.vstack([rng.normal(size=(200, 4)), [[0.0, 0.0, 0.0, 1.0], [0.0, 0.0, 0.6, 0.8]]])
+    for quat in quats:
+        assert np.array_equal(matrix_from_quaternion(quat), _rotations(quat)[0]), quat

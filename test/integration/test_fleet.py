@@ -12,9 +12,15 @@ executable started directly; outcomes from the probe, the launcher's output and 
 import json
 import os
 import signal
+import time
 
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from formation_ros.core.trajectory import Trajectory
+from formation_ros.nodes.robot import LISTENER_LOOKS, LISTENERS_PERIOD
+from formation_ros.ros import qos
+from formation_ros.ros.diagnostics import PERIOD
 from formation_ros.tools.supervise import ProcessSpec
+from geometry_msgs.msg import TwistStamped
 from helpers import (exe, launch, project_processes, SimClock, SQUARE, START_UP,
                      stop_when, TWICE_REAL_TIME, wait_exit, watch_commands, write_params)
 import numpy as np
@@ -82,6 +88,18 @@ def test_each_robot_of_a_fleet_is_its_own_node_with_its_parameters(
     assert probe.spin_until(lambda: clock_readers() and all(
         probe.count_publishers(f'/robot_{i}/cmd_vel') == 1 for i in (1, 2, 3)), START_UP)
     assert len(clock_readers()) == 1, clock_readers()
+    [pid] = fleet_pids(install, '--robots 1-3')
+    arrays = []
+    probe.create_subscription(DiagnosticArray, '/diagnostics', arrays.append, qos.DIAGNOSTICS)
+    assert probe.spin_until(lambda: len(arrays) >= 2, 30)
+    assert [[status.name for status in array.status] for array in arrays] == [
+        [f'formation_ros/robot_{i}' for i in (1, 2, 3)]] * len(arrays)
+    for array in arrays:
+        for i, status in enumerate(array.status, 1):
+            values = {pair.key: pair.value for pair in status.values}
+            assert (values['process'], values['node']) == (str(pid), f'/robot_{i}/robot')
+    assert [info.node_namespace for info in probe.get_publishers_info_by_topic('/diagnostics')
+            if info.node_namespace.startswith('/robot_')] == ['/robot_1']
     refused = call(probe, probe.create_client(SetParameters, '/robot_2/robot/set_parameters'),
                    SetParameters.Request(parameters=[
                        Parameter('use_sim_time', value=False).to_parameter_msg()]))
@@ -135,3 +153,71 @@ def test_a_team_fleet_whose_robots_differ_in_the_law_is_refused_in_one_line(
     errors = [line for line in log.splitlines() if '[ERROR]' in line]
     assert len(errors) == 1 and "'controller.gain': must be the same for every robot" in errors[0]
     assert 'Traceback' not in log
+
+
+def test_a_team_fleet_sends_one_status_array_and_serves_any_robots_cmd_vel(
+        processes, install, probe, tmp_path):
+    """
+    22 robots in two team fleets of 11: one DiagnosticArray per fleet and period, its robots'.
+
+    Each status keeps its robot's name and identity; a fleet's listener looks take
+    LISTENER_LOOKS < 11 robots each, so the last robot of a fleet is looked at only in turn
+    and its cmd_vel, subscribed to during the run, must still carry its commands.
+    """
+    n, fleet = 22, 11
+    assert LISTENER_LOOKS < fleet
+    lattice = [float(v) for k in range(n) for v in (2.0 * (k % 6), 2.0 * (k // 6))]
+    params = write_params(tmp_path, 'square_4.yaml', {
+        'transport': 'team', 'num_robots': n, 'formation.vertices': lattice,
+        'start.random_radius': 2.5, 'start.min_separation': 0.2})
+    arrays = []
+    probe.create_subscription(DiagnosticArray, '/diagnostics', lambda array: arrays.append(
+        (time.monotonic(), [(status.name, status.message, status.level,
+                             {pair.key: pair.value for pair in status.values})
+                            for status in array.status if status.name.startswith(
+                                'formation_ros/robot_')])), qos.DIAGNOSTICS)
+    robots = [f'formation_ros/robot_{i}' for i in range(1, n + 1)]
+
+    def latest():
+        found = {}
+        for _, statuses in arrays:
+            found.update({name: (message, level) for name, message, level, _ in statuses})
+        return found
+
+    launch(processes, install, params, options=('--robots-per-process', str(fleet)))
+    assert probe.spin_until(lambda: all(latest().get(name) == (
+        'controlling', DiagnosticStatus.OK) for name in robots), START_UP), (
+        latest(), processes.log('launcher'))
+
+    heard = []
+    probe.create_subscription(TwistStamped, f'/robot_{fleet}/cmd_vel', heard.append,
+                              qos.COMMAND)
+    subscribed = time.monotonic()
+    bound = LISTENERS_PERIOD * -(-fleet // LISTENER_LOOKS)
+    assert probe.spin_until(lambda: len(heard) >= 5, 30.0), latest()[robots[fleet - 1]]
+    served = time.monotonic() - subscribed
+
+    def window():
+        return [statuses for at, statuses in arrays if at >= subscribed and statuses]
+
+    assert probe.spin_until(lambda: len(window()) >= 6, 30.0), len(window())
+    per_process = {}
+    for statuses in window():
+        processes_in = {values['process'] for _, _, _, values in statuses}
+        assert len(processes_in) == 1 and len(statuses) == fleet, [s[0] for s in statuses]
+        first = int(statuses[0][0].rsplit('_', 1)[1])
+        assert first in (1, fleet + 1)
+        assert [name for name, _, _, _ in statuses] == robots[first - 1:first - 1 + fleet]
+        for name, _, _, values in statuses:
+            i = name.rsplit('_', 1)[1]
+            assert values['node'] == f'/robot_{i}/robot' and values['team: num_robots'] == '22'
+            assert 'host' in values and 'neighbours within R_i' in values
+        per_process.setdefault(processes_in.pop(), []).append(first)
+    assert len(per_process) == 2 and all(len(set(firsts)) == 1
+                                         for firsts in per_process.values()), per_process
+    elapsed = time.monotonic() - subscribed
+    assert all(len(firsts) <= elapsed / PERIOD + 1 for firsts in per_process.values()), (
+        elapsed, {process: len(firsts) for process, firsts in per_process.items()})
+    stop_when(probe, processes, lambda: True)
+    print(f'cmd_vel of robot {fleet} served {served:.2f} s after subscribing (looks bound '
+          f'{bound:g} s after discovery)')
