@@ -4,11 +4,12 @@
 """
 An independent listener that the multi-host tests run inside a host: what arrives there.
 
-``python hosts_probe.py OUT ROBOTS``: an rclpy node that writes one JSON line per message to
-OUT (line-buffered): ``{"m": time.monotonic(), "clock": s}`` for ``/clock`` (at most every
-0.05 s of simulated time), ``{"m": ..., "robot": i, "topic": "cmd_vel" | "pose", "stamp": s,
-"u": [x, y, z]}`` for ``/robot_<i>/cmd_vel`` and ``/robot_<i>/pose`` of each robot in ROBOTS
-(comma-separated ids, may be empty; ``u`` is the command or the position). CLOCK_MONOTONIC is
+``python hosts_probe.py OUT ROBOTS [TOPICS]``: an rclpy node that writes one JSON line per
+message to OUT (line-buffered): ``{"m": time.monotonic(), "clock": s}`` for ``/clock`` (at most
+every 0.05 s of simulated time), ``{"m": ..., "robot": i, "topic": "cmd_vel" | "pose", "stamp":
+s, "u": [x, y, z]}`` for ``/robot_<i>/cmd_vel`` and ``/robot_<i>/pose`` of each robot in ROBOTS
+(comma-separated ids, may be empty; ``u`` is the command or the position); TOPICS
+(comma-separated, default ``cmd_vel,pose``) says which of the two it hears. CLOCK_MONOTONIC is
 one clock for every network namespace, so the test can set these times against its own. Ends
 on SIGINT or SIGTERM.
 """
@@ -29,6 +30,7 @@ from rosgraph_msgs.msg import Clock
 def main(argv):
     """Listen and write until stopped."""
     out, robots = argv[1], [int(word) for word in argv[2].split(',') if word]
+    heard = set((argv[3] if len(argv) > 3 else 'cmd_vel,pose').split(','))
     rclpy.init(signal_handler_options=SignalHandlerOptions.NO)
     stop = []
     for number in (signal.SIGINT, signal.SIGTERM):
@@ -58,10 +60,12 @@ def main(argv):
 
     node.create_subscription(Clock, '/clock', on_clock, qos.CLOCK)
     for robot in robots:
-        node.create_subscription(TwistStamped, f'/robot_{robot}/cmd_vel',
-                                 lambda m, i=robot: on_command(i, m), qos.COMMAND)
-        node.create_subscription(PoseStamped, f'/robot_{robot}/pose',
-                                 lambda m, i=robot: on_pose(i, m), qos.STATE)
+        if 'cmd_vel' in heard:
+            node.create_subscription(TwistStamped, f'/robot_{robot}/cmd_vel',
+                                     lambda m, i=robot: on_command(i, m), qos.COMMAND)
+        if 'pose' in heard:
+            node.create_subscription(PoseStamped, f'/robot_{robot}/pose',
+                                     lambda m, i=robot: on_pose(i, m), qos.STATE)
     executor = SingleThreadedExecutor()
     executor.add_node(node)
     try:
