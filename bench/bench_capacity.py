@@ -77,6 +77,10 @@ def build_parser() -> argparse.ArgumentParser:
                         help='wall seconds measured after the clock starts (default %(default)g)')
     parser.add_argument('--startup-timeout', type=float, default=600.0,
                         help='wall seconds to wait for the clock to start (default %(default)g)')
+    parser.add_argument('--no-parameter-services', action='store_false',
+                        dest='parameter_services',
+                        help="fleet.parameter_services false: a fleet's first robot alone "
+                             'offers the parameter services (fewer DDS endpoints)')
     parser.add_argument('--lockstep', action='store_true',
                         help='run the plant in lockstep and report steps per second')
     parser.add_argument('--prefix', default=os.path.join(ROOT, 'install', 'formation_ros'),
@@ -132,13 +136,13 @@ def fresh_fraction(age_steps: Sequence[int], max_age: int) -> Optional[float]:
     return sum(age_steps[:kept + 1]) / total if total else None
 
 
-def case_params(n: int, rate: float, lockstep: bool,
-                transport: str = 'robot') -> Dict[str, Any]:
+def case_params(n: int, rate: float, lockstep: bool, transport: str = 'robot',
+                parameter_services: bool = True) -> Dict[str, Any]:
     """Parameters of one case (Section 5 constants, N robots, control and publish at RATE)."""
     params = params_for(n)
     params.update({'control_rate': float(rate), 'plant.publish_rate': float(rate),
                    'reference.rate': float(rate), 'plant.rate': PLANT_RATE, 'duration': 1e4,
-                   'transport': transport})
+                   'transport': transport, 'fleet.parameter_services': parameter_services})
     if lockstep:
         params.update({'plant.lockstep': True, 'plant.realtime_factor': 1e3})
     return params
@@ -176,15 +180,17 @@ def run_case(args: argparse.Namespace, mode: str, n: int, rate: float,
              folder: str, transport: str = 'robot') -> Dict[str, Any]:
     """Run one case and return its row."""
     params = os.path.join(folder, 'params.yaml')
-    write_params_file(params, case_params(n, rate, args.lockstep, transport))
+    write_params_file(params, case_params(n, rate, args.lockstep, transport,
+                                          args.parameter_services))
     run_dir = os.path.join(folder, 'run')
     log = os.path.join(folder, 'launcher.txt')
     command = ['bash', os.path.join(ROOT, 'scripts', 'launch_formation.sh'), params,
-               '--duration', '0', '--out', run_dir, '--prefix', args.prefix]
+               '--duration', '0', '--out', run_dir, '--prefix', args.prefix, '--no-plots']
     if mode == 'fleet':
         command += ['--robots-per-process', str(args.robots_per_process)]
     row: Dict[str, Any] = {'transport': transport, 'mode': mode, 'robots': n, 'rate_hz': rate,
-                           'lockstep': args.lockstep}
+                           'lockstep': args.lockstep,
+                           'parameter_services': args.parameter_services}
     with open(log, 'wb') as output:
         started = time.monotonic()
         process = subprocess.Popen(command, stdout=output, stderr=subprocess.STDOUT,

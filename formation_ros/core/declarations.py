@@ -318,6 +318,14 @@ DECLARATIONS = (
           'process or fleet per state; the per-robot topics only while something subscribes '
           'to them).', choices=_choices(Transport),
           users=frozenset({Exe.PLANT, Exe.ROBOT})),
+    Param('fleet.parameter_services', Kind.BOOL, True,
+          'In a fleet process, whether every robot node offers the parameter services (ros2 '
+          "param list, get, set, dump on /robot_<i>/robot). False: the fleet's first robot "
+          'alone does, and each other robot node has 12 DDS endpoints fewer (its parameters '
+          'are still declared, checked and announced on /diagnostics); discovery, start-up '
+          'and memory grow with the endpoints of every process, which is what limits a team '
+          'of a thousand robots. A robot process of its own always offers them.',
+          users=ROBOT),
     Param('wait_for_subscribers', Kind.INT, 1,
           'A robot sends its first command only once cmd_vel has this many subscribers (the '
           'plant; 2 when a recorder listens too).', low=at_least(0), high=at_least(1000),

@@ -98,7 +98,9 @@ class RobotSettings:
     A robot node's own parameters.
 
     plant_period: the simulated time between two states of the plant, s (``state_period``);
-    relay_period: the wall-clock time between two relay cycles, s (1 / ``relay.rate``).
+    relay_period: the wall-clock time between two relay cycles, s (1 / ``relay.rate``);
+    parameter_services: whether every robot node of a fleet offers the parameter services
+    (``fleet.parameter_services``; the fleet's first robot always does).
     """
 
     robot_id: int
@@ -108,6 +110,7 @@ class RobotSettings:
     pose_type: PoseType = PoseType.POSE_STAMPED
     plant_period: float = 0.02
     relay_period: float = 0.02
+    parameter_services: bool = True
 
 
 @dataclass(frozen=True)
@@ -523,7 +526,8 @@ def _own_settings(values: Mapping[str, Any], exe: Exe, n: int,
             pose_type=PoseType(values['pose_type']),
             plant_period=state_period(values['plant.rate'], values['plant.publish_rate'],
                                       values.get('plant.lockstep', False)),
-            relay_period=1.0 / values['relay.rate'])}
+            relay_period=1.0 / values['relay.rate'],
+            parameter_services=values['fleet.parameter_services'])}
     if exe is Exe.REFERENCE:
         step_ns = NS_PER_S / values['plant.rate']
         if not math.isfinite(step_ns):

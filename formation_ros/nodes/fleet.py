@@ -23,13 +23,16 @@ commands come from one call of the law per state, their clocks are set from the 
 (no ``/clock`` subscription), and the first robot alone hears ``/formation/reference``,
 ``/formation/shape`` and ``/formation/status`` for all of them. Either way the first robot
 publishes the fleet's ``/diagnostics``: one DiagnosticArray a second holding one status per
-robot, each named ``formation_ros/robot_<i>`` as a robot process names its own.
+robot, each named ``formation_ros/robot_<i>`` as a robot process names its own. With
+``fleet.parameter_services: false`` only the first robot's node offers the parameter services
+(``ros2 param``): each of the others then costs a dozen DDS endpoints less.
 """
 
 import re
 import sys
 from typing import List, Optional, Sequence
 
+from formation_ros.core.declarations import ParamError
 from formation_ros.nodes.robot import RobotNode, TeamLink
 from formation_ros.ros.runner import run
 from formation_ros.ros.sim_clock import share_sim_clock
@@ -104,9 +107,22 @@ def make_fleet(ids: Sequence[int]) -> List[RobotNode]:
         return []
     first = RobotNode(namespace=robot_namespace(ids[0]))
     team = first.config.team_transport
+    settings = first.config.robot
+    assert settings is not None
+    services = settings.parameter_services
     nodes = [first] + [RobotNode(namespace=robot_namespace(i), leader=first if team else None,
-                                 reports=False)
+                                 reports=False, start_parameter_services=services)
                        for i in ids[1:]]
+    differing = [node for node in nodes[1:] if node.config.robot is not None
+                 and node.config.robot.parameter_services != services]
+    if differing:
+        raise ParamError([('fleet.parameter_services', 'must be the same for every robot of a '
+                                                       "fleet (the first robot's value "
+                                                       'decides how the others are made)')])
+    if not services:
+        first.get_logger().info(f'fleet of {len(nodes)} robots: parameter services on '
+                                f'{first.get_fully_qualified_name()} alone '
+                                '(fleet.parameter_services false)')
     first.reported = nodes
     if team:
         TeamLink(nodes)

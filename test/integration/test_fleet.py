@@ -106,6 +106,30 @@ def test_each_robot_of_a_fleet_is_its_own_node_with_its_parameters(
     assert not refused.results[0].successful and 'fleet' in refused.results[0].reason
 
 
+def test_without_parameter_services_only_the_first_robot_offers_them(processes, install, probe):
+    processes.start(ProcessSpec('fleet', [exe(install, 'fleet'), '--robots', '1-3', '--ros-args',
+                                          '--params-file', SQUARE, '-p', 'use_sim_time:=true',
+                                          '-p', 'fleet.parameter_services:=false']))
+    statuses = {}
+    probe.create_subscription(
+        DiagnosticArray, '/diagnostics',
+        lambda m: statuses.update({status.name: status for status in m.status}), qos.DIAGNOSTICS)
+    assert probe.spin_until(
+        lambda: {('robot', f'/robot_{i}') for i in (1, 2, 3)}
+        <= set(probe.get_node_names_and_namespaces()) and len(statuses) == 3
+        and probe.count_publishers('/robot_3/cmd_vel') == 1, START_UP), processes.log('fleet')
+    services = {i: {name for name, _ in probe.get_service_names_and_types_by_node(
+        'robot', f'/robot_{i}')} for i in (1, 2, 3)}
+    assert '/robot_1/robot/get_parameters' in services[1], services[1]
+    assert not any('parameters' in name for i in (2, 3) for name in services[i]), services
+    answer = call(probe, probe.create_client(GetParameters, '/robot_1/robot/get_parameters'),
+                  GetParameters.Request(names=['fleet.parameter_services']))
+    assert answer.values[0].bool_value is False
+    assert sorted(statuses) == [f'formation_ros/robot_{i}' for i in (1, 2, 3)]
+    log = processes.log('fleet')
+    assert log.count('parameter services on /robot_1/robot alone') == 1, log
+
+
 def test_killing_one_fleet_process_stops_only_its_robots(processes, install, probe, tmp_path):
     heard, _ = watch_commands(probe, 4)
     clock = SimClock(probe)
