@@ -58,7 +58,7 @@ import json
 import os
 import shutil
 import time
-from typing import Any, Dict, List, Optional
+from typing import Any, Dict, List, Optional, Sequence
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.bodies import make_bodies
@@ -90,6 +90,7 @@ from formation_ros.ros.team import announced, PublisherWatch, team_problems, Tea
 from formation_ros.ros.wake import Wake
 from geometry_msgs.msg import PoseArray, PoseStamped, Twist, TwistStamped
 import numpy as np
+from numpy.typing import NDArray
 from rclpy.clock import Clock, ClockType
 from rclpy.duration import Duration
 from rclpy.node import Node
@@ -552,8 +553,10 @@ class PlantNode(Node):
     def _log(self, report: StepReport) -> None:
         """Say once what changed: a robot's command status, a bound violation, a collision."""
         status = report.admission.status
-        for i in np.flatnonzero(status != self.status):
-            self._log_status(int(i), CommandStatus(status[i]), report.t_ns)
+        changed = np.flatnonzero(status != self.status)
+        self._log_staleness(changed, status, report.t_ns)
+        for i in changed[status[changed] != CommandStatus.STALE].tolist():
+            self._log_status(i, CommandStatus(status[i]), report.t_ns)
         self.status = status
         for robot, value in report.violations:
             self.get_logger().error(
@@ -567,12 +570,28 @@ class PlantNode(Node):
                 f'collision: robots {i + 1} and {j + 1} are {distance:.3g} m apart at t = '
                 f'{self.model.t:.3f} s (< {limit})')
 
+    def _log_staleness(self, changed: NDArray[np.intp], status: NDArray[np.int_],
+                       t_ns: int) -> None:
+        """
+        Say in one line which robots' commands went stale this step, and which are fresh again.
+
+        A stall of a process (or of the machine) makes many robots' commands late at once: one
+        line names them all (the first few and how many more), not a line per robot.
+        """
+        stale = changed[status[changed] == CommandStatus.STALE].tolist()
+        ages = {i: (t_ns - int(self.commands.stamp_ns[i])) / NS_PER_S for i in stale}
+        self.once.start_group([f'stale-{i}' for i in stale], lambda keys: (
+            f"{robots_named(keys)}: latest command{'' if len(keys) == 1 else 's'} "
+            f'{max(ages[key_robot(key)] for key in keys):.3g} s old'
+            f"{'' if len(keys) == 1 else ' at most'}; using zero"))
+        fresh = changed[(status[changed] == CommandStatus.APPLIED)
+                        | (status[changed] == CommandStatus.SATURATED)].tolist()
+        self.once.end_group([f'stale-{i}' for i in fresh],
+                            lambda keys: f'{robots_named(keys)}: commands fresh again')
+
     def _log_status(self, i: int, status: CommandStatus, t_ns: int) -> None:
         age = (t_ns - int(self.commands.stamp_ns[i])) / NS_PER_S
-        if status is CommandStatus.STALE:
-            self.once.start(f'stale-{i}', f'robot {i + 1}: latest command is {age:.3g} s old; '
-                                          'using zero')
-        elif status is CommandStatus.FUTURE:
+        if status is CommandStatus.FUTURE:
             self.once.start(f'future-{i}', f'robot {i + 1}: command stamped {-age:.3g} s after '
                                            'the present state (a sender on another clock? '
                                            'check use_sim_time); using zero', 'error')
@@ -584,7 +603,6 @@ class PlantNode(Node):
                                               'allows; saturating it (counted in saturated '
                                               'command steps)', 'error')
         if status in (CommandStatus.APPLIED, CommandStatus.SATURATED):
-            self.once.end(f'stale-{i}', f'robot {i + 1}: commands fresh again')
             self.once.end(f'future-{i}', f'robot {i + 1}: commands answer present states again')
         if status is CommandStatus.APPLIED:
             self.once.end(f'saturated-{i}')
@@ -945,6 +963,21 @@ def _some(topics: List[str], shown: int = 3) -> str:
         return f'{topics[0]} has'
     more = f' and {len(topics) - shown} more topics' if len(topics) > shown else ''
     return f"{', '.join(topics[:shown])}{more} have"
+
+
+def key_robot(key: str) -> int:
+    """Return the robot index (0-based) of a per-robot log key such as ``stale-3``."""
+    return int(key.rsplit('-', 1)[1])
+
+
+def robots_named(keys: Sequence[str], shown: int = 5) -> str:
+    """Return 'robot 4', 'robots 1, 4 and 7' or 'robots 1, 2, 3, 4, 5 and 95 more' for keys."""
+    ids = sorted(key_robot(key) + 1 for key in keys)
+    if len(ids) == 1:
+        return f'robot {ids[0]}'
+    if len(ids) <= shown:
+        return f"robots {', '.join(map(str, ids[:-1]))} and {ids[-1]}"
+    return f"robots {', '.join(map(str, ids[:shown]))} and {len(ids) - shown} more"
 
 
 def main(args: Optional[List[str]] = None) -> int:

@@ -3,7 +3,7 @@
 
 """Log a condition once when it starts and once when it ends, not every cycle."""
 
-from typing import Any, Set
+from typing import Any, Callable, List, Sequence, Set
 
 
 class OnceLog:
@@ -19,6 +19,32 @@ class OnceLog:
         if key in self._active:
             return False
         self._active.add(key)
+        self._say(message, level)
+        return True
+
+    def start_group(self, keys: Sequence[str], message: Callable[[List[str]], str],
+                    level: str = 'warning') -> List[str]:
+        """
+        Mark ``keys`` active; log ``message(new)`` once for those that were not; return them.
+
+        One line for every condition of a cycle that starts at once (a thousand robots' commands
+        late after one stall), instead of a line each.
+        """
+        new = [key for key in keys if key not in self._active]
+        if new:
+            self._active.update(new)
+            self._say(message(new), level)
+        return new
+
+    def end_group(self, keys: Sequence[str], message: Callable[[List[str]], str]) -> List[str]:
+        """Mark ``keys`` inactive; log ``message(ended)`` (info) once for those active before."""
+        ended = [key for key in keys if key in self._active]
+        if ended:
+            self._active.difference_update(ended)
+            self._logger.info(message(ended))
+        return ended
+
+    def _say(self, message: str, level: str) -> None:
         # rclpy ties a severity to each call site, hence one call per level.
         if level == 'error':
             self._logger.error(message)
@@ -26,7 +52,6 @@ class OnceLog:
             self._logger.info(message)
         else:
             self._logger.warning(message)
-        return True
 
     def end(self, key: str, message: str = '') -> None:
         """Mark ``key`` inactive again, logging ``message`` (info) if it was active."""

@@ -180,6 +180,9 @@ def test_a_dead_robot_stays_still_while_the_others_go_on(processes, install, pro
     assert info.returncode == 1, log
     assert log.rstrip().endswith('exit code 1: robot_2 ended on its own (signal SIGKILL)'), log
     assert robot_pids(install, 2) == [] and project_processes(install) == []
+    stale = [line for line in log.splitlines() if 'latest command' in line]
+    assert len(stale) == 1 and stale[0].startswith('[plant] ') and \
+        'robot 2: latest command 0.5' in stale[0] and ' s old; using zero' in stale[0], stale
 
     trajectory = Trajectory.load(str(out / 'trajectory.npz'))
     timeout = load_config(SQUARE, Exe.PLANT).plant.input_timeout
