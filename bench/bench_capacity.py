@@ -233,8 +233,9 @@ def _sum_where(values: Mapping[str, float], robots: bool) -> float:
 
 
 def format_row(row: Mapping[str, Any]) -> str:
-    """One Markdown table row."""
-    head = f"| {row['mode']} | {row['robots']} | {row['rate_hz']:g} |"
+    """One Markdown table row (mode 'fleet -ps': without its robots' parameter services)."""
+    lean = ' -ps' if row.get('parameter_services') is False else ''
+    head = f"| {row['mode']}{lean} | {row['robots']} | {row['rate_hz']:g} |"
     transport = f" {row.get('transport', 'robot')} |"
     if 'error' in row:
         return head + f" {row['error']} |" + ' |' * 8 + transport

@@ -156,7 +156,7 @@ def test_the_topic_table_names_every_topic_with_its_qos():
 
 def test_the_capacity_table_has_every_row_of_the_json_files():
     lines = formation_docs.bench_capacity()
-    rows = [line for line in lines if re.match(r'\| (lockstep )?(process|fleet) \|', line)]
+    rows = [line for line in lines if re.match(r'\| (lockstep )?(process|fleet)( -ps)? \|', line)]
     expected = []
     for name in formation_docs.BENCH_FILES['capacity']:
         with open(os.path.join(DOCS, 'bench', name), encoding='utf-8') as stream:

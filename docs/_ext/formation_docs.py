@@ -46,7 +46,8 @@ LOG = logging.getLogger(__name__)
 ROBOT_PLACEHOLDER = '/robot_<i>'
 BENCH_FILES = {
     'capacity': ('capacity_process.json', 'capacity_fleet.json', 'capacity_lockstep.json',
-                 'capacity_transports.json', 'capacity_lockstep_transports.json'),
+                 'capacity_transports.json', 'capacity_lockstep_transports.json',
+                 'capacity_team_large.json'),
     'offline': ('offline.json',),
     'robustness': ('robustness.json',),
     'switch': ('switch.json',),
