@@ -322,9 +322,10 @@ DECLARATIONS = (
           'In a fleet process, whether every robot node offers the parameter services (ros2 '
           "param list, get, set, dump on /robot_<i>/robot). False: the fleet's first robot "
           'alone does, and each other robot node has 12 DDS endpoints fewer (its parameters '
-          'are still declared, checked and announced on /diagnostics); discovery, start-up '
-          'and memory grow with the endpoints of every process, which is what limits a team '
-          'of a thousand robots. A robot process of its own always offers them.',
+          'are still declared and checked, its team values announced on /diagnostics); '
+          'discovery, start-up and memory grow with the endpoints of every process, which is '
+          'what limits a team of a thousand robots. A robot process of its own always offers '
+          'them.',
           users=ROBOT),
     Param('wait_for_subscribers', Kind.INT, 1,
           'A robot sends its first command only once cmd_vel has this many subscribers (the '

@@ -26,7 +26,7 @@ Frames:
 
 from dataclasses import dataclass
 import math
-from typing import Optional, overload
+from typing import Any, Optional, overload, Tuple
 
 from formation_ros.core.unicycle import headings_from_quaternions
 import numpy as np
@@ -241,16 +241,19 @@ def matrix_from_quaternion(quat: ArrayLike) -> NDArray[np.float64]:
     """
     Return the rotation matrix (3, 3) of a quaternion (x, y, z, w) != 0, normalised first.
 
-    The same operations as :func:`_rotations` on floats: the same bits, a fifth of the time
+    The same operations as :func:`_rotations` on floats: the same bits, a quarter of the time
     for one quaternion (a team process turns each reference sample into a frame).
     """
     x, y, z, w = (float(v) for v in np.asarray(quat, dtype=float).reshape(4))
     norm = math.sqrt(x * x + y * y + z * z + w * w)
-    x, y, z, w = x / norm, y / norm, z / norm, w / norm
-    return np.array([
-        [1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w)],
-        [2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w)],
-        [2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)]])
+    return np.array(_rotation_rows(x / norm, y / norm, z / norm, w / norm))
+
+
+def _rotation_rows(x: Any, y: Any, z: Any, w: Any) -> Tuple[Tuple[Any, Any, Any], ...]:
+    """Return the rows of the rotation matrix of unit quaternions: floats or arrays alike."""
+    return ((1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w)),
+            (2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w)),
+            (2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)))
 
 
 QUATERNION_TOLERANCE = 1e-3
@@ -271,11 +274,7 @@ def _rotations(quaternion: ArrayLike) -> NDArray[np.float64]:
     """Return the rotation matrices (N, 3, 3) of valid quaternions (N, 4), normalised first."""
     quat = np.asarray(quaternion, dtype=float).reshape(-1, 4)
     x, y, z, w = (quat / np.linalg.norm(quat, axis=1, keepdims=True)).T
-    return np.stack([
-        np.stack([1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w)], -1),
-        np.stack([2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w)], -1),
-        np.stack([2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)], -1),
-    ], axis=1)
+    return np.stack([np.stack(row, -1) for row in _rotation_rows(x, y, z, w)], axis=1)
 
 
 def _planar_rotations(quaternion: ArrayLike) -> NDArray[np.float64]:

@@ -10,7 +10,6 @@ a call instead of all of them: :class:`Turns` hands out the indices of the next 
 going round. An item is then looked at within ceil(n / limit) calls of any change.
 """
 
-import math
 from typing import List, Optional
 
 
@@ -38,9 +37,3 @@ class Turns:
         start = self.cursor % n
         self.cursor = (start + self.limit) % n
         return [(start + k) % n for k in range(self.limit)]
-
-    def calls_to_see_all(self, n: int) -> int:
-        """Return how many calls at most it takes to look at every one of n items once."""
-        if n <= 0:
-            return 0
-        return 1 if self.limit is None else math.ceil(n / min(self.limit, n))

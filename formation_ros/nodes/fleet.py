@@ -116,6 +116,8 @@ def make_fleet(ids: Sequence[int]) -> List[RobotNode]:
     differing = [node for node in nodes[1:] if node.config.robot is not None
                  and node.config.robot.parameter_services != services]
     if differing:
+        for node in nodes:
+            node.destroy_node()
         raise ParamError([('fleet.parameter_services', 'must be the same for every robot of a '
                                                        "fleet (the first robot's value "
                                                        'decides how the others are made)')])

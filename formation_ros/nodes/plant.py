@@ -58,7 +58,7 @@ import json
 import os
 import shutil
 import time
-from typing import Any, Dict, List, Optional, Sequence
+from typing import Any, Dict, List, Optional
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.bodies import make_bodies
@@ -83,7 +83,7 @@ from formation_ros.ros.changes import Changes
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.liveliness import PeerLiveliness
 from formation_ros.ros.markers import formation_markers, Paths
-from formation_ros.ros.once import OnceLog
+from formation_ros.ros.once import OnceLog, robots_named
 from formation_ros.ros.parameters import declare_parameters
 from formation_ros.ros.runner import run
 from formation_ros.ros.team import announced, PublisherWatch, team_problems, TeamCheck
@@ -578,16 +578,19 @@ class PlantNode(Node):
         A stall of a process (or of the machine) makes many robots' commands late at once: one
         line names them all (the first few and how many more), not a line per robot.
         """
-        stale = changed[status[changed] == CommandStatus.STALE].tolist()
-        ages = {i: (t_ns - int(self.commands.stamp_ns[i])) / NS_PER_S for i in stale}
-        self.once.start_group([f'stale-{i}' for i in stale], lambda keys: (
-            f"{robots_named(keys)}: latest command{'' if len(keys) == 1 else 's'} "
-            f'{max(ages[key_robot(key)] for key in keys):.3g} s old'
+        stale = {f'stale-{i}': i
+                 for i in changed[status[changed] == CommandStatus.STALE].tolist()}
+        ages = {key: (t_ns - int(self.commands.stamp_ns[i])) / NS_PER_S
+                for key, i in stale.items()}
+        self.once.start_group(list(stale), lambda keys: (
+            f'{robots_named([stale[key] for key in keys])}: latest '
+            f"command{'' if len(keys) == 1 else 's'} {max(ages[key] for key in keys):.3g} s old"
             f"{'' if len(keys) == 1 else ' at most'}; using zero"))
-        fresh = changed[(status[changed] == CommandStatus.APPLIED)
-                        | (status[changed] == CommandStatus.SATURATED)].tolist()
-        self.once.end_group([f'stale-{i}' for i in fresh],
-                            lambda keys: f'{robots_named(keys)}: commands fresh again')
+        fresh = {f'stale-{i}': i for i in changed[
+            (status[changed] == CommandStatus.APPLIED)
+            | (status[changed] == CommandStatus.SATURATED)].tolist()}
+        self.once.end_group(list(fresh), lambda keys: (
+            f'{robots_named([fresh[key] for key in keys])}: commands fresh again'))
 
     def _log_status(self, i: int, status: CommandStatus, t_ns: int) -> None:
         age = (t_ns - int(self.commands.stamp_ns[i])) / NS_PER_S
@@ -963,21 +966,6 @@ def _some(topics: List[str], shown: int = 3) -> str:
         return f'{topics[0]} has'
     more = f' and {len(topics) - shown} more topics' if len(topics) > shown else ''
     return f"{', '.join(topics[:shown])}{more} have"
-
-
-def key_robot(key: str) -> int:
-    """Return the robot index (0-based) of a per-robot log key such as ``stale-3``."""
-    return int(key.rsplit('-', 1)[1])
-
-
-def robots_named(keys: Sequence[str], shown: int = 5) -> str:
-    """Return 'robot 4', 'robots 1, 4 and 7' or 'robots 1, 2, 3, 4, 5 and 95 more' for keys."""
-    ids = sorted(key_robot(key) + 1 for key in keys)
-    if len(ids) == 1:
-        return f'robot {ids[0]}'
-    if len(ids) <= shown:
-        return f"robots {', '.join(map(str, ids[:-1]))} and {ids[-1]}"
-    return f"robots {', '.join(map(str, ids[:shown]))} and {len(ids) - shown} more"
 
 
 def main(args: Optional[List[str]] = None) -> int:

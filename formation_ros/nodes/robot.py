@@ -97,6 +97,8 @@ import rclpy
 from rclpy.clock import Clock, ClockType
 from rclpy.duration import Duration
 from rclpy.node import Node
+from rclpy.publisher import Publisher
+from rclpy.timer import Timer
 from trajectory_msgs.msg import MultiDOFJointTrajectory
 
 Read = TypeVar('Read')
@@ -230,6 +232,8 @@ class RobotNode(Node):
         self.reported: List[RobotNode] = [self]
         """The robots whose statuses this node publishes (a fleet's first robot: all of its)."""
         self.announcing: Optional[Tuple[Shape, Dict[str, str]]] = None
+        self.diagnostics_pub: Optional[Publisher] = None
+        self.diagnostics_timer: Optional[Timer] = None
         if reports:
             self.diagnostics_pub = self.create_publisher(DiagnosticArray, topics.DIAGNOSTICS,
                                                          qos.DIAGNOSTICS)
@@ -720,7 +724,9 @@ class RobotNode(Node):
 
     def on_diagnostics(self) -> None:
         """Publish one DiagnosticArray with the status of each robot this node reports."""
-        self.diagnostics_pub.publish(encode_statuses([node.status() for node in self.reported]))
+        if self.diagnostics_pub is not None:
+            self.diagnostics_pub.publish(
+                encode_statuses([node.status() for node in self.reported]))
 
     def _announcement(self, stamp_ns: int) -> Dict[str, str]:
         """Return the team values and identity this robot announces, made again on a new shape."""

@@ -543,18 +543,6 @@ class StatusData:
     values: Sequence[Tuple[str, str]]
 
 
-def _put_string(out: bytearray, text: str) -> None:
-    """Append a CDR string to ``out`` (from the encapsulation header on): length 4-aligned."""
-    raw = text.encode('utf-8')
-    out += _ZEROS[-len(out) % 4]
-    out += struct.pack('<I', len(raw) + 1)
-    out += raw
-    out += b'\x00'
-
-
-_ZEROS = (b'', b'\x00', b'\x00\x00', b'\x00\x00\x00')
-
-
 def encode_diagnostics(stamp_ns: int, statuses: Sequence[StatusData]) -> bytes:
     """
     Return a serialized diagnostic_msgs/DiagnosticArray stamped ``stamp_ns`` (no frame).
@@ -564,16 +552,13 @@ def encode_diagnostics(stamp_ns: int, statuses: Sequence[StatusData]) -> bytes:
     ``out`` align as offsets from the end of the header do).
     """
     out = bytearray(encode_header(stamp_ns, ''))
-    out += _ZEROS[-len(out) % 4]
-    out += struct.pack('<I', len(statuses))
+    out += _pad(len(out), 4) + struct.pack('<I', len(statuses))
     for status in statuses:
         out.append(status.level)
-        _put_string(out, status.name)
-        _put_string(out, status.message)
-        _put_string(out, status.hardware_id)
-        out += _ZEROS[-len(out) % 4]
-        out += struct.pack('<I', len(status.values))
+        for text in (status.name, status.message, status.hardware_id):
+            out += _pad(len(out), 4) + _string(text)
+        out += _pad(len(out), 4) + struct.pack('<I', len(status.values))
         for key, value in status.values:
-            _put_string(out, key)
-            _put_string(out, value)
+            out += _pad(len(out), 4) + _string(key)
+            out += _pad(len(out), 4) + _string(value)
     return bytes(out)

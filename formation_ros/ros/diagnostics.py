@@ -11,22 +11,21 @@ whichever clock the node itself runs on, so statuses from nodes with and without
 (``simulated time [s]``, ``stale command steps``); counts have no unit.
 
 A process holding many robot nodes (a fleet) publishes one DiagnosticArray a period with one
-status per robot (:func:`make_status` of each, then :func:`encode_statuses`), written as CDR
-bytes: a message of Python objects (a KeyValue per value) costs about four times as much.
+status per robot (:func:`make_status` of each, then :func:`encode_statuses`). Every array is
+written as CDR bytes: a message of Python objects (a KeyValue per value) costs about four times
+as much.
 """
 
 import time
 from typing import Any, Mapping, Sequence
 
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from diagnostic_msgs.msg import DiagnosticStatus
 from formation_ros.ros.cdr import encode_diagnostics, StatusData
-from rclpy.clock import Clock, ClockType
 
 PERIOD = 1.0
 LEVELS = {'ok': DiagnosticStatus.OK, 'warn': DiagnosticStatus.WARN,
           'error': DiagnosticStatus.ERROR}
 HARDWARE_ID = 'formation_ros'
-_WALL = Clock(clock_type=ClockType.SYSTEM_TIME)
 
 
 def format_value(value: Any) -> str:
@@ -34,24 +33,17 @@ def format_value(value: Any) -> str:
     return f'{value:.6g}' if isinstance(value, float) else str(value)
 
 
-def diagnostics(name: str, level: str, message: str,
-                values: Mapping[str, Any]) -> DiagnosticArray:
+def diagnostics(name: str, level: str, message: str, values: Mapping[str, Any]) -> bytes:
     """
-    Build a DiagnosticArray with one status, stamped with the system time now.
+    Return a serialized DiagnosticArray with one status, stamped with the system time now.
 
     name: e.g. 'formation_ros/plant'; level: 'ok', 'warn' or 'error'; values: {key: value}.
     """
-    status = DiagnosticStatus(level=LEVELS[level], name=name, message=message,
-                              hardware_id=HARDWARE_ID)
-    status.values = [KeyValue(key=key, value=format_value(value))
-                     for key, value in values.items()]
-    array = DiagnosticArray(status=[status])
-    array.header.stamp = _WALL.now().to_msg()
-    return array
+    return encode_statuses([make_status(name, level, message, values)])
 
 
 def make_status(name: str, level: str, message: str, values: Mapping[str, Any]) -> StatusData:
-    """Return one status (as :func:`diagnostics` builds it) for :func:`encode_statuses`."""
+    """Return one status for :func:`encode_statuses`: values formatted by format_value."""
     return StatusData(LEVELS[level][0], name, message, HARDWARE_ID,
                       [(key, format_value(value)) for key, value in values.items()])
 

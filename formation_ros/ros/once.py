@@ -63,3 +63,13 @@ class OnceLog:
     def is_active(self, key: str) -> bool:
         """Whether ``key`` is active."""
         return key in self._active
+
+
+def robots_named(indices: Sequence[int], shown: int = 5) -> str:
+    """Return 'robot 4', 'robots 1, 4 and 7' or 'robots 1, 2, 3, 4, 5 and 95 more' (0-based in)."""
+    ids = sorted(i + 1 for i in indices)
+    if len(ids) == 1:
+        return f'robot {ids[0]}'
+    if len(ids) <= shown:
+        return f"robots {', '.join(map(str, ids[:-1]))} and {ids[-1]}"
+    return f"robots {', '.join(map(str, ids[:shown]))} and {len(ids) - shown} more"

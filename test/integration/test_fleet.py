@@ -114,20 +114,44 @@ def test_without_parameter_services_only_the_first_robot_offers_them(processes, 
     probe.create_subscription(
         DiagnosticArray, '/diagnostics',
         lambda m: statuses.update({status.name: status for status in m.status}), qos.DIAGNOSTICS)
+
+    def services():
+        return {i: {name for name, _ in probe.get_service_names_and_types_by_node(
+            'robot', f'/robot_{i}')} for i in (1, 2, 3)}
+
+    # Each robot node offers its type description service whatever fleet.parameter_services
+    # says: once it is seen, the node's services have been discovered.
     assert probe.spin_until(
         lambda: {('robot', f'/robot_{i}') for i in (1, 2, 3)}
         <= set(probe.get_node_names_and_namespaces()) and len(statuses) == 3
-        and probe.count_publishers('/robot_3/cmd_vel') == 1, START_UP), processes.log('fleet')
-    services = {i: {name for name, _ in probe.get_service_names_and_types_by_node(
-        'robot', f'/robot_{i}')} for i in (1, 2, 3)}
-    assert '/robot_1/robot/get_parameters' in services[1], services[1]
-    assert not any('parameters' in name for i in (2, 3) for name in services[i]), services
+        and all(f'/robot_{i}/robot/get_type_description' in offered
+                for i, offered in services().items()), START_UP), (
+        services(), processes.log('fleet'))
+    offered = services()
+    assert '/robot_1/robot/get_parameters' in offered[1], offered[1]
+    assert not any('parameters' in name for i in (2, 3) for name in offered[i]), offered
     answer = call(probe, probe.create_client(GetParameters, '/robot_1/robot/get_parameters'),
                   GetParameters.Request(names=['fleet.parameter_services']))
     assert answer.values[0].bool_value is False
     assert sorted(statuses) == [f'formation_ros/robot_{i}' for i in (1, 2, 3)]
     log = processes.log('fleet')
     assert log.count('parameter services on /robot_1/robot alone') == 1, log
+
+
+def test_a_fleet_whose_robots_differ_in_parameter_services_is_refused_in_one_line(
+        processes, install, probe, tmp_path):
+    own = tmp_path / 'robot_2.yaml'
+    own.write_text(yaml.safe_dump({'/robot_2/robot': {'ros__parameters': {
+        'fleet': {'parameter_services': False}}}}))
+    processes.start(ProcessSpec('fleet', [exe(install, 'fleet'), '--robots', '1-3', '--ros-args',
+                                          '--params-file', SQUARE, '--params-file', str(own),
+                                          '-p', 'use_sim_time:=true']))
+    info = wait_exit(probe, processes, 'fleet', START_UP)
+    log = processes.log('fleet')
+    assert info is not None and info.returncode == 2, log
+    errors = [line for line in log.splitlines() if '[ERROR]' in line]
+    assert len(errors) == 1 and "'fleet.parameter_services': must be the same" in errors[0], log
+    assert 'Traceback' not in log
 
 
 def test_killing_one_fleet_process_stops_only_its_robots(processes, install, probe, tmp_path):
@@ -208,7 +232,7 @@ def test_a_team_fleet_sends_one_status_array_and_serves_any_robots_cmd_vel(
             found.update({name: (message, level) for name, message, level, _ in statuses})
         return found
 
-    launch(processes, install, params, options=('--robots-per-process', str(fleet)))
+    launch(processes, install, params, per_process=fleet)
     assert probe.spin_until(lambda: all(latest().get(name) == (
         'controlling', DiagnosticStatus.OK) for name in robots), START_UP), (
         latest(), processes.log('launcher'))
@@ -242,6 +266,6 @@ def test_a_team_fleet_sends_one_status_array_and_serves_any_robots_cmd_vel(
     elapsed = time.monotonic() - subscribed
     assert all(len(firsts) <= elapsed / PERIOD + 1 for firsts in per_process.values()), (
         elapsed, {process: len(firsts) for process, firsts in per_process.items()})
-    stop_when(probe, processes, lambda: True)
+    assert stop_when(probe, processes, lambda: True).returncode == 0, processes.log('launcher')
     print(f'cmd_vel of robot {fleet} served {served:.2f} s after subscribing (looks bound '
           f'{bound:g} s after discovery)')

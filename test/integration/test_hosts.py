@@ -23,7 +23,7 @@ import subprocess
 import sys
 import time
 
-from formation_ros.core.declarations import Exe
+from formation_ros.core.declarations import Exe, ReferenceKind
 from formation_ros.core.params import load_config
 from formation_ros.ros.watch import watch_environment
 from formation_ros.tools import hosts as hosts_module
@@ -168,12 +168,16 @@ class Run:
 
         The square's reference is fixed at the origin; the plant's host hears every pose.
         """
-        vertices = load_config(self.params).vertices
+        config = load_config(self.params)
+        reference = config.reference()
+        assert reference.kind is ReferenceKind.FIXED and not np.any(reference.origin), \
+            'the vertices are the goals of a fixed reference at the origin'
+        vertices = config.vertices
         plant = self.probes['plant']
 
         def settled():
             latest = plant.latest_positions()
-            return plant.clock() >= after and len(latest) == 4 and all(
+            return plant.clock() >= after and len(latest) == len(vertices) and all(
                 np.linalg.norm(np.asarray(q[:2]) - vertices[i - 1]) <= SETTLED / 2
                 for i, q in latest.items())
         self.wait(settled, f'every robot within {SETTLED / 2} m of its vertex after {after} s')

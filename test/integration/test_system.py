@@ -77,10 +77,11 @@ def test_robot_publishes_zero_when_its_plant_stops(processes, install, probe):
 
 
 def lockstep_matches_simulation(processes, install, probe, tmp_path, source, changes=(),
-                                until=1.5):
+                                until=1.5, one_fleet=True):
     """
     Run ``source`` (with ``changes``) in lockstep to ``until`` s; assert it is formation_sim's.
 
+    one_fleet: the robots in one fleet process (else one process each, the launcher's default).
     Returns (the plant's trajectory, the parameters file).
     """
     params = write_params(tmp_path, source, {'plant.lockstep': True,
@@ -88,7 +89,8 @@ def lockstep_matches_simulation(processes, install, probe, tmp_path, source, cha
     config = load_config(params)
     clock = SimClock(probe)
     out = tmp_path / 'lockstep'
-    launch(processes, install, params, out=out, per_process=config.num_robots)
+    launch(processes, install, params, out=out,
+           per_process=config.num_robots if one_fleet else None)
     info = stop_when(probe, processes, lambda: clock.seconds >= until)
     assert info.returncode == 0, processes.log('launcher')
     plant = Trajectory.load(str(out / 'trajectory.npz'))
@@ -102,7 +104,8 @@ def lockstep_matches_simulation(processes, install, probe, tmp_path, source, cha
 
 
 def test_lockstep_equals_formation_sim_fixed_reference(processes, install, probe, tmp_path):
-    lockstep_matches_simulation(processes, install, probe, tmp_path, 'square_4.yaml')
+    lockstep_matches_simulation(processes, install, probe, tmp_path, 'square_4.yaml',
+                                one_fleet=False)
 
 
 def test_lockstep_equals_formation_sim_moving_reference(processes, install, probe, tmp_path):

@@ -3,7 +3,7 @@
 
 """A DiagnosticArray written as bytes (one per fleet): what rclpy reads from it."""
 
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
 from formation_ros.ros.cdr import encode_diagnostics, StatusData
 from formation_ros.ros.diagnostics import diagnostics, encode_statuses, make_status
 import pytest
@@ -33,8 +33,14 @@ def test_rclpy_reads_every_status_of_the_array_as_written(count):
 
 
 def test_a_status_as_bytes_equals_the_status_as_a_message():
-    message = diagnostics('formation_ros/robot_3', 'warn', 'waiting for its first inputs',
-                          VALUES).status[0]
+    message = DiagnosticStatus(level=DiagnosticStatus.WARN, name='formation_ros/robot_3',
+                               message='waiting for its first inputs', hardware_id='formation_ros')
+    message.values = [KeyValue(key=key, value=f'{value:.6g}' if isinstance(value, float)
+                               else str(value)) for key, value in VALUES.items()]
+    alone = deserialize_message(diagnostics('formation_ros/robot_3', 'warn',
+                                            'waiting for its first inputs', VALUES),
+                                DiagnosticArray)
+    assert [fields(status) for status in alone.status] == [fields(message)]
     written = deserialize_message(encode_statuses(
         [make_status('formation_ros/robot_3', 'warn', 'waiting for its first inputs', VALUES),
          make_status('formation_ros/robot_4', 'error', 'two teams', {})]), DiagnosticArray)

@@ -3,8 +3,7 @@
 
 """Conditions logged once when they start and once when they end, alone or many at once."""
 
-from formation_ros.nodes.plant import robots_named
-from formation_ros.ros.once import OnceLog
+from formation_ros.ros.once import OnceLog, robots_named
 
 
 class Logger:
@@ -49,7 +48,6 @@ def test_a_group_ending_names_only_those_that_were_active():
 
 
 def test_robots_are_named_one_by_one_up_to_five_then_counted():
-    assert robots_named(['stale-3']) == 'robot 4'
-    assert robots_named(['stale-6', 'stale-0', 'stale-3']) == 'robots 1, 4 and 7'
-    keys = [f'stale-{i}' for i in range(100)]
-    assert robots_named(keys) == 'robots 1, 2, 3, 4, 5 and 95 more'
+    assert robots_named([3]) == 'robot 4'
+    assert robots_named([6, 0, 3]) == 'robots 1, 4 and 7'
+    assert robots_named(range(100)) == 'robots 1, 2, 3, 4, 5 and 95 more'
