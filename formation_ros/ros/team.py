@@ -7,11 +7,11 @@ One team: announce the values every node must agree on, and name the nodes that 
 Every formation node adds ``core.team.team_values`` to its ``/diagnostics`` status under keys
 ``team: <name>``, and who it is: its host, process id and node name (:func:`announced`; the
 ROS graph names a node but not its host). The plant and the reference hear every node's status
-(:class:`TeamCheck`: the callback stores, the node's diagnostics timer compares) and name each
-node whose values differ from their own. The shape in force may differ for a moment after a
-switch (a node takes it a few milliseconds later, and announcements are a second apart), so a
-shape counts as different only when it is none of the shapes this node itself had in force in
-its last :data:`RECENT` checks.
+(:class:`TeamCheck`: the callback keeps each array, the node's diagnostics timer reads and
+compares) and name each node whose values differ from their own. The shape in force may
+differ for a moment after a switch (a node takes it a few milliseconds later, and announcements
+are a second apart), so a shape counts as different only when it is none of the shapes this
+node itself had in force in its last :data:`RECENT` checks.
 
 One team per domain: :class:`PublisherWatch` looks, on the node's timer, for publishers on a
 topic besides the one expected (:func:`formation_ros.core.team.duplicate_due` decides when one
@@ -41,6 +41,9 @@ HOST, PROCESS, NODE = 'host', 'process', 'node'
 LIVE_FOR = 3.0
 """A process that announced itself on /diagnostics within this many seconds (three of its
 once-a-second statuses) is taken to be running."""
+PENDING = 4096
+"""Arrays heard between two looks that are kept (a look comes once a second: N / 25 arrays a
+second from fleets of 25, one a second from each other node)."""
 Process = Tuple[str, str]
 """(host name, process id) as a node announces them."""
 
@@ -85,10 +88,20 @@ class TeamCheck:
         self.heard: Dict[str, Dict[str, str]] = {}
         self.processes: Dict[str, Dict[Process, float]] = {}
         self.own_recent: deque = deque(maxlen=RECENT)
+        self.pending: deque = deque(maxlen=PENDING)
         node.create_subscription(DiagnosticArray, topics.DIAGNOSTICS, self.store,
                                  qos.DIAGNOSTICS)
 
     def store(self, msg: DiagnosticArray) -> None:
+        """Keep an array heard, and when, for the next look (the oldest beyond PENDING go)."""
+        self.pending.append((time.monotonic(), msg))
+
+    def _take(self) -> None:
+        """Read the arrays heard since the last look (:meth:`_read`)."""
+        while self.pending:
+            self._read(*self.pending.popleft())
+
+    def _read(self, heard_at: float, msg: DiagnosticArray) -> None:
         """
         Keep the team values each formation node announced last, and when each process spoke.
 
@@ -105,7 +118,7 @@ class TeamCheck:
                 continue
             if keys.get(PROCESS):
                 name = keys.get(NODE) or status.name
-                self.processes.setdefault(name, {})[process] = time.monotonic()
+                self.processes.setdefault(name, {})[process] = heard_at
             values = {key[len(PREFIX):]: value for key, value in keys.items()
                       if key.startswith(PREFIX)}
             if values:
@@ -113,6 +126,7 @@ class TeamCheck:
 
     def running(self, node_name: str, now: float) -> List[Process]:
         """Return the other processes that announced node ``node_name`` in the last LIVE_FOR s."""
+        self._take()
         return sorted(process for process, when in self.processes.get(node_name, {}).items()
                       if now - when <= LIVE_FOR)
 
@@ -126,6 +140,7 @@ class TeamCheck:
 
     def disagreeing(self, own: Mapping[str, str]) -> Dict[str, Dict[str, str]]:
         """Return {node: {value: 'theirs (here: ours)'}} of the nodes whose last word differs."""
+        self._take()
         self.own_recent.append(dict(own))
         found: Dict[str, Dict[str, str]] = {}
         for name, values in self.heard.items():
