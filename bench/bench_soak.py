@@ -36,6 +36,7 @@ sys.path[:0] = [ROOT, BENCH]
 
 from bench_core import params_for  # noqa: E402
 from formation_ros.core.params_file import write_params_file  # noqa: E402, I100
+from formation_ros.ros.watch import stat_fields  # noqa: E402
 
 NODES = ('plant', 'reference', 'robot', 'record', 'fleet')
 LAUNCHER = 'launcher'
@@ -111,15 +112,13 @@ def _process_table() -> Dict[int, Tuple[int, List[str]]]:
         if not entry.isdigit():
             continue
         try:
-            with open(f'/proc/{entry}/stat', 'rb') as stream:
-                stat = stream.read()
+            parent = int(stat_fields(int(entry))[1])
             with open(f'/proc/{entry}/cmdline', 'rb') as stream:
                 cmdline = stream.read()
-        except OSError:
+        except (OSError, ValueError, IndexError):
             continue
-        fields_after_name = stat[stat.rfind(b')') + 2:].split()
         args = [arg.decode(errors='replace') for arg in cmdline.split(b'\0') if arg]
-        table[int(entry)] = (int(fields_after_name[1]), args)
+        table[int(entry)] = (parent, args)
     return table
 
 
