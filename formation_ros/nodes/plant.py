@@ -554,9 +554,10 @@ class PlantNode(Node):
         """Say once what changed: a robot's command status, a bound violation, a collision."""
         status = report.admission.status
         changed = np.flatnonzero(status != self.status)
-        self._log_staleness(changed, status, report.t_ns)
-        for i in changed[status[changed] != CommandStatus.STALE].tolist():
-            self._log_status(i, CommandStatus(status[i]), report.t_ns)
+        if changed.size:
+            self._log_staleness(changed, status, report.t_ns)
+            for i in changed[status[changed] != CommandStatus.STALE].tolist():
+                self._log_status(i, CommandStatus(status[i]), report.t_ns)
         self.status = status
         for robot, value in report.violations:
             self.get_logger().error(
