@@ -278,8 +278,9 @@ class PlantNode(Node):
         self.team_reader = TeamCommandReader(self.n)
         self.team_liveliness = PeerLiveliness()
         self.team_sub = self.create_subscription(
-            MultiDOFJointTrajectory, topics.TEAM_COMMANDS, self.on_team_command, qos.COMMAND,
-            raw=True, event_callbacks=self.team_liveliness.callbacks())
+            MultiDOFJointTrajectory, topics.TEAM_COMMANDS, self.on_team_command,
+            qos.team_commands_input(self.n), raw=True,
+            event_callbacks=self.team_liveliness.callbacks())
         self.listeners_timer = self.create_timer(LISTENERS_PERIOD, self._look_at_listeners,
                                                  clock=self.steady)
         self._look_at_listeners()
