@@ -16,7 +16,8 @@ process per robot ('process') or --robots-per-process robots per 'fleet' process
 with the per-robot topics ('robot', the default) or the team messages ('team': one state message,
 one command message per process per state; parameter transport). It measures the
 start-up (launch until the plant starts its clock: every robot has answered), then for MEASURE
-wall seconds the CPU time and resident memory of every process of the run, then stops the run
+wall seconds the CPU time and memory of every process of the run (resident, RSS, and
+proportional, PSS: shared libraries counted once over all processes), then stops the run
 with Ctrl-C and reads the plant's plant_stats.json: the achieved step rate, the fraction of
 steps at which every robot's applied command answered a state at most two control periods old
 ('fresh'), and the latency from the plant publishing a state to the answer arriving (p50, p99,
@@ -44,7 +45,8 @@ ROOT = os.path.dirname(BENCH)
 sys.path[:0] = [ROOT, BENCH]
 
 from bench_core import params_for  # noqa: E402
-from bench_soak import find_run_processes, LAUNCHER, read_rss_kib  # noqa: E402
+from bench_soak import (find_run_processes, LAUNCHER, read_pss_kib,  # noqa: E402
+                        read_rss_kib)
 from formation_ros.core.params_file import write_params_file  # noqa: E402, I100
 from formation_ros.ros.watch import stat_fields  # noqa: E402
 
@@ -160,9 +162,11 @@ def wait_for_text(path: str, text: str, process: 'subprocess.Popen[bytes]',
     return False
 
 
-def snapshot(pids: Mapping[str, int]) -> Dict[str, Tuple[Optional[float], Optional[int]]]:
-    """Return {name: (CPU seconds, RSS KiB)} of the processes."""
-    return {name: (cpu_seconds(pid), read_rss_kib(pid)) for name, pid in pids.items()}
+def snapshot(pids: Mapping[str, int]) -> Dict[str, Tuple[Optional[float], Optional[int],
+                                                        Optional[int]]]:
+    """Return {name: (CPU seconds, RSS KiB, PSS KiB)} of the processes."""
+    return {name: (cpu_seconds(pid), read_rss_kib(pid), read_pss_kib(pid))
+            for name, pid in pids.items()}
 
 
 def stop(process: 'subprocess.Popen[bytes]') -> None:
@@ -213,6 +217,8 @@ def run_case(args: argparse.Namespace, mode: str, n: int, rate: float,
                           if before[name][0] is not None and after[name][0] is not None}
     row['rss_mib'] = {name: after[name][1] / 1024.0 for name in pids
                       if after[name][1] is not None}
+    row['pss_mib'] = {name: after[name][2] / 1024.0 for name in pids
+                      if after[name][2] is not None}
     stats_path = os.path.join(run_dir, 'plant_stats.json')
     if not os.path.isfile(stats_path):
         row['error'] = 'no plant_stats.json (see launcher.txt)'
@@ -238,22 +244,23 @@ def format_row(row: Mapping[str, Any]) -> str:
     head = f"| {row['mode']}{lean} | {row['robots']} | {row['rate_hz']:g} |"
     transport = f" {row.get('transport', 'robot')} |"
     if 'error' in row:
-        return head + f" {row['error']} |" + ' |' * 8 + transport
+        return head + f" {row['error']} |" + ' |' * 9 + transport
     latency = row['latency_ms']
     fresh = row['fresh_fraction']
     cpu, rss = row['cpu_percent'], row['rss_mib']
+    pss = f"{sum(row['pss_mib'].values()) / 1024.0:.2f}" if 'pss_mib' in row else '-'
     return (head + f" {row['processes']} | {row['startup_s']:.1f} | {row['step_rate']:.1f} | "
             f"{'-' if fresh is None else f'{100.0 * fresh:.1f}'} | "
             f"{latency['p50_ms'] or 0:.1f} / {latency['p99_ms'] or 0:.1f} / "
             f"{latency['max_ms']:.0f} | {cpu.get('plant', 0.0):.0f} | "
             f'{_sum_where(cpu, True):.0f} | {rss.get("plant", 0.0):.0f} | '
-            f'{sum(rss.values()) / 1024.0:.2f} |' + transport)
+            f'{sum(rss.values()) / 1024.0:.2f} | {pss} |' + transport)
 
 
 HEADER = ('| mode | N | rate (Hz) | processes | start-up (s) | plant steps/s | fresh (%) | '
           'latency p50 / p99 / max (ms) | plant CPU (%) | robots CPU (%) | plant RSS (MiB) | '
-          'all RSS (GiB) | transport |\n'
-          '|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|')
+          'all RSS (GiB) | all PSS (GiB) | transport |\n'
+          '|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|')
 
 
 def write_figure(path: str, rows: Sequence[Mapping[str, Any]]) -> None:

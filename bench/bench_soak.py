@@ -105,6 +105,24 @@ def read_rss_kib(pid: int) -> Optional[int]:
     return None
 
 
+def read_pss_kib(pid: int) -> Optional[int]:
+    """
+    Return the proportional set size of process ``pid`` in KiB, or None when it is gone.
+
+    Its private pages and its share of the pages it shares (libraries, shared memory): the sum
+    over processes is the memory they take from the machine, where the sum of their RSS counts
+    each shared library once per process.
+    """
+    try:
+        with open(f'/proc/{pid}/smaps_rollup', encoding='ascii', errors='replace') as stream:
+            for line in stream:
+                if line.startswith('Pss:'):
+                    return int(line.split()[1])
+    except (FileNotFoundError, ProcessLookupError, PermissionError):
+        return None
+    return None
+
+
 def _process_table() -> Dict[int, Tuple[int, List[str]]]:
     """Map every visible pid to (parent pid, command line arguments)."""
     table: Dict[int, Tuple[int, List[str]]] = {}

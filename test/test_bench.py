@@ -103,11 +103,14 @@ def test_finds_the_nodes_a_process_started_and_reads_their_memory(soak, fake_ins
         assert found == {'robot_3': children[0].pid, 'plant': children[1].pid}
         assert soak.find_run_processes(children[2].pid, str(fake_install)) == {}
         assert soak.read_rss_kib(children[0].pid) > 1000
+        # a child's share of the pages it shares with the others is less than all of them
+        assert 0 < soak.read_pss_kib(children[0].pid) < soak.read_rss_kib(children[0].pid)
     finally:
         for child in children:
             child.stdin.close()
             child.wait(timeout=30)
     assert soak.read_rss_kib(children[0].pid) is None
+    assert soak.read_pss_kib(children[0].pid) is None
 
 
 def test_summary_compares_first_and_last_window(soak):

@@ -119,23 +119,28 @@ def test_without_parameter_services_only_the_first_robot_offers_them(processes, 
         return {i: {name for name, _ in probe.get_service_names_and_types_by_node(
             'robot', f'/robot_{i}')} for i in (1, 2, 3)}
 
-    # Each robot node offers its type description service whatever fleet.parameter_services
-    # says: once it is seen, the node's services have been discovered.
+    def robot_3_seen():
+        return ('/robot_3/cmd_vel' in dict(probe.get_publisher_names_and_types_by_node(
+            'robot', '/robot_3')) and '/robot_3/pose' in dict(
+                probe.get_subscriber_names_and_types_by_node('robot', '/robot_3')))
+
+    # A node's services are made before its topics, and robot 2 before robot 3, and one
+    # process announces its readers and writers in the order it made them: once robot 3's
+    # pose reader and cmd_vel writer are seen, any service of robots 1 and 2 would be too.
     assert probe.spin_until(
         lambda: {('robot', f'/robot_{i}') for i in (1, 2, 3)}
         <= set(probe.get_node_names_and_namespaces()) and len(statuses) == 3
-        and all(f'/robot_{i}/robot/get_type_description' in offered
-                for i, offered in services().items()), START_UP), (
-        services(), processes.log('fleet'))
+        and robot_3_seen(), START_UP), (services(), processes.log('fleet'))
     offered = services()
-    assert '/robot_1/robot/get_parameters' in offered[1], offered[1]
-    assert not any('parameters' in name for i in (2, 3) for name in offered[i]), offered
+    assert {'/robot_1/robot/get_parameters',
+            '/robot_1/robot/get_type_description'} <= offered[1], offered[1]
+    assert not offered[2] and not offered[3], offered
     answer = call(probe, probe.create_client(GetParameters, '/robot_1/robot/get_parameters'),
                   GetParameters.Request(names=['fleet.parameter_services']))
     assert answer.values[0].bool_value is False
     assert sorted(statuses) == [f'formation_ros/robot_{i}' for i in (1, 2, 3)]
     log = processes.log('fleet')
-    assert log.count('parameter services on /robot_1/robot alone') == 1, log
+    assert log.count('parameter and type description services on /robot_1/robot alone') == 1, log
 
 
 def test_a_fleet_whose_robots_differ_in_parameter_services_is_refused_in_one_line(
