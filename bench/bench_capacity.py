@@ -162,8 +162,10 @@ def wait_for_text(path: str, text: str, process: 'subprocess.Popen[bytes]',
     return False
 
 
-def snapshot(pids: Mapping[str, int]) -> Dict[str, Tuple[Optional[float], Optional[int],
-                                                        Optional[int]]]:
+Snapshot = Tuple[Optional[float], Optional[int], Optional[int]]
+
+
+def snapshot(pids: Mapping[str, int]) -> Dict[str, Snapshot]:
     """Return {name: (CPU seconds, RSS KiB, PSS KiB)} of the processes."""
     return {name: (cpu_seconds(pid), read_rss_kib(pid), read_pss_kib(pid))
             for name, pid in pids.items()}

@@ -320,7 +320,7 @@ DECLARATIONS = (
           users=frozenset({Exe.PLANT, Exe.ROBOT})),
     Param('fleet.parameter_services', Kind.BOOL, True,
           'In a fleet process, whether every robot node offers the parameter services (ros2 '
-          "param list, get, set, dump on /robot_<i>/robot) and the type description "
+          'param list, get, set, dump on /robot_<i>/robot) and the type description '
           "service. False: the fleet's first robot alone does, and each other robot node has "
           '14 DDS endpoints fewer (its parameters '
           'are still declared and checked, its team values announced on /diagnostics); '
