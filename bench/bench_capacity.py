@@ -15,7 +15,8 @@ apart), control_rate, plant.publish_rate and reference.rate = RATE, plant.rate 1
 process per robot ('process') or --robots-per-process robots per 'fleet' process ('fleet'),
 with the per-robot topics ('robot', the default) or the team messages ('team': one state message,
 one command message per process per state; parameter transport). It measures the
-start-up (launch until the plant starts its clock: every robot has answered), then for MEASURE
+start-up (launch until the plant starts its clock: every robot has answered; and the CPU time
+of every process until then), then for MEASURE
 wall seconds the CPU time and memory of every process of the run (resident, RSS, and
 proportional, PSS: shared libraries counted once over all processes), then stops the run
 with Ctrl-C and reads the plant's plant_stats.json: the achieved step rate, the fraction of
@@ -214,6 +215,8 @@ def run_case(args: argparse.Namespace, mode: str, n: int, rate: float,
     finally:
         stop(process)
     row['processes'] = len(pids) - 1
+    row['startup_cpu_s'] = {name: before[name][0] for name in pids
+                            if before[name][0] is not None}
     row['cpu_percent'] = {name: 100.0 * (after[name][0] - before[name][0]) / (t1 - t0)
                           for name in pids
                           if before[name][0] is not None and after[name][0] is not None}

@@ -851,6 +851,8 @@ class TeamLink:
         self.local[self.indices] = np.arange(len(self.nodes))
         self.names = encode_names([robot_name(int(i) + 1) for i in self.indices])
         self.heard: Optional[bytes] = None
+        self.taken: Optional[bytes] = None
+        """The bytes of the state taken last: a copy of them is not read and sensed again."""
         self.state: Optional[PoseArrayData] = None
         self.taken_ns = 0
         self.bounds = np.zeros(len(self.nodes) + 1, dtype=np.intp)
@@ -910,11 +912,19 @@ class TeamLink:
 
         A state must hold exactly ``num_robots`` finite poses (and unit quaternions where the
         headings are needed) in ``world_frame``, on this node's clock; others are counted and
-        logged once in the leader's diagnostics (``rejected states messages``).
+        logged once in the leader's diagnostics (``rejected states messages``). A copy of the
+        state taken last (the plant sends one again while it waits for answers: 20 a second
+        while a thousand robots start) is not read again: it is heard anew, and answered as a
+        copy is (:meth:`RobotNode._may_answer`).
         """
         data, self.heard = self.heard, None
         leader = self.leader
         if data is None:
+            return
+        if data == self.taken:
+            self.taken_ns = leader._now_ns()
+            leader.received_ns['pose'] = leader.received_ns['neighbour'] = self.taken_ns
+            leader.pose_count += 1
             return
         state = leader._read('states', lambda raw: read_pose_array(raw, self.n), data)
         if state is None:
@@ -940,7 +950,7 @@ class TeamLink:
             self.points = positions
         self.orientations = orientations
         self.bounds = np.searchsorted(self.observer, np.arange(len(self.nodes) + 1))
-        self.state, self.taken_ns = state, leader._now_ns()
+        self.state, self.taken_ns, self.taken = state, leader._now_ns(), data
         self.give(leader)
         leader.pose_count += 1
 

@@ -5,7 +5,9 @@
 Fixtures of the integration tests: a colcon install space, supervised processes, a probe node.
 
 The install space is built once per test process with ``python -m colcon build`` into a
-temporary directory; every executable is started from it, as ``ros2 run`` would, with the test
+temporary directory and byte-compiled (where ``PYTHONDONTWRITEBYTECODE`` is set, setuptools
+leaves that out, and every process would compile the package again: a quarter of a second of
+CPU each); every executable is started from it, as ``ros2 run`` would, with the test
 process's ROS_DOMAIN_ID and discovery limited to this host. Under pytest-xdist each worker
 builds its own (a few seconds; the builds write nothing into the source tree), in its own
 temporary directory: its path is in every command line of the worker's processes, so
@@ -40,7 +42,11 @@ def install(tmp_path_factory):
          '--install-base', str(base / 'install')],
         cwd=str(base), capture_output=True, text=True, timeout=600)
     assert result.returncode == 0, result.stdout + result.stderr
-    return str(base / 'install' / 'formation_ros')
+    prefix = base / 'install' / 'formation_ros'
+    compiled = subprocess.run([sys.executable, '-m', 'compileall', '-q', str(prefix / 'lib')],
+                              capture_output=True, text=True, timeout=600)
+    assert compiled.returncode == 0, compiled.stdout + compiled.stderr
+    return str(prefix)
 
 
 @pytest.fixture(scope='session')
