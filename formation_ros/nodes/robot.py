@@ -228,7 +228,8 @@ class RobotNode(Node):
             self.changes = Changes(self, config, self.steady, self._reject_change,
                                    self._new_state)
         self.cmd_pub = self.create_publisher(TwistStamped if self.stamped else Twist,
-                                             topics.CMD_VEL, qos.COMMAND)
+                                             topics.CMD_VEL, qos.TEAM_CMD_VEL
+                                             if config.team_transport else qos.COMMAND)
         self.reported: List[RobotNode] = [self]
         """The robots whose statuses this node publishes (a fleet's first robot: all of its)."""
         self.announcing: Optional[Tuple[Shape, Dict[str, str]]] = None

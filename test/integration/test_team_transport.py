@@ -152,8 +152,9 @@ class Heard:
                                   qos.STATE_INPUT)
         probe.create_subscription(MultiDOFJointTrajectory, '/formation/commands',
                                   self._on_team, qos.COMMAND)
+        # as ros2 topic echo does: asking for no lease (a team robot's cmd_vel offers none)
         self.cmd_vel = probe.create_subscription(TwistStamped, '/robot_2/cmd_vel', self._on_own,
-                                                 qos.COMMAND)
+                                                 qos.TEAM_CMD_VEL)
         probe.create_subscription(DiagnosticArray, '/diagnostics', self._on_diagnostics,
                                   qos.DIAGNOSTICS)
 

@@ -32,6 +32,10 @@ def test_commands_and_states_offer_the_lease_and_the_recorder_asks_for_none():
                                                                profile.durability)
     for kind in (QosKind.REFERENCE, QosKind.CLOCK, QosKind.DIAGNOSTICS, QosKind.MARKERS):
         assert qos.BY_KIND[kind].liveliness_lease_duration.nanoseconds == 0
+    # a team robot's own cmd_vel is a command for those who listen, without the lease's cost
+    assert qos.TEAM_CMD_VEL.liveliness_lease_duration.nanoseconds == 0
+    assert (qos.TEAM_CMD_VEL.reliability, qos.TEAM_CMD_VEL.durability, qos.TEAM_CMD_VEL.depth) \
+        == (qos.COMMAND.reliability, qos.COMMAND.durability, qos.COMMAND.depth)
     # robots hear any publisher of poses and neighbours: they ask for no lease
     assert qos.STATE_INPUT.liveliness_lease_duration.nanoseconds == 0
     assert (qos.STATE_INPUT.reliability, qos.STATE_INPUT.depth) == (qos.STATE.reliability,
