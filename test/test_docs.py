@@ -148,7 +148,8 @@ def test_the_topic_table_names_every_topic_with_its_qos():
     assert "'/nowhere' is described but is no topic of ros/topics.py" in problems
     assert "topic '/robot_<i>/cmd_vel' (ros/topics.py) has no description" in problems
     cmd_vel = next(row for row in table if row.startswith('| `/robot_<i>/cmd_vel` |'))
-    assert 'reliable, keep last 10, volatile, liveliness lease 1 s' in cmd_vel
+    assert ('reliable, keep last 10, volatile, liveliness lease 1 s kept by the messages'
+            in cmd_vel)
     clock = next(row for row in table if row.startswith('| `/clock` |'))
     assert clock == ('| `/clock` | `rosgraph_msgs/msg/Clock` | reliable, keep last 1, volatile '
                      '| the time |')

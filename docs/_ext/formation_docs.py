@@ -148,8 +148,11 @@ def qos_text(profile: Any) -> str:
     from rclpy.qos import LivelinessPolicy
     words = [profile.reliability.name.lower().replace('_', ' '), f'keep last {profile.depth}',
              profile.durability.name.lower().replace('_', ' ')]
-    if profile.liveliness == LivelinessPolicy.AUTOMATIC:
-        words.append(f'liveliness lease {profile.liveliness_lease_duration.nanoseconds / 1e9:g} s')
+    kept_by = {LivelinessPolicy.AUTOMATIC: 'DDS',
+               LivelinessPolicy.MANUAL_BY_TOPIC: 'the messages'}.get(profile.liveliness)
+    if kept_by is not None:
+        words.append(f'liveliness lease {profile.liveliness_lease_duration.nanoseconds / 1e9:g} s'
+                     f' kept by {kept_by}')
     return ', '.join(words)
 
 

@@ -219,7 +219,8 @@ class PlantNode(Node):
             self.command_liveliness.append(PeerLiveliness())
             self.command_subs.append(self.create_subscription(
                 TwistStamped if self.stamped else Twist, topics.robot_topic(i, topics.CMD_VEL),
-                lambda data, index=i - 1: self.on_command(index, data), qos.COMMAND, raw=True,
+                lambda data, index=i - 1: self.on_command(index, data), qos.COMMAND_INPUT,
+                raw=True,
                 event_callbacks=self.command_liveliness[-1].callbacks()))
         self.malformed_team = 0
         self.wrong_frame_team = 0

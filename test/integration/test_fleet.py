@@ -244,7 +244,7 @@ def test_a_team_fleet_sends_one_status_array_and_serves_any_robots_cmd_vel(
 
     heard = []
     probe.create_subscription(TwistStamped, f'/robot_{fleet}/cmd_vel', heard.append,
-                              qos.COMMAND)
+                              qos.TEAM_CMD_VEL)  # no lease asked, as ros2 topic echo
     subscribed = time.monotonic()
     bound = LISTENERS_PERIOD * -(-fleet // LISTENER_LOOKS)
     assert probe.spin_until(lambda: len(heard) >= 5, 30.0), latest()[robots[fleet - 1]]

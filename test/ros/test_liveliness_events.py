@@ -24,7 +24,8 @@ def changed(alive, not_alive, alive_change, not_alive_change):
 def test_commands_and_states_offer_the_lease_and_the_recorder_asks_for_none():
     lease_ns = int(qos.LIVELINESS_LEASE * 1e9)
     for profile in (qos.COMMAND, qos.STATE):
-        assert profile.liveliness == LivelinessPolicy.AUTOMATIC
+        # the lease is kept by the messages, not by DDS messages to every participant
+        assert profile.liveliness == LivelinessPolicy.MANUAL_BY_TOPIC
         assert profile.liveliness_lease_duration.nanoseconds == lease_ns
         recorded = qos.recording(profile)
         assert recorded.liveliness_lease_duration.nanoseconds == 0  # infinite: matches all
@@ -32,6 +33,10 @@ def test_commands_and_states_offer_the_lease_and_the_recorder_asks_for_none():
                                                                profile.durability)
     for kind in (QosKind.REFERENCE, QosKind.CLOCK, QosKind.DIAGNOSTICS, QosKind.MARKERS):
         assert qos.BY_KIND[kind].liveliness_lease_duration.nanoseconds == 0
+    # the plant asks for a lease kept by DDS: it matches publishers that keep theirs either way
+    for asked in (qos.COMMAND_INPUT, qos.team_commands_input(100)):
+        assert asked.liveliness == LivelinessPolicy.AUTOMATIC
+        assert asked.liveliness_lease_duration.nanoseconds == lease_ns
     # a team robot's own cmd_vel is a command for those who listen, without the lease's cost
     assert qos.TEAM_CMD_VEL.liveliness_lease_duration.nanoseconds == 0
     assert (qos.TEAM_CMD_VEL.reliability, qos.TEAM_CMD_VEL.durability, qos.TEAM_CMD_VEL.depth) \
