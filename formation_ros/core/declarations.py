@@ -321,8 +321,9 @@ DECLARATIONS = (
     Param('fleet.parameter_services', Kind.BOOL, True,
           'In a fleet process, whether every robot node offers the parameter services (ros2 '
           'param list, get, set, dump on /robot_<i>/robot) and the type description '
-          "service. False: the fleet's first robot alone does, and each other robot node has "
-          '14 DDS endpoints fewer (its parameters '
+          "service, and publishes on /rosout. False: the fleet's first robot alone does (the "
+          "others' log lines still reach the console), and each other robot node has 15 DDS "
+          'endpoints fewer (its parameters '
           'are still declared and checked, its team values announced on /diagnostics); '
           'discovery, start-up and memory grow with the endpoints of every process, which is '
           'what limits a team of a thousand robots. A robot process of its own always offers '

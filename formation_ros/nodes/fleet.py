@@ -26,9 +26,10 @@ publishes the fleet's ``/diagnostics``: one DiagnosticArray a second holding one
 robot, each named ``formation_ros/robot_<i>`` as a robot process names its own. With
 ``fleet.parameter_services: false`` only the first robot's node offers the parameter services
 (``ros2 param``) and the type description service (``~/get_type_description``, which tools
-use to learn a message type they do not have): each of the others then costs 14 DDS
-endpoints less, which is what discovery spends its time and memory on with hundreds of
-robots.
+use to learn a message type they do not have), and publishes its log lines on ``/rosout``
+(the others' lines still reach the console, where the launcher collects them): each of the
+others then costs 15 DDS endpoints less, which is what discovery spends its time and memory
+on with hundreds of robots.
 """
 
 import re
@@ -118,7 +119,7 @@ def make_fleet(ids: Sequence[int]) -> List[RobotNode]:
     lean = [] if services else [Parameter(START_TYPE_DESCRIPTION_SERVICE_PARAM, value=False)]
     nodes = [first] + [RobotNode(namespace=robot_namespace(i), leader=first if team else None,
                                  reports=False, start_parameter_services=services,
-                                 parameter_overrides=lean)
+                                 parameter_overrides=lean, enable_rosout=services)
                        for i in ids[1:]]
     differing = [node for node in nodes[1:] if node.config.robot is not None
                  and node.config.robot.parameter_services != services]
@@ -130,7 +131,7 @@ def make_fleet(ids: Sequence[int]) -> List[RobotNode]:
                                                        'decides how the others are made)')])
     if not services:
         first.get_logger().info(f'fleet of {len(nodes)} robots: parameter and type '
-                                'description services on '
+                                'description services and /rosout on '
                                 f'{first.get_fully_qualified_name()} alone '
                                 '(fleet.parameter_services false)')
     first.reported = nodes

@@ -140,7 +140,12 @@ def test_without_parameter_services_only_the_first_robot_offers_them(processes, 
     assert answer.values[0].bool_value is False
     assert sorted(statuses) == [f'formation_ros/robot_{i}' for i in (1, 2, 3)]
     log = processes.log('fleet')
-    assert log.count('parameter and type description services on /robot_1/robot alone') == 1, log
+    assert log.count('parameter and type description services and /rosout on /robot_1/robot '
+                     'alone') == 1, log
+    publishers = {i: dict(probe.get_publisher_names_and_types_by_node('robot', f'/robot_{i}'))
+                  for i in (1, 2, 3)}
+    assert '/rosout' in publishers[1] and not any('/rosout' in publishers[i] for i in (2, 3))
+    assert 'robot 3/4: vertex' in log  # its log line reaches the console all the same
 
 
 def test_a_fleet_whose_robots_differ_in_parameter_services_is_refused_in_one_line(
