@@ -93,16 +93,21 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     return args
 
 
-def read_rss_kib(pid: int) -> Optional[int]:
-    """Return VmRSS of process ``pid`` in KiB, or None when it is gone (or a kernel thread)."""
+def _proc_kib(pid: int, name: str, field: str) -> Optional[int]:
+    """Return the KiB of ``field`` (e.g. 'VmRSS:') in ``/proc/<pid>/<name>``; None if absent."""
     try:
-        with open(f'/proc/{pid}/status', encoding='ascii', errors='replace') as stream:
+        with open(f'/proc/{pid}/{name}', encoding='ascii', errors='replace') as stream:
             for line in stream:
-                if line.startswith('VmRSS:'):
+                if line.startswith(field):
                     return int(line.split()[1])
     except (FileNotFoundError, ProcessLookupError, PermissionError):
         return None
     return None
+
+
+def read_rss_kib(pid: int) -> Optional[int]:
+    """Return VmRSS of process ``pid`` in KiB, or None when it is gone (or a kernel thread)."""
+    return _proc_kib(pid, 'status', 'VmRSS:')
 
 
 def read_pss_kib(pid: int) -> Optional[int]:
@@ -113,14 +118,7 @@ def read_pss_kib(pid: int) -> Optional[int]:
     over processes is the memory they take from the machine, where the sum of their RSS counts
     each shared library once per process.
     """
-    try:
-        with open(f'/proc/{pid}/smaps_rollup', encoding='ascii', errors='replace') as stream:
-            for line in stream:
-                if line.startswith('Pss:'):
-                    return int(line.split()[1])
-    except (FileNotFoundError, ProcessLookupError, PermissionError):
-        return None
-    return None
+    return _proc_kib(pid, 'smaps_rollup', 'Pss:')
 
 
 def _process_table() -> Dict[int, Tuple[int, List[str]]]:
