@@ -14,10 +14,10 @@ the Section 5 constants with N robots (random start at about 10 robots per m^2, 
 apart), control_rate, plant.publish_rate and reference.rate = RATE, plant.rate 100 Hz, one
 process per robot ('process') or --robots-per-process robots per 'fleet' process ('fleet'),
 with the per-robot topics ('robot', the default) or the team messages ('team': one state message,
-one command message per process per state; parameter transport). It measures the
-start-up (launch until the plant starts its clock: every robot has answered; and the CPU time
-of every process until then), then for MEASURE
-wall seconds the CPU time and memory of every process of the run (resident, RSS, and
+one command message per process per state; parameter transport). It byte-compiles the
+install first, then measures the start-up (launch until the plant starts its clock: every
+robot has answered; and the CPU time of every process until then), then for MEASURE wall
+seconds the CPU time and memory of every process of the run (resident, RSS, and
 proportional, PSS: shared libraries counted once over all processes), then stops the run
 with Ctrl-C and reads the plant's plant_stats.json: the achieved step rate, the fraction of
 steps at which every robot's applied command answered a state at most two control periods old
@@ -320,7 +320,7 @@ def byte_compile(prefix: str) -> None:
     Where ``PYTHONDONTWRITEBYTECODE`` is set, neither setuptools nor Python writes them, and
     every process of a run would compile the package again (a quarter of a second of CPU
     each, 10 s for the 42 processes of 1000 robots). A symlink install's package is the
-    source tree's, which is compiled too.
+    source tree's, which is compiled too. A folder that cannot be written is left as it is.
     """
     import formation_ros
     for folder in (os.path.realpath(prefix), os.path.dirname(formation_ros.__file__)):

@@ -33,8 +33,9 @@ Quality of service of every formation topic, in one place.
   20 fleets overwrote each other while the plant was busy stepping (16 % of them lost at
   N = 500, measured). A team robot's own ``cmd_vel``, published only for those who listen
   (``ros2 topic echo``, a recorder), is ``COMMAND`` without the lease (``TEAM_CMD_VEL``): the
-  plant hears the team topic, and a writer that offers a lease costs DDS work for as long as
-  it lives (1000 of them took half a core on this machine, with no reader at all).
+  plant hears the team topic, and nothing needs to know whether a thousand such publishers
+  are alive (when they offered a lease kept by DDS, they took half a core of this machine
+  with no reader at all).
 * Measurements (the relay's sources, ``relay.source_topic``: a motion-capture system's poses):
   best effort, keep last 1, volatile, no liveliness asked (``MEASUREMENT``). A best-effort
   subscriber matches best-effort publishers (vrpn_mocap, which uses the sensor-data QoS) and
