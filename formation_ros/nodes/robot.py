@@ -919,28 +919,29 @@ class TeamLink:
         copy is (:meth:`RobotNode._may_answer`).
         """
         data, self.heard = self.heard, None
+        if data is None or (data != self.taken and not self._sense(data)):
+            return
+        self.taken, self.taken_ns = data, self.leader._now_ns()
+        self.give(self.leader)
+        self.leader.pose_count += 1
+
+    def _sense(self, data: bytes) -> bool:
+        """Read and check a new state's bytes, set the clocks, sense; False if refused."""
         leader = self.leader
-        if data is None:
-            return
-        if data == self.taken:
-            self.taken_ns = leader._now_ns()
-            leader.received_ns['pose'] = leader.received_ns['neighbour'] = self.taken_ns
-            leader.pose_count += 1
-            return
         state = leader._read('states', lambda raw: read_pose_array(raw, self.n), data)
         if state is None:
-            return
+            return False
         if len(state.positions) != self.n:
             leader._reject('states', Reason.MALFORMED, f' ({len(state.positions)} poses for '
                                                        f'{self.n} robots)')
-            return
+            return False
         positions, orientations = state.positions[:, :self.dim], state.orientations
         needs_orientation = self.unicycle or self.body_frame
         finite = bool(np.all(np.isfinite(positions))
                       and (not needs_orientation or np.all(np.isfinite(orientations))))
         oriented = not needs_orientation or bool(np.all(valid_quaternions(orientations)))
         if not leader._check('states', state.frame_id, state.stamp_ns, finite, oriented):
-            return
+            return False
         self.clock.advance(state.stamp_ns)
         observer, self.seen = sensed_pairs(positions, self.reach, observers=self.indices)
         self.observer = self.local[observer]
@@ -951,9 +952,8 @@ class TeamLink:
             self.points = positions
         self.orientations = orientations
         self.bounds = np.searchsorted(self.observer, np.arange(len(self.nodes) + 1))
-        self.state, self.taken_ns, self.taken = state, leader._now_ns(), data
-        self.give(leader)
-        leader.pose_count += 1
+        self.state = state
+        return True
 
     def give(self, node: RobotNode) -> None:
         """
