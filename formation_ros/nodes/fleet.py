@@ -16,11 +16,11 @@ of K robots costs one of each, which is what lets a hundred robots run on one sm
 Parameters given on the command line (``-p``) or in a parameters file apply to every robot of
 the fleet; a file's ``/robot_3/robot:`` section applies to robot 3 alone, as it would to a
 robot process. The namespace of each robot is set by the fleet: ``-r __ns:=...`` is refused,
-and a ``robot_id`` must match it. The robots share one ``/clock`` subscription, so their
-``use_sim_time`` cannot be changed while they run. With ``transport: team`` they share one
-``/formation/states`` subscription and one ``/formation/commands`` publisher instead, their
-commands come from one call of the law per state, their clocks are set from the states' stamps
-(no ``/clock`` subscription), and the first robot alone hears ``/formation/reference``,
+and a ``robot_id`` must match it. As in a robot process, each robot's simulated clock is set
+from its states' stamps (no ``/clock`` subscription), so its ``use_sim_time`` cannot be changed
+while it runs. With ``transport: team`` the robots share one ``/formation/states``
+subscription and one ``/formation/commands`` publisher, their commands come from one call of
+the law per state, and the first robot alone hears ``/formation/reference``,
 ``/formation/shape`` and ``/formation/status`` for all of them. Either way the first robot
 publishes the fleet's ``/diagnostics``: one DiagnosticArray a second holding one status per
 robot, each named ``formation_ros/robot_<i>`` as a robot process names its own. With
@@ -39,7 +39,6 @@ from typing import List, Optional, Sequence
 from formation_ros.core.declarations import ParamError
 from formation_ros.nodes.robot import RobotNode, TeamLink
 from formation_ros.ros.runner import run
-from formation_ros.ros.sim_clock import share_sim_clock
 from formation_ros.ros.topics import robot_namespace
 from rclpy.parameter import Parameter
 from rclpy.type_description_service import START_TYPE_DESCRIPTION_SERVICE_PARAM
@@ -100,7 +99,7 @@ def parse_command_line(argv: Sequence[str]) -> Optional[List[int]]:
 
 def make_fleet(ids: Sequence[int]) -> List[RobotNode]:
     """
-    Build one robot node per id, robot i in ``/robot_<i>``, sharing one ``/clock`` subscription.
+    Build one robot node per id, robot i in ``/robot_<i>``.
 
     Each node checks its parameters as a robot process does (a ``robot_id`` given to the fleet
     disagrees with every namespace but one and is refused there). The first robot publishes
@@ -137,13 +136,6 @@ def make_fleet(ids: Sequence[int]) -> List[RobotNode]:
     first.reported = nodes
     if team:
         TeamLink(nodes)
-        if first.sim_time:
-            first.get_logger().info(f'fleet of {len(nodes)} robots: their clocks set from the '
-                                    "states' stamps (no /clock subscription)")
-    elif first.sim_time:
-        shared = share_sim_clock(nodes)
-        first.get_logger().info(f'fleet of {len(nodes)} robots: {shared + 1} clocks driven by '
-                                'one /clock subscription')
     return nodes
 
 

@@ -19,7 +19,10 @@ it. The watchdog, another one-shot timer, looks when the oldest input is due to 
 (states arriving keep it away: no wake-up per state) and then publishes zero at
 ``control_rate`` while the inputs stay stale. The command is stamped with the stamp of the
 state it was computed from, so the plant can tell how old it is (and, in lockstep, which state
-it answers).
+it answers). On simulated time (``use_sim_time:=true``, beside a plant) a robot's clock is set
+from the stamps of the poses it accepts, which carry the plant's simulated time (forward only,
+``formation_ros.ros.sim_clock.StateClock``): no ``/clock`` subscription, one message less per
+state; its ``use_sim_time`` is then fixed while it runs.
 Every input is read from its serialized bytes and the command written as bytes
 (``formation_ros.ros.cdr``): rclpy's own conversions were most of a robot's time.
 
@@ -47,7 +50,7 @@ while someone subscribes to it. The process evaluates the reference frame for ea
 stamp itself from the reference's parameters and the changes the reference node announced;
 the reference node's samples, heard by the first robot of the process alone, are checked as
 always and against that frame, and in lockstep a state is answered once its sample is in. Its
-robots' simulated clocks follow the states' stamps instead of ``/clock``.
+robots' simulated clocks follow the team states' stamps.
 
 Every state and reference message must be in ``world_frame`` (default ``world``). Commands for
 real bases: ``command.type: twist`` publishes a geometry_msgs/Twist (no stamp) instead of a
@@ -214,8 +217,11 @@ class RobotNode(Node):
         """The team link this robot leads (team transport: the first robot of its process)."""
         self.member_of: Optional[TeamLink] = None
 
+        self.clock: Optional[StateClock] = None
+        """Robot transport: this node's simulated clock, set from its own poses' stamps."""
         if not config.team_transport:
             self._subscribe_to_states(settings.pose_type)
+            self.clock = StateClock([self])
         self.expected_publishers: Dict[str, Optional[str]] = {}
         if leader is not None and config.team_transport:
             self.changes = leader.changes
@@ -257,7 +263,8 @@ class RobotNode(Node):
               f'{self.command_frame}, '
 
             + ('lockstep' if self.lockstep else f'{settings.control_rate:g} Hz')
-            + (', team transport' if config.team_transport else ''))
+            + (', team transport' if config.team_transport else '')
+            + (", simulated time from the states' stamps" if self.sim_time else ''))
 
     def _subscribe_to_states(self, pose_type: PoseType) -> None:
         """Robot transport: hear this robot's ``pose`` and ``neighbors``."""
@@ -361,6 +368,8 @@ class RobotNode(Node):
     def _store_pose(self, pose: PoseData) -> None:
         oriented = not self.needs_orientation or bool(valid_quaternions(pose.orientation))
         if self._check('pose', pose.frame_id, pose.stamp_ns, pose.finite, oriented):
+            if self.clock is not None:
+                self.clock.advance(pose.stamp_ns)
             self.pose = pose
             self.pose_count += 1
             self.received_ns['pose'] = self._now_ns()

@@ -2,22 +2,17 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-Simulated time for robot nodes with fewer ``/clock`` subscriptions than nodes.
+Simulated time for robot nodes without a ``/clock`` subscription.
 
 With ``use_sim_time`` every rclpy node subscribes to ``/clock`` and runs a Python callback per
-tick (the plant publishes one per published state). Two ways to need fewer:
-
-* :func:`share_sim_clock` (a fleet on the robot transport): one ``/clock`` subscription, on the
-  first node, sets the clocks of all the process's nodes.
-* :class:`StateClock` (the team transport): no ``/clock`` subscription at all. Every state on
-  ``/formation/states`` is stamped with the plant's simulated time, which is the time the
-  robots need, so the team link sets its nodes' clocks to each state's stamp as it takes it
-  (forward only). ``use_sim_time`` still decides which clock a robot is on: with it false the
-  robot stays on the wall clock and refuses the plant's states as stamped on another clock.
-
-Either way ``use_sim_time`` is fixed while the nodes run (:func:`keep_sim_time` refuses a
-change). Nodes on wall time, and rclpy versions without the node's time source attribute, are
-left as they are.
+tick (the plant publishes one per published state). A robot needs none: every state the plant
+sends it (its ``pose``, or ``/formation/states`` with the team transport) is stamped with the
+plant's simulated time, which is the time the robot needs, so :class:`StateClock` detaches the
+nodes' ``/clock`` subscriptions and sets their clocks to each accepted state's stamp (forward
+only). ``use_sim_time`` still decides which clock a robot is on: with it false the robot stays
+on the wall clock and refuses the plant's states as stamped on another clock. It is fixed while
+the nodes run (:func:`keep_sim_time` refuses a change). Nodes on wall time, and rclpy versions
+without the node's time source attribute, are left as they are.
 """
 
 from typing import List, Optional, Sequence
@@ -42,35 +37,9 @@ def keep_sim_time(parameters: List[Parameter]) -> SetParametersResult:
     """Refuse to change ``use_sim_time`` of a robot whose clock is driven for it."""
     if any(parameter.name == 'use_sim_time' for parameter in parameters):
         return SetParametersResult(successful=False, reason='use_sim_time of this robot is '
-                                   'fixed at start (its clock is driven by its process: one '
-                                   '/clock subscription for a fleet, the states with the team '
-                                   'transport)')
+                                   'fixed at start (its clock is set from the stamps of the '
+                                   'states it hears)')
     return SetParametersResult(successful=True)
-
-
-def share_sim_clock(nodes: Sequence[Node]) -> int:
-    """
-    Drive the clocks of all ``nodes`` from the first one's ``/clock``; return how many shared.
-
-    The others' time sources are detached from their nodes (their subscriptions destroyed) and
-    their clocks attached to the first node's time source, which then sets all of them at each
-    tick.
-    """
-    first = _active_source(nodes[0]) if nodes else None
-    if first is None:
-        return 0
-    shared = 0
-    for node in nodes[1:]:
-        source = _active_source(node)
-        clock = node.get_clock()
-        if source is None or not isinstance(clock, ROSClock):
-            continue
-        source.detach_node()
-        first.attach_clock(clock)
-        shared += 1
-    for node in nodes:
-        node.add_on_set_parameters_callback(keep_sim_time)
-    return shared
 
 
 class StateClock:

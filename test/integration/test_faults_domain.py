@@ -12,7 +12,7 @@ from formation_ros.ros import messages, qos
 from formation_ros.tools import domain
 from geometry_msgs.msg import PoseStamped, TwistStamped
 from helpers import (launch, node, said_once, SimClock, SQUARE, Statuses, stop_when,
-                     wait_exit, write_params)
+                     wait_exit, watch_commands, write_params)
 from nav_msgs.msg import Odometry
 import pytest
 from rosgraph_msgs.msg import Clock as ClockMsg
@@ -127,13 +127,23 @@ def test_a_robot_names_a_second_reference_publisher(processes, install, probe):
 
 def test_a_robot_on_two_clocks_names_them_instead_of_advising_use_sim_time(
         processes, install, probe):
+    """
+    A second team's plant (its /clock and a pose 1000 s on) meets robot 1 of the first.
+
+    The robot's clock follows the poses it accepted, not /clock: the other team's /clock
+    leaves it alone, and its pose is refused as stamped on another clock, naming both clocks.
+    """
+    heard, _ = watch_commands(probe, 1)
     start_plant_and_robot_1(processes, install, probe)
+    assert probe.spin_until(lambda: len(heard) > 0, START_UP), processes.log('robot_1')
     other = probe.create_publisher(ClockMsg, '/clock', qos.CLOCK)
     far = ClockMsg()
     far.clock = messages.ns_to_stamp(1000 * 10 ** 9)
+    forged = probe.create_publisher(PoseStamped, '/robot_1/pose', qos.STATE)
 
     def refused():
         other.publish(far)
+        forged.publish(wire.pose_stamped((0.0, 0.0), 1000 * 10 ** 9, 2))
         return 'stamps from another clock' in processes.log('robot_1')
 
     assert probe.spin_until(refused, START_UP), processes.log('robot_1')
@@ -144,6 +154,8 @@ def test_a_robot_on_two_clocks_names_them_instead_of_advising_use_sim_time(
         assert 'use_sim_time' not in line, line
     assert probe.spin_until(lambda: '/clock has more than one publisher: /plant, /probe'
                             in processes.log('robot_1'), 30), processes.log('robot_1')
+    answered = len(heard)
+    assert probe.spin_until(lambda: len(heard) > answered + 10, 30), processes.log('robot_1')
 
 
 def test_the_launcher_runs_on_a_free_domain_of_its_own(processes, install, probe, tmp_path):

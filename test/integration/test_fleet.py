@@ -81,13 +81,13 @@ def test_each_robot_of_a_fleet_is_its_own_node_with_its_parameters(
     assert sorted(names) == ['robot'] * 3, names
     assert len(fleet_pids(install, '--robots 1-3')) == 1
 
-    def clock_readers():
-        return [info for info in probe.get_subscriptions_info_by_topic('/clock')
+    def readers(topic):
+        return [info for info in probe.get_subscriptions_info_by_topic(topic)
                 if info.node_namespace.startswith('/robot_')]
 
-    assert probe.spin_until(lambda: clock_readers() and all(
+    assert probe.spin_until(lambda: len(readers('/formation/reference')) == 3 and all(
         probe.count_publishers(f'/robot_{i}/cmd_vel') == 1 for i in (1, 2, 3)), START_UP)
-    assert len(clock_readers()) == 1, clock_readers()
+    assert readers('/clock') == [], readers('/clock')
     [pid] = fleet_pids(install, '--robots 1-3')
     arrays = []
     probe.create_subscription(DiagnosticArray, '/diagnostics', arrays.append, qos.DIAGNOSTICS)

@@ -1,0 +1,93 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+A robot on simulated time takes its clock from the poses it accepts, not from ``/clock``.
+
+Robot 1 of the square team (robot transport) is given serialized poses as its ``pose``
+callback would give them; its clock is then read as its timers and checks read it.
+"""
+
+import os
+import time
+
+from formation_ros.core.units import NS_PER_S
+from formation_ros.nodes.robot import RobotNode
+import pytest
+import rclpy
+from rclpy.parameter import Parameter
+import wire
+
+SQUARE = os.path.join(os.path.dirname(__file__), '..', '..', 'config', 'square_4.yaml')
+CORNER = (-2.0, -2.0)
+
+
+def robot_node(sim_time):
+    """Return (robot 1 with ``use_sim_time``, its context)."""
+    context = rclpy.Context()
+    rclpy.init(context=context, args=['--ros-args', '--params-file', SQUARE,
+                                      '-p', f'use_sim_time:={str(sim_time).lower()}'])
+    return RobotNode(namespace='/robot_1', context=context), context
+
+
+@pytest.fixture
+def sim_robot():
+    """Yield robot 1 on simulated time, then clean up."""
+    node, context = robot_node(True)
+    try:
+        yield node
+    finally:
+        node.destroy_node()
+        rclpy.shutdown(context=context)
+
+
+def pose(stamp_s, frame='world'):
+    return wire.pose_stamped_bytes(int(round(stamp_s * NS_PER_S)), frame, CORNER)
+
+
+def now_s(node):
+    return node.get_clock().now().nanoseconds / NS_PER_S
+
+
+def test_a_robot_on_simulated_time_has_no_clock_subscription(sim_robot):
+    topics = {subscription.topic_name for subscription in sim_robot.subscriptions}
+    assert '/clock' not in topics
+    assert {'/robot_1/pose', '/robot_1/neighbors', '/formation/reference'} <= topics
+    assert now_s(sim_robot) == 0.0
+
+
+def test_its_clock_follows_the_poses_it_accepts_forward_only(sim_robot):
+    sim_robot.on_pose(pose(5.0))
+    assert now_s(sim_robot) == 5.0 and sim_robot.pose_count == 1
+    sim_robot.on_pose(pose(4.9))
+    assert sim_robot.pose_count == 2 and now_s(sim_robot) == 5.0
+    sim_robot.on_pose(pose(5.25))
+    assert now_s(sim_robot) == 5.25
+
+
+def test_a_refused_pose_leaves_its_clock_alone(sim_robot):
+    sim_robot.on_pose(pose(5.0))
+    sim_robot.on_pose(pose(1000.0))
+    sim_robot.on_pose(pose(5.5, frame='map'))
+    assert now_s(sim_robot) == 5.0 and sim_robot.pose_count == 1
+    rejected = {reason.name: count for (name, reason), count in sim_robot.rejected.items()
+                if name == 'pose'}
+    assert rejected == {'CLOCK': 1, 'FRAME': 1}
+
+
+def test_its_use_sim_time_cannot_change_while_it_runs(sim_robot):
+    [result] = sim_robot.set_parameters([Parameter('use_sim_time', value=False)])
+    assert not result.successful and 'fixed at start' in result.reason
+    assert sim_robot.get_parameter('use_sim_time').value is True
+
+
+def test_a_robot_on_the_wall_clock_refuses_simulated_stamps():
+    node, context = robot_node(False)
+    try:
+        before = time.time()
+        node.on_pose(pose(5.0))
+        assert node.pose_count == 0 and now_s(node) >= before
+        assert '/clock' not in {subscription.topic_name for subscription in node.subscriptions}
+    finally:
+        node.destroy_node()
+        rclpy.shutdown(context=context)
