@@ -103,7 +103,8 @@ def test_each_robot_of_a_fleet_is_its_own_node_with_its_parameters(
     refused = call(probe, probe.create_client(SetParameters, '/robot_2/robot/set_parameters'),
                    SetParameters.Request(parameters=[
                        Parameter('use_sim_time', value=False).to_parameter_msg()]))
-    assert not refused.results[0].successful and 'fleet' in refused.results[0].reason
+    assert not refused.results[0].successful, refused.results
+    assert 'fixed at start' in refused.results[0].reason, refused.results
 
 
 def test_without_parameter_services_only_the_first_robot_offers_them(processes, install, probe):
