@@ -6,8 +6,8 @@ Capacity benchmark: how many robots, at what rate, on this machine (on demand, n
 
 Usage: python bench/bench_capacity.py [--sizes 10 20 50 100] [--rates 20 50]
 [--modes process fleet] [--transport robot team] [--robots-per-process 25] [--measure 20]
-[--lockstep] [--prefix INSTALL] [--out DIR]; or python bench/bench_capacity.py --figure JSON...
---out DIR
+[--lockstep] [--prefix INSTALL] [--out DIR] [--keep]
+or:    python bench/bench_capacity.py --figure JSON... --out DIR
 
 For each transport, mode, team size N and control rate it runs scripts/launch_formation.sh on
 the Section 5 constants with N robots (random start at about 10 robots per m^2, lattice goal 2 m
@@ -89,6 +89,10 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument('--prefix', default=os.path.join(ROOT, 'install', 'formation_ros'),
                         help='install space of formation_ros (default: %(default)s)')
     parser.add_argument('--out', help='output directory (default: runs/capacity-<date>-<time>)')
+    parser.add_argument('--keep', action='store_true',
+                        help="keep each case's parameters, launcher log and run folder (the "
+                             "plant's plant_stats.json, every node's log) in "
+                             'OUT/<transport>-<mode>-<N>-<rate>/ instead of removing them')
     parser.add_argument('--figure', nargs='+', metavar='JSON',
                         help='run nothing: draw OUT/capacity_fresh.png from the rows of these '
                              'capacity.json files of earlier runs (e.g. one per mode)')
@@ -347,8 +351,13 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         for rate in args.rates:
             for n in args.sizes:
                 for transport in args.transports:
-                    with tempfile.TemporaryDirectory(dir=args.out) as folder:
+                    if args.keep:
+                        folder = os.path.join(args.out, f'{transport}-{mode}-{n}-{rate:g}')
+                        os.makedirs(folder, exist_ok=True)
                         row = run_case(args, mode, n, rate, folder, transport)
+                    else:
+                        with tempfile.TemporaryDirectory(dir=args.out) as folder:
+                            row = run_case(args, mode, n, rate, folder, transport)
                     rows.append(row)
                     print(format_row(row), flush=True)
     result = {**machine, 'load_after': os.getloadavg(), 'arguments': vars(args), 'rows': rows}

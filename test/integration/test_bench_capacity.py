@@ -16,7 +16,7 @@ def test_capacity_benchmark_runs_both_modes_on_two_robots(install, ros_env, tmp_
     result = subprocess.run(
         [sys.executable, os.path.join(ROOT, 'bench', 'bench_capacity.py'), '--sizes', '2',
          '--rates', '20', '--modes', 'process', 'fleet', '--robots-per-process', '2',
-         '--measure', '1', '--prefix', str(install), '--out', str(out)],
+         '--measure', '1', '--prefix', str(install), '--out', str(out), '--keep'],
         capture_output=True, text=True, env=ros_env, timeout=600)
     assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
     rows = json.loads((out / 'capacity.json').read_text())['rows']
@@ -28,3 +28,8 @@ def test_capacity_benchmark_runs_both_modes_on_two_robots(install, ros_env, tmp_
         assert row['latency_ms']['count'] > 0 and row['startup_s'] > 0.0, row
         assert row['rss_mib']['plant'] > 10.0 and 'launcher' in row['cpu_percent'], row
     assert (out / 'capacity_fresh.png').exists()
+    for mode in ('process', 'fleet'):
+        kept = out / f'robot-{mode}-2-20'
+        assert 'starting the clock' in (kept / 'launcher.txt').read_text()
+        stats = json.loads((kept / 'run' / 'plant_stats.json').read_text())
+        assert stats['steps'] == next(row['steps'] for row in rows if row['mode'] == mode)
