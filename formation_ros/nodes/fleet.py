@@ -18,12 +18,14 @@ the fleet; a file's ``/robot_3/robot:`` section applies to robot 3 alone, as it 
 robot process. The namespace of each robot is set by the fleet: ``-r __ns:=...`` is refused,
 and a ``robot_id`` must match it. As in a robot process, each robot's simulated clock is set
 from its states' stamps (no ``/clock`` subscription), so its ``use_sim_time`` cannot be changed
-while it runs. With ``transport: team`` the robots share one ``/formation/states``
-subscription and one ``/formation/commands`` publisher, their commands come from one call of
-the law per state, and the first robot alone hears ``/formation/reference``,
-``/formation/shape`` and ``/formation/status`` for all of them. Either way the first robot
-publishes the fleet's ``/diagnostics``: one DiagnosticArray a second holding one status per
-robot, each named ``formation_ros/robot_<i>`` as a robot process names its own. With
+while it runs. The first robot alone hears ``/formation/reference``, ``/formation/shape`` and
+``/formation/status`` for all of them (it checks the reference's samples once, and each robot
+uses them as its own): a robot whose own parameters give other ``reference.*``,
+``formation.*`` or ``formations.*`` values hears them itself. With ``transport: team`` the
+robots share one ``/formation/states`` subscription and one ``/formation/commands``
+publisher, and their commands come from one call of the law per state. Either way the first
+robot publishes the fleet's ``/diagnostics``: one DiagnosticArray a second holding one status
+per robot, each named ``formation_ros/robot_<i>`` as a robot process names its own. With
 ``fleet.parameter_services: false`` only the first robot's node offers the parameter services
 (``ros2 param``) and the type description service (``~/get_type_description``, which tools
 use to learn a message type they do not have), and publishes its log lines on ``/rosout``
@@ -116,7 +118,7 @@ def make_fleet(ids: Sequence[int]) -> List[RobotNode]:
     assert settings is not None
     services = settings.parameter_services
     lean = [] if services else [Parameter(START_TYPE_DESCRIPTION_SERVICE_PARAM, value=False)]
-    nodes = [first] + [RobotNode(namespace=robot_namespace(i), leader=first if team else None,
+    nodes = [first] + [RobotNode(namespace=robot_namespace(i), leader=first,
                                  reports=False, start_parameter_services=services,
                                  parameter_overrides=lean, enable_rosout=services)
                        for i in ids[1:]]

@@ -66,7 +66,7 @@ from collections import deque
 import enum
 import math
 import time
-from typing import Callable, Dict, List, Optional, Sequence, Tuple, TypeVar
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, TypeVar
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.answers import AnswerBudget
@@ -74,6 +74,7 @@ from formation_ros.core.bodies import make_bodies
 from formation_ros.core.declarations import CommandFrame, Exe, ParamError, PoseType
 from formation_ros.core.frames import advance, FrameSample, to_body_frame, valid_quaternions
 from formation_ros.core.law import Command, robot_command, robot_commands
+from formation_ros.core.params import FormationConfig
 from formation_ros.core.sensing import sensed_pairs, sensor_radii
 from formation_ros.core.team import team_values
 from formation_ros.core.timeline import Mode, Shape, TeamState
@@ -136,6 +137,17 @@ TEAM_VALUES = ('num_robots', 'dim', 'world_frame', 'repulsion_radius', 'controll
                'transport')
 """Parameters the robots of one team link share: it computes their commands in one call (the
 watchdog and input timeout are the leader's)."""
+REFERENCE_VALUES = ('num_robots', 'dim', 'world_frame', 'repulsion_radius')
+REFERENCE_PREFIXES = ('reference.', 'formation.', 'formations.')
+"""Parameters that decide how a robot checks the reference's samples and the changes (with
+every ``reference.*``, ``formation.*`` and ``formations.*``): a fleet's robot that has the
+first robot's values hears the reference and the changes through it."""
+
+
+def reference_values(config: FormationConfig) -> Dict[str, Any]:
+    """Return the values of ``config`` that decide how the reference and changes are checked."""
+    return {name: value for name, value in config.values.items()
+            if name in REFERENCE_VALUES or name.startswith(REFERENCE_PREFIXES)}
 
 
 class Reason(enum.Enum):
@@ -162,8 +174,9 @@ class RobotNode(Node):
         """
         Declare and check parameters, then set up topics and the control timer.
 
-        ``leader``: with ``transport: team``, the first robot of this process; this robot then
-        hears the reference and the changes through it (one subscription per process).
+        ``leader``: the first robot of this process (a fleet's other robots); this robot then
+        hears the reference and the changes through it (one subscription per process), with
+        ``transport: team`` always, else if it has the leader's :func:`reference_values`.
         ``reports``: whether this node publishes on /diagnostics itself; a fleet's other robots
         do not, its first robot publishes their statuses with its own (:attr:`reported`).
         """
@@ -227,8 +240,17 @@ class RobotNode(Node):
             self._subscribe_to_states(settings.pose_type)
             self.clock = StateClock([self])
         self.expected_publishers: Dict[str, Optional[str]] = {}
-        if leader is not None and config.team_transport:
+        self.first: RobotNode = self
+        """The robot that hears the reference and the changes for this one (or itself)."""
+        self.followers: List[RobotNode] = []
+        """The robots that hear the reference and the changes through this one."""
+        if leader is not None and (config.team_transport or reference_values(config)
+                                   == reference_values(leader.config)):
+            self.first = leader
+            leader.followers.append(self)
             self.changes = leader.changes
+            self.references = leader.references
+            self.expected_publishers = leader.expected_publishers
         else:
             reference = self.create_subscription(Odometry, topics.REFERENCE, self.on_reference,
                                                  qos.REFERENCE, raw=True)
@@ -434,9 +456,11 @@ class RobotNode(Node):
                 self.once.end(f'reference-{Reason.OTHER_REFERENCE.name}',
                               'the reference is the one this robot evaluates again')
             self.references.append(msg)
-            self.received_ns['reference'] = self._now_ns()
-            if self.lockstep and (self.member_of is None or self.team is not None):
-                self.answer.arm()
+            now = self._now_ns()
+            for node in [self] + self.followers:
+                node.received_ns['reference'] = now
+                if node.lockstep and (node.member_of is None or node.team is not None):
+                    node.answer.arm()
 
     def _reject_change(self, what: str, why: str) -> None:
         """Count and log once a shape or status refused (``ros.changes``)."""
@@ -799,7 +823,7 @@ class RobotNode(Node):
             values['cmd_vel published'] = self.member_of.publishes_cmd_vel(self)
         flooding = leader.flooded > self.flooded_reported
         self.flooded_reported = leader.flooded
-        shared = self._shared_topics() if leader is self else leader.shared
+        shared = self._shared_topics() if self.first is self else self.first.shared
         if shared:
             values['topics with more than one publisher'] = ' | '.join(
                 f'{topic}: {names}' for topic, names in sorted(shared.items()))
@@ -1008,7 +1032,6 @@ class TeamLink:
         node.neighbours = PoseArrayData(state.stamp_ns, state.frame_id, state.positions[seen],
                                         state.orientations[seen])
         node.received_ns['pose'] = node.received_ns['neighbour'] = self.taken_ns
-        node.received_ns['reference'] = self.leader.received_ns['reference']
         if self.command is not None:
             node.vertex = self.vertices[k]
             node.last = Command(u=self.command.u[k], u_hat=self.command.u_hat[k],

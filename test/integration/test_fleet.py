@@ -60,8 +60,9 @@ def test_six_robots_in_two_fleet_processes_converge(processes, install, probe, t
 def test_each_robot_of_a_fleet_is_its_own_node_with_its_parameters(
         processes, install, probe, tmp_path):
     own = tmp_path / 'robot_2.yaml'
-    own.write_text(yaml.safe_dump({'/robot_2/robot': {'ros__parameters': {
-        'control_rate': 25.0}}}))
+    own.write_text(yaml.safe_dump({
+        '/robot_2/robot': {'ros__parameters': {'control_rate': 25.0}},
+        '/robot_3/robot': {'ros__parameters': {'reference.speed': 0.25}}}))
     processes.start(ProcessSpec('fleet', [exe(install, 'fleet'), '--robots', '1-3', '--ros-args',
                                           '--params-file', SQUARE, '--params-file', str(own),
                                           '-p', 'use_sim_time:=true']))
@@ -85,8 +86,13 @@ def test_each_robot_of_a_fleet_is_its_own_node_with_its_parameters(
         return [info for info in probe.get_subscriptions_info_by_topic(topic)
                 if info.node_namespace.startswith('/robot_')]
 
-    assert probe.spin_until(lambda: len(readers('/formation/reference')) == 3 and all(
-        probe.count_publishers(f'/robot_{i}/cmd_vel') == 1 for i in (1, 2, 3)), START_UP)
+    def namespaces(topic):
+        return sorted(info.node_namespace for info in readers(topic))
+
+    assert probe.spin_until(lambda: namespaces('/formation/reference') == ['/robot_1', '/robot_3']
+                            and all(probe.count_publishers(f'/robot_{i}/cmd_vel') == 1
+                                    for i in (1, 2, 3)), START_UP), readers('/formation/reference')
+    assert namespaces('/formation/shape') == ['/robot_1', '/robot_3']
     assert readers('/clock') == [], readers('/clock')
     [pid] = fleet_pids(install, '--robots 1-3')
     arrays = []

@@ -53,8 +53,8 @@ def lockstep_run(processes, probe, install, tmp_path, transport):
 
     The shape switches to a wedge at SWITCH. With the team transport, run until every robot
     (the second of each fleet too) reports 'lockstep' with its neighbours in /diagnostics, and
-    check that only the first of each fleet subscribes to the reference and the changes. No
-    robot subscribes to /clock with either transport.
+    check (either transport) that only the first of each fleet subscribes to the reference and
+    the changes, and no robot to /clock.
     """
     out = tmp_path / transport
     params = write_params(tmp_path, 'square_4.yaml', {
@@ -76,15 +76,11 @@ def lockstep_run(processes, probe, install, tmp_path, transport):
 
     launch(processes, install, params, name=transport, options=('--robots-per-process', '2'))
     leaders = ['/robot_1', '/robot_3']
-    if transport == 'team':
-        assert probe.spin_until(lambda: every_robot_reports()
-                                and robot_subscribers(probe, '/formation/reference') == leaders,
-                                START_UP), (statuses, processes.log(transport))
-        assert robot_subscribers(probe, '/formation/shape') == leaders
-        assert robot_subscribers(probe, '/formation/status') == leaders
-    else:
-        assert probe.spin_until(
-            lambda: len(robot_subscribers(probe, '/formation/reference')) == 4, START_UP)
+    assert probe.spin_until(lambda: every_robot_reports()
+                            and robot_subscribers(probe, '/formation/reference') == leaders,
+                            START_UP), (statuses, processes.log(transport))
+    assert robot_subscribers(probe, '/formation/shape') == leaders
+    assert robot_subscribers(probe, '/formation/status') == leaders
     assert robot_subscribers(probe, '/clock') == []
     info = stop_when(probe, processes, lambda: clock.seconds >= UNTIL and every_robot_reports(),
                      name=transport)
