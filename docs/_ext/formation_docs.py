@@ -48,7 +48,7 @@ BENCH_FILES = {
     'capacity': ('capacity_process.json', 'capacity_fleet.json', 'capacity_lockstep.json',
                  'capacity_transports.json', 'capacity_lockstep_transports.json',
                  'capacity_team_large.json', 'capacity_targets.json',
-                 'capacity_afternoon.json'),
+                 'capacity_afternoon.json', 'capacity_evening.json'),
     'offline': ('offline.json',),
     'robustness': ('robustness.json',),
     'switch': ('switch.json',),
