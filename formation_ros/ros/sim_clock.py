@@ -8,11 +8,13 @@ With ``use_sim_time`` every rclpy node subscribes to ``/clock`` and runs a Pytho
 tick (the plant publishes one per published state). A robot needs none: every state the plant
 sends it (its ``pose``, or ``/formation/states`` with the team transport) is stamped with the
 plant's simulated time, which is the time the robot needs, so :class:`StateClock` detaches the
-nodes' ``/clock`` subscriptions and sets their clocks to each accepted state's stamp (forward
-only). ``use_sim_time`` still decides which clock a robot is on: with it false the robot stays
-on the wall clock and refuses the plant's states as stamped on another clock. It is fixed while
-the nodes run (:func:`keep_sim_time` refuses a change). Nodes on wall time, and rclpy versions
-without the node's time source attribute, are left as they are.
+nodes' ``/clock`` subscriptions and sets their clocks to each accepted state's stamp: forward
+only while the states come, whichever way it jumps once they had stopped (the robot decides:
+a link cut for a while, a plant started again). ``use_sim_time`` still decides which clock a
+robot is on: with it false the robot stays on the wall clock and refuses the plant's states as
+stamped on another clock. It is fixed while the nodes run (:func:`keep_sim_time` refuses a
+change). Nodes on wall time, and rclpy versions without the node's time source attribute, are
+left as they are.
 """
 
 from typing import List, Optional, Sequence
@@ -58,9 +60,9 @@ class StateClock:
             self.clocks.append(clock)
             node.add_on_set_parameters_callback(keep_sim_time)
 
-    def advance(self, stamp_ns: int) -> None:
-        """Set every clock to ``stamp_ns`` (ns) if it is later than the time they have."""
-        if stamp_ns <= self.now_ns or not self.clocks:
+    def advance(self, stamp_ns: int, jump: bool = False) -> None:
+        """Set every clock to ``stamp_ns`` (ns) if it is later than their time, or ``jump``."""
+        if not self.clocks or stamp_ns == self.now_ns or (stamp_ns < self.now_ns and not jump):
             return
         self.now_ns = stamp_ns
         moment = Time(nanoseconds=stamp_ns, clock_type=self.clocks[0].clock_type)

@@ -12,26 +12,50 @@ import os
 import time
 
 from formation_ros.core.units import NS_PER_S
-from formation_ros.nodes.robot import RobotNode
+from formation_ros.nodes.robot import RobotNode, TeamLink
+from geometry_msgs.msg import Point, Pose, PoseArray
 import pytest
 import rclpy
 from rclpy.parameter import Parameter
+from rclpy.serialization import serialize_message
 import wire
 
 SQUARE = os.path.join(os.path.dirname(__file__), '..', '..', 'config', 'square_4.yaml')
 CORNER = (-2.0, -2.0)
 
 
-def robot_node(sim_time):
+def robot_node(sim_time, transport='robot'):
     """Return (robot 1 with ``use_sim_time``, its context)."""
     context = rclpy.Context()
     rclpy.init(context=context, args=['--ros-args', '--params-file', SQUARE,
-                                      '-p', f'use_sim_time:={str(sim_time).lower()}'])
+                                      '-p', f'use_sim_time:={str(sim_time).lower()}',
+                                      '-p', f'transport:={transport}'])
     return RobotNode(namespace='/robot_1', context=context), context
 
 
+class Steady:
+    """The robots' steady clock, moved by the test (ns)."""
+
+    def __init__(self):
+        self.ns = 10 ** 12
+
+    def __call__(self):
+        return self.ns
+
+    def wait(self, node):
+        """Let more than the robot's input_timeout pass."""
+        self.ns += node.timeout_ns + 1
+
+
 @pytest.fixture
-def sim_robot():
+def steady(monkeypatch):
+    clock = Steady()
+    monkeypatch.setattr(RobotNode, '_now_ns', staticmethod(clock))
+    return clock
+
+
+@pytest.fixture
+def sim_robot(steady):
     """Yield robot 1 on simulated time, then clean up."""
     node, context = robot_node(True)
     try:
@@ -47,6 +71,17 @@ def pose(stamp_s, frame='world'):
 
 def now_s(node):
     return node.get_clock().now().nanoseconds / NS_PER_S
+
+
+def team_state(stamp_s):
+    """Return the bytes of a square_4 team state at ``stamp_s``."""
+    message = PoseArray()
+    message.header.frame_id = 'world'
+    message.header.stamp.sec = int(stamp_s)
+    message.header.stamp.nanosec = int(round((stamp_s % 1.0) * NS_PER_S))
+    message.poses = [Pose(position=Point(x=x, y=y))
+                     for x, y in ((-2.0, -2.0), (2.0, -2.0), (2.0, 2.0), (-2.0, 2.0))]
+    return serialize_message(message)
 
 
 def test_a_robot_on_simulated_time_has_no_clock_subscription(sim_robot):
@@ -73,6 +108,38 @@ def test_a_refused_pose_leaves_its_clock_alone(sim_robot):
     rejected = {reason.name: count for (name, reason), count in sim_robot.rejected.items()
                 if name == 'pose'}
     assert rejected == {'CLOCK': 1, 'FRAME': 1}
+
+
+def test_once_its_states_stopped_the_next_one_sets_its_clock_either_way(sim_robot, steady):
+    sim_robot.on_pose(pose(5.0))
+    steady.wait(sim_robot)
+    sim_robot.on_pose(pose(20.0))
+    assert now_s(sim_robot) == 20.0 and sim_robot.pose_count == 2
+    sim_robot.on_pose(pose(40.0))
+    assert now_s(sim_robot) == 20.0 and sim_robot.pose_count == 2
+    steady.wait(sim_robot)
+    sim_robot.on_pose(pose(0.5))
+    assert now_s(sim_robot) == 0.5 and sim_robot.pose_count == 3
+    assert {(name, reason.name): count for (name, reason), count
+            in sim_robot.rejected.items()} == {('pose', 'CLOCK'): 1}
+
+
+def test_a_team_process_follows_its_states_the_same_way(steady):
+    node, context = robot_node(True, 'team')
+    try:
+        team = TeamLink([node])
+        for stamp, later, taken in ((5.0, False, 5.0), (9.0, False, 5.0), (9.0, True, 9.0),
+                                    (2.0, True, 2.0)):
+            if later:
+                steady.wait(node)
+            team.on_states(team_state(stamp))
+            team.take()
+            assert now_s(node) == taken, (stamp, later)
+        assert {(name, reason.name): count for (name, reason), count
+                in node.rejected.items()} == {('states', 'CLOCK'): 1}
+    finally:
+        node.destroy_node()
+        rclpy.shutdown(context=context)
 
 
 def test_its_use_sim_time_cannot_change_while_it_runs(sim_robot):
