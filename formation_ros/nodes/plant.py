@@ -128,6 +128,9 @@ is at most this many state periods old (as bench_capacity's fresh share)."""
 LISTENERS_PERIOD = 0.5
 """Team transport: seconds between looks at who subscribes to each robot's pose and neighbors
 (published only while someone does)."""
+DOUBLED_WITHIN = 1.5
+"""Team transport: two processes that announced one robot node within this many seconds (their
+statuses come once a second) both run it."""
 LISTENER_LOOKS = 50
 """Team transport: robots whose pose and neighbors subscribers are looked up in the graph per
 LISTENERS_PERIOD while the plant has no publishers of theirs (two lookups each)."""
@@ -238,11 +241,9 @@ class PlantNode(Node):
             self.expected_publishers[self.states_pub.topic_name] = self.own_name
         self.command_index = {sub.topic_name: i for i, sub in enumerate(self.command_subs)}
         self.expected_publishers.update(dict.fromkeys(self.command_index))
-        self.team_cmd_vel_topics = (
-            {topics.robot_topic(i + 1, topics.CMD_VEL): i for i in range(self.n)}
-            if self.team_transport else {})
-        """Team transport: each robot's cmd_vel, watched for a second robot of that id."""
-        self.expected_publishers.update(dict.fromkeys(self.team_cmd_vel_topics))
+        self.robot_nodes = [topics.robot_node_name(i) for i in range(1, self.n + 1)]
+        self.doubled: Dict[str, str] = {}
+        """Team transport: {robot node: its processes} for robots that two processes run."""
         self.diagnostics_pub = self.create_publisher(
             DiagnosticArray, topics.DIAGNOSTICS, qos.DIAGNOSTICS)
         period = RESEND_AFTER if self.lockstep else self.model.dt / settings.realtime_factor
@@ -744,6 +745,10 @@ class PlantNode(Node):
         if others:
             values['nodes with other team values'] = ' | '.join(others)
         shared = self._shared_topics(now)
+        doubled = self._doubled_robots(now)
+        if doubled:
+            values['robot nodes in more than one process'] = ' | '.join(
+                f'{name}: {processes}' for name, processes in sorted(doubled.items()))
         plants = (self.team.running(self.own_name, now) if self.looked and not self.refusal
                   else [])
         if plants:
@@ -756,10 +761,12 @@ class PlantNode(Node):
         if shared:
             values['topics with more than one publisher'] = ' | '.join(
                 f'{topic}: {names}' for topic, names in sorted(shared.items()))
-        if counts.collisions or counts.bound_violations or shared or others or plants:
+        if (counts.collisions or counts.bound_violations or shared or doubled or others
+                or plants):
             level, message = 'error', (f'{counts.collisions} collisions, '
                                        f'{counts.bound_violations} commands above the bound, '
                                        f'{len(shared)} topics with several publishers, '
+                                       f'{len(doubled)} robots in several processes, '
                                        f'{len(others)} nodes with other team values')
         elif not self.looked:
             level, message = 'ok', 'looking for another plant on this domain'
@@ -812,8 +819,7 @@ class PlantNode(Node):
         for topic, names in shared.items():
             by_names.setdefault(names, []).append(topic)
         for names, listed in by_names.items():
-            hint = ('a second node with this robot_id?'
-                    if listed[0] in self.command_index or listed[0] in self.team_cmd_vel_topics
+            hint = ('a second node with this robot_id?' if listed[0] in self.command_index
                     else 'another team on this domain, or a node forging them?')
             self.once.start(f'publishers-{names}', f'{_some(listed)} more than one publisher: '
                                                    f'{names} ({hint})', 'error')
@@ -822,12 +828,33 @@ class PlantNode(Node):
         self.shared = shared
         return shared
 
+    def _doubled_robots(self, now: float) -> Dict[str, str]:
+        """
+        Team transport: return {robot node: its processes} run by two processes; log each once.
+
+        Two processes that claim one robot both answer for it on the team topic, where the
+        plant cannot tell them apart; each announces its robots' nodes, host and process in
+        its ``/diagnostics`` once a second (``ros.team.TeamCheck``), which shows them: both
+        within DOUBLED_WITHIN s (a restarted process announces its first more than that after
+        the one it replaces announced its last).
+        """
+        if not self.team_transport or not self.looked:
+            return {}
+        doubled = {name: self.team.describe(name, now) for name in self.robot_nodes
+                   if len(self.team.running(name, now, DOUBLED_WITHIN)) >= 2}
+        for name, processes in doubled.items():
+            self.once.start(f'doubled-{name}', f'{name} runs in more than one process: '
+                                               f'{processes} (a second node with this '
+                                               'robot_id?)', 'error')
+        for name in set(self.doubled) - set(doubled):
+            self.once.end(f'doubled-{name}', f'{name} runs in one process again')
+        self.doubled = doubled
+        return doubled
+
     def _alive(self, topic: str, names: List[str]) -> bool:
         """Whether a same-named second publisher of ``topic`` is known to run."""
         now = time.monotonic()
         index = self.command_index.get(topic)
-        if topic in self.team_cmd_vel_topics:
-            return len(self.team.running(names[0], now)) >= 2
         if index is None:
             return bool(self.team.running(self.own_name, now))
         return (self.command_liveliness[index].alive >= 2

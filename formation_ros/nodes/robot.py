@@ -46,8 +46,9 @@ then instead of advising ``use_sim_time``.
 With ``transport: team`` a robot hears no ``pose`` or ``neighbors``: its process reads the
 team's ``/formation/states`` once for all its robots and answers with one
 ``/formation/commands`` message (:class:`TeamLink`); its ``cmd_vel`` carries its command only
-while someone subscribes to it (the publisher is there all the same: two processes that claim
-one robot show as two publishers of its ``cmd_vel``, which the plant names). The process
+while someone subscribes to it, and unless more subscribers than the plant are awaited
+(``wait_for_subscribers`` > 1) its publisher is made only once a subscriber shows in the graph
+(a thousand publishers nobody hears are a thousand endpoints for discovery). The process
 evaluates the reference frame for each state's stamp itself from the reference's parameters
 and the changes the reference node announced; the reference node's samples, heard by the
 first robot of the process alone, are checked as always and against that frame, and in
@@ -126,9 +127,10 @@ STALE_MARGIN_NS = 1_000_000
 LISTENERS_PERIOD = 0.5
 """Team transport: seconds between looks at who subscribes to the robots' cmd_vel."""
 LISTENER_LOOKS = 10
-"""Team transport: robots of a process whose cmd_vel subscribers are looked up per look (in
-turn; those with subscribers at every look): a subscriber to one of K robots' cmd_vel gets
-data within ceil(K / LISTENER_LOOKS) looks of its discovery, 1.5 s in a fleet of 25."""
+"""Team transport: robots of a process without a cmd_vel publisher looked up in the graph per
+look, in turn (each lookup costs more as the graph grows): a subscriber to one of K robots'
+cmd_vel gets data within ceil(K / LISTENER_LOOKS) + 1 looks of its discovery, 2 s in a fleet
+of 25. A robot with a publisher is looked at every look (its matched subscribers: no graph)."""
 TEAM_VALUES = ('num_robots', 'dim', 'world_frame', 'repulsion_radius', 'controller.gain',
                'controller.kappa', 'controller.psi', 'jump.kind', 'jump.order', 'body.kind',
                'body.hand_distance', 'command.type', 'command.frame', 'plant.lockstep',
@@ -257,9 +259,10 @@ class RobotNode(Node):
                 self.expected_publishers[topics.CLOCK] = None
             self.changes = Changes(self, config, self.steady, self._reject_change,
                                    self._new_state)
-        self.cmd_pub = self.create_publisher(TwistStamped if self.stamped else Twist,
-                                             topics.CMD_VEL, qos.TEAM_CMD_VEL
-                                             if config.team_transport else qos.COMMAND)
+        self.lazy_cmd_vel = config.team_transport and self.wait_subscribers <= 1
+        """Team transport with only the plant awaited: this robot's ``cmd_vel`` publisher is
+        made once a subscriber shows in the graph (:meth:`TeamLink.look_at_listeners`)."""
+        self.cmd_pub: Optional[Publisher] = None if self.lazy_cmd_vel else self.make_cmd_pub()
         self.reported: List[RobotNode] = [self]
         """The robots whose statuses this node publishes (a fleet's first robot: all of its)."""
         self.announcing: Optional[Tuple[Shape, Dict[str, str]]] = None
@@ -289,6 +292,12 @@ class RobotNode(Node):
             + ('lockstep' if self.lockstep else f'{settings.control_rate:g} Hz')
             + (', team transport' if config.team_transport else '')
             + (", simulated time from the states' stamps" if self.sim_time else ''))
+
+    def make_cmd_pub(self) -> Publisher:
+        """Create this robot's ``cmd_vel`` publisher (a team robot's offers no lease)."""
+        return self.create_publisher(TwistStamped if self.stamped else Twist, topics.CMD_VEL,
+                                     qos.TEAM_CMD_VEL if self.config.team_transport
+                                     else qos.COMMAND)
 
     def _subscribe_to_states(self, pose_type: PoseType) -> None:
         """Robot transport: hear this robot's ``pose`` and ``neighbors``."""
@@ -613,6 +622,7 @@ class RobotNode(Node):
             message = encode_twist_stamped(stamp_ns, self.command_frame, linear, angular)
         else:
             message = encode_twist(linear, angular)
+        assert self.cmd_pub is not None
         self.cmd_pub.publish(message)
         self.last_message = message
 
@@ -706,6 +716,7 @@ class RobotNode(Node):
             elif (self.last_message is not None
                   and now - self.resent_ns >= max(COPY_GAP_NS, self.budget.period_ns)):
                 if self.team is None:
+                    assert self.cmd_pub is not None
                     self.cmd_pub.publish(self.last_message)
                 else:
                     self.team.resend()
@@ -732,8 +743,9 @@ class RobotNode(Node):
     def _ready(self) -> bool:
         """Start-up: every input heard once and cmd_vel has its subscribers (plant, recorder)."""
         never = [name for name in INPUTS if self.received_ns[name] is None]
-        listeners = (self.cmd_pub.get_subscription_count() if self.team is None
-                     else self.team.listeners())
+        listeners = (self.team.listeners() if self.team is not None
+                     else self.cmd_pub.get_subscription_count() if self.cmd_pub is not None
+                     else 0)
         if never or listeners < self.wait_subscribers:
             what = 'cmd_vel' if self.team is None else 'command (team topic and cmd_vel)'
             missing = never + ([f'{self.wait_subscribers} {what} subscribers (have '
@@ -776,8 +788,9 @@ class RobotNode(Node):
                 or (self.member_of is not None and self.team is None)):
             return
         self._publish_command(None, self.pose.stamp_ns)
-        (self.cmd_pub if self.team is None else self.team.pub).wait_for_all_acked(
-            Duration(seconds=LAST_WORD))
+        last = self.cmd_pub if self.team is None else self.team.pub
+        if last is not None:
+            last.wait_for_all_acked(Duration(seconds=LAST_WORD))
 
     def on_diagnostics(self) -> None:
         """Publish one DiagnosticArray with the status of each robot this node reports."""
@@ -873,7 +886,8 @@ class TeamLink:
     state as a robot answers one (the leader's answer budget, watchdog and lockstep rules):
     every robot's command from one call of the law (``core.law.robot_commands``,
     :meth:`commands`), in one team command message (:meth:`publish`). Robot i's own
-    ``cmd_vel`` carries its command too while something subscribes to it. The reference frame
+    ``cmd_vel`` carries its command too while something subscribes to it
+    (:meth:`look_at_listeners`). The reference frame
     is evaluated in the process for each state's stamp (:meth:`RobotNode._reference_for`); the
     leader alone hears the reference node (its samples checked: on this clock, plausible, the
     frame evaluated here) and the changes. The nodes' simulated clocks follow the states'
@@ -946,22 +960,32 @@ class TeamLink:
         """
         Note which robots' cmd_vel someone subscribes to (published only then).
 
-        LISTENER_LOOKS robots a look, in turn, and every robot whose cmd_vel had subscribers:
-        each lookup costs more as the graph grows.
+        A robot without a publisher (``RobotNode.lazy_cmd_vel``) gets one when its turn
+        (LISTENER_LOOKS robots a look) finds a subscriber in the graph; it is published to
+        from the look after, once the subscriber has matched it.
         """
-        looked = set(self.turns.due(len(self.nodes)))
-        looked.update(np.flatnonzero(self.listening).tolist())
-        for k in looked:
-            self.listening[k] = self.nodes[k].cmd_pub.get_subscription_count() > 0
+        lazy = [k for k in self.turns.due(len(self.nodes)) if self.nodes[k].cmd_pub is None]
+        for k in lazy:
+            node = self.nodes[k]
+            if node.count_subscribers(topics.CMD_VEL) > 0:
+                node.cmd_pub = node.make_cmd_pub()
+        self.listening = np.array([node.cmd_pub is not None
+                                   and node.cmd_pub.get_subscription_count() > 0
+                                   for node in self.nodes], dtype=bool)
 
     def publishes_cmd_vel(self, node: RobotNode) -> str:
         """Return 'yes' while robot ``node``'s own cmd_vel is published (someone listens)."""
         return 'yes' if self.listening[self.local[node.index]] else 'no'
 
     def listeners(self) -> int:
-        """Return the command subscribers every robot has: team topic plus its fewest cmd_vel."""
-        return (self.pub.get_subscription_count()
-                + min(node.cmd_pub.get_subscription_count() for node in self.nodes))
+        """
+        Return the command subscribers every robot has: team topic plus its fewest cmd_vel.
+
+        Those of the team topic alone with lazy cmd_vel publishers (only the plant awaited).
+        """
+        return self.pub.get_subscription_count() + min(
+            0 if node.cmd_pub is None else node.cmd_pub.get_subscription_count()
+            for node in self.nodes)
 
     def take(self) -> None:
         """
@@ -1075,6 +1099,7 @@ class TeamLink:
                       if self.nodes[k].stamped else encode_twist(linear[k], angular[k]))
                      for k in np.flatnonzero(self.listening).tolist()]
         for node, own in self.sent:
+            assert node.cmd_pub is not None
             node.cmd_pub.publish(own)
         self.last_sent = message
         return message
@@ -1085,6 +1110,7 @@ class TeamLink:
             return
         self.pub.publish(self.last_sent)
         for node, own in self.sent:
+            assert node.cmd_pub is not None
             node.cmd_pub.publish(own)
 
 

@@ -124,11 +124,11 @@ class TeamCheck:
             if values:
                 self.heard[status.name] = values
 
-    def running(self, node_name: str, now: float) -> List[Process]:
-        """Return the other processes that announced node ``node_name`` in the last LIVE_FOR s."""
+    def running(self, node_name: str, now: float, within: float = LIVE_FOR) -> List[Process]:
+        """Return the other processes that announced ``node_name`` in the last ``within`` s."""
         self._take()
         return sorted(process for process, when in self.processes.get(node_name, {}).items()
-                      if now - when <= LIVE_FOR)
+                      if now - when <= within)
 
     def describe(self, node_name: str, now: float) -> str:
         """Name a node with its host and process, where it announced them; else say so."""

@@ -65,6 +65,11 @@ def robot_namespace(robot_id: int) -> str:
     return f'/robot_{robot_id}'
 
 
+def robot_node_name(robot_id: int) -> str:
+    """Return the fully qualified name of robot ``robot_id``'s node: ``/robot_<i>/robot``."""
+    return f'{robot_namespace(robot_id)}/robot'
+
+
 def robot_topic(robot_id: int, name: str) -> str:
     """Return the absolute name of a robot topic: (3, CMD_VEL) gives ``/robot_3/cmd_vel``."""
     return f'{robot_namespace(robot_id)}/{name}'

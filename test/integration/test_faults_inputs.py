@@ -151,17 +151,28 @@ def test_identity_comes_from_the_namespace(processes, install, probe):
 @pytest.mark.parametrize('transport', ['robot', 'team'])
 def test_two_publishers_on_one_cmd_vel_are_reported(processes, install, probe, tmp_path,
                                                     transport):
-    """Two robot processes with robot_id 1: named by the plant, with either transport."""
+    """
+    Two robot processes with robot_id 1: named by the plant, with either transport.
+
+    Robot transport: two publishers of /robot_1/cmd_vel. Team transport (where a robot's
+    cmd_vel publisher is made only for a subscriber): one robot node announced by two
+    processes on /diagnostics.
+    """
     params = write_params(tmp_path, 'square_4.yaml', {'transport': transport})
     processes.start(node(install, 'plant', params))
-    for name in ('robot_1', 'robot_1_again'):
-        processes.start(node(install, 'robot', params, '-r', '__ns:=/robot_1',
-                             '-p', 'use_sim_time:=true', process=name))
-    said = '/robot_1/cmd_vel has more than one publisher: /robot_1/robot'
+    started = [processes.start(node(install, 'robot', params, '-r', '__ns:=/robot_1',
+                                    '-p', 'use_sim_time:=true', process=name))
+               for name in ('robot_1', 'robot_1_again')]
+    said = ('/robot_1/cmd_vel has more than one publisher: /robot_1/robot' if transport == 'robot'
+            else '/robot_1/robot runs in more than one process: /robot_1/robot on ')
     assert probe.spin_until(lambda: said in processes.log('plant'), START_UP), \
         processes.log('plant')
-    assert processes.log('plant').count('more than one publisher') == 1, processes.log('plant')
-    assert 'a second node with this robot_id?' in processes.log('plant')
+    log = processes.log('plant')
+    assert log.count(said) == 1, log
+    assert 'a second node with this robot_id?' in log
+    if transport == 'team':
+        line = next(line for line in log.splitlines() if said in line)
+        assert all(f'(process {robot.pid})' in line for robot in started), line
     assert not math.isnan(BOUND)
 
 
