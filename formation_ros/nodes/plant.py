@@ -818,13 +818,12 @@ class PlantNode(Node):
         by_names: Dict[str, List[str]] = {}
         for topic, names in shared.items():
             by_names.setdefault(names, []).append(topic)
-        for names, listed in by_names.items():
-            hint = ('a second node with this robot_id?' if listed[0] in self.command_index
-                    else 'another team on this domain, or a node forging them?')
-            self.once.start(f'publishers-{names}', f'{_some(listed)} more than one publisher: '
-                                                   f'{names} ({hint})', 'error')
-        for names in set(self.shared.values()) - set(by_names):
-            self.once.end(f'publishers-{names}', f'{names}: no longer publishing here')
+        lines = {names: f'{_some(listed)} more than one publisher: {names} ('
+                 + ('a second node with this robot_id?' if listed[0] in self.command_index
+                    else 'another team on this domain, or a node forging them?') + ')'
+                 for names, listed in by_names.items()}
+        self.once.follow('publishers', lines, self.shared.values(),
+                         lambda names: f'{names}: no longer publishing here')
         self.shared = shared
         return shared
 
@@ -842,12 +841,10 @@ class PlantNode(Node):
             return {}
         doubled = {name: self.team.describe(name, now) for name in self.robot_nodes
                    if len(self.team.running(name, now, DOUBLED_WITHIN)) >= 2}
-        for name, processes in doubled.items():
-            self.once.start(f'doubled-{name}', f'{name} runs in more than one process: '
-                                               f'{processes} (a second node with this '
-                                               'robot_id?)', 'error')
-        for name in set(self.doubled) - set(doubled):
-            self.once.end(f'doubled-{name}', f'{name} runs in one process again')
+        self.once.follow('doubled', {name: f'{name} runs in more than one process: {processes}'
+                                           ' (a second node with this robot_id?)'
+                                     for name, processes in doubled.items()},
+                         self.doubled, lambda name: f'{name} runs in one process again')
         self.doubled = doubled
         return doubled
 

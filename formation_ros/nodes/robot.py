@@ -863,12 +863,11 @@ class RobotNode(Node):
     def _shared_topics(self) -> Dict[str, str]:
         """Return {topic: its publishers} of /clock and the reference with several; log once."""
         shared = self.graph.check(self.expected_publishers, time.monotonic())
-        for topic, names in shared.items():
-            self.once.start(f'publishers-{topic}', f'{topic} has more than one publisher: '
-                                                   f'{names} (two teams on one domain? each '
-                                                   'needs a ROS_DOMAIN_ID of its own)', 'error')
-        for topic in set(self.shared) - set(shared):
-            self.once.end(f'publishers-{topic}', f'{topic} has one publisher again')
+        self.once.follow('publishers', {topic: f'{topic} has more than one publisher: {names} '
+                                               '(two teams on one domain? each needs a '
+                                               'ROS_DOMAIN_ID of its own)'
+                                        for topic, names in shared.items()},
+                         self.shared, lambda topic: f'{topic} has one publisher again')
         self.shared = shared
         return shared
 

@@ -3,7 +3,7 @@
 
 """Log a condition once when it starts and once when it ends, not every cycle."""
 
-from typing import Any, Callable, List, Sequence, Set
+from typing import Any, Callable, Iterable, List, Mapping, Sequence, Set
 
 
 class OnceLog:
@@ -43,6 +43,19 @@ class OnceLog:
             self._active.difference_update(ended)
             self._logger.info(message(ended))
         return ended
+
+    def follow(self, prefix: str, present: Mapping[str, str], before: Iterable[str],
+               ended: Callable[[str], str], level: str = 'error') -> None:
+        """
+        Log each condition of ``present`` once as it starts, and each of ``before`` that ended.
+
+        present: {name: the line to log when it starts}; before: the names present last time,
+        each gone one logged (info) as ``ended(name)``; keys are ``prefix-name``.
+        """
+        for name, line in present.items():
+            self.start(f'{prefix}-{name}', line, level)
+        for name in set(before) - set(present):
+            self.end(f'{prefix}-{name}', ended(name))
 
     def _say(self, message: str, level: str) -> None:
         # rclpy ties a severity to each call site, hence one call per level.

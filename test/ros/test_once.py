@@ -51,3 +51,17 @@ def test_robots_are_named_one_by_one_up_to_five_then_counted():
     assert robots_named([3]) == 'robot 4'
     assert robots_named([6, 0, 3]) == 'robots 1, 4 and 7'
     assert robots_named(range(100)) == 'robots 1, 2, 3, 4, 5 and 95 more'
+
+
+def test_followed_conditions_are_logged_as_they_start_and_end():
+    logger = Logger()
+    once = OnceLog(logger)
+    once.follow('doubled', {'/robot_1/robot': 'robot 1 twice'}, [], lambda name: f'{name} ok')
+    once.follow('doubled', {'/robot_1/robot': 'robot 1 twice', '/robot_2/robot': 'robot 2 twice'},
+                ['/robot_1/robot'], lambda name: f'{name} ok')
+    once.follow('doubled', {'/robot_2/robot': 'robot 2 twice'},
+                ['/robot_1/robot', '/robot_2/robot'], lambda name: f'{name} ok')
+    assert logger.lines == [('error', 'robot 1 twice'), ('error', 'robot 2 twice'),
+                            ('info', '/robot_1/robot ok')]
+    assert once.is_active('doubled-/robot_2/robot')
+    assert not once.is_active('doubled-/robot_1/robot')
