@@ -30,6 +30,7 @@ runs (one per mode, say) and runs nothing.
 """
 
 import argparse
+import contextlib
 import datetime
 import json
 import os
@@ -351,13 +352,12 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         for rate in args.rates:
             for n in args.sizes:
                 for transport in args.transports:
+                    kept = os.path.join(args.out, f'{transport}-{mode}-{n}-{rate:g}')
                     if args.keep:
-                        folder = os.path.join(args.out, f'{transport}-{mode}-{n}-{rate:g}')
-                        os.makedirs(folder, exist_ok=True)
+                        os.makedirs(kept, exist_ok=True)
+                    with (contextlib.nullcontext(kept) if args.keep
+                          else tempfile.TemporaryDirectory(dir=args.out)) as folder:
                         row = run_case(args, mode, n, rate, folder, transport)
-                    else:
-                        with tempfile.TemporaryDirectory(dir=args.out) as folder:
-                            row = run_case(args, mode, n, rate, folder, transport)
                     rows.append(row)
                     print(format_row(row), flush=True)
     result = {**machine, 'load_after': os.getloadavg(), 'arguments': vars(args), 'rows': rows}

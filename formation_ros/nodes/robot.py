@@ -20,9 +20,9 @@ it. The watchdog, another one-shot timer, looks when the oldest input is due to 
 ``control_rate`` while the inputs stay stale. The command is stamped with the stamp of the
 state it was computed from, so the plant can tell how old it is (and, in lockstep, which state
 it answers). On simulated time (``use_sim_time:=true``, beside a plant) a robot's clock is set
-from the stamps of the poses it accepts, which carry the plant's simulated time (forward only,
-``formation_ros.ros.sim_clock.StateClock``): no ``/clock`` subscription, one message less per
-state; its ``use_sim_time`` is then fixed while it runs.
+from the stamps of the poses it accepts, which carry the plant's simulated time
+(``formation_ros.ros.sim_clock.StateClock``; forward only while they come): no ``/clock``
+subscription, one message less per state; its ``use_sim_time`` is then fixed while it runs.
 Every input is read from its serialized bytes and the command written as bytes
 (``formation_ros.ros.cdr``): rclpy's own conversions were most of a robot's time.
 
@@ -299,6 +299,11 @@ class RobotNode(Node):
                                      qos.TEAM_CMD_VEL if self.config.team_transport
                                      else qos.COMMAND)
 
+    def cmd_vel_pub(self) -> Publisher:
+        """Return this robot's ``cmd_vel`` publisher where it is published to (made then)."""
+        assert self.cmd_pub is not None
+        return self.cmd_pub
+
     def _subscribe_to_states(self, pose_type: PoseType) -> None:
         """Robot transport: hear this robot's ``pose`` and ``neighbors``."""
         if pose_type is PoseType.ODOMETRY:
@@ -333,9 +338,11 @@ class RobotNode(Node):
         (:meth:`_states_stopped`): the next state's stamp is then the time.
         """
         now = self.get_clock().now().nanoseconds
-        if self.sim_time and (now == 0 or self._states_stopped()):
+        gap_ns = stamp_ns - now
+        if self.sim_time and (now == 0 or (abs(gap_ns) > self.timeout_ns
+                                           and self._states_stopped())):
             return 0.0
-        return (stamp_ns - now) / NS_PER_S
+        return gap_ns / NS_PER_S
 
     def _states_stopped(self) -> bool:
         """
@@ -622,8 +629,7 @@ class RobotNode(Node):
             message = encode_twist_stamped(stamp_ns, self.command_frame, linear, angular)
         else:
             message = encode_twist(linear, angular)
-        assert self.cmd_pub is not None
-        self.cmd_pub.publish(message)
+        self.cmd_vel_pub().publish(message)
         self.last_message = message
 
     def on_state(self) -> None:
@@ -716,8 +722,7 @@ class RobotNode(Node):
             elif (self.last_message is not None
                   and now - self.resent_ns >= max(COPY_GAP_NS, self.budget.period_ns)):
                 if self.team is None:
-                    assert self.cmd_pub is not None
-                    self.cmd_pub.publish(self.last_message)
+                    self.cmd_vel_pub().publish(self.last_message)
                 else:
                     self.team.resend()
                 self.resent_ns = now
@@ -743,9 +748,8 @@ class RobotNode(Node):
     def _ready(self) -> bool:
         """Start-up: every input heard once and cmd_vel has its subscribers (plant, recorder)."""
         never = [name for name in INPUTS if self.received_ns[name] is None]
-        listeners = (self.team.listeners() if self.team is not None
-                     else self.cmd_pub.get_subscription_count() if self.cmd_pub is not None
-                     else 0)
+        listeners = (self.cmd_vel_pub().get_subscription_count() if self.team is None
+                     else self.team.listeners())
         if never or listeners < self.wait_subscribers:
             what = 'cmd_vel' if self.team is None else 'command (team topic and cmd_vel)'
             missing = never + ([f'{self.wait_subscribers} {what} subscribers (have '
@@ -788,9 +792,8 @@ class RobotNode(Node):
                 or (self.member_of is not None and self.team is None)):
             return
         self._publish_command(None, self.pose.stamp_ns)
-        last = self.cmd_pub if self.team is None else self.team.pub
-        if last is not None:
-            last.wait_for_all_acked(Duration(seconds=LAST_WORD))
+        (self.cmd_vel_pub() if self.team is None else self.team.pub).wait_for_all_acked(
+            Duration(seconds=LAST_WORD))
 
     def on_diagnostics(self) -> None:
         """Publish one DiagnosticArray with the status of each robot this node reports."""
@@ -1098,8 +1101,7 @@ class TeamLink:
                       if self.nodes[k].stamped else encode_twist(linear[k], angular[k]))
                      for k in np.flatnonzero(self.listening).tolist()]
         for node, own in self.sent:
-            assert node.cmd_pub is not None
-            node.cmd_pub.publish(own)
+            node.cmd_vel_pub().publish(own)
         self.last_sent = message
         return message
 
@@ -1109,8 +1111,7 @@ class TeamLink:
             return
         self.pub.publish(self.last_sent)
         for node, own in self.sent:
-            assert node.cmd_pub is not None
-            node.cmd_pub.publish(own)
+            node.cmd_vel_pub().publish(own)
 
 
 def make_robot() -> RobotNode:
