@@ -58,7 +58,7 @@ import json
 import os
 import shutil
 import time
-from typing import Any, Dict, List, Optional
+from typing import Any, Dict, List, Optional, Set
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.bodies import make_bodies
@@ -189,6 +189,8 @@ class PlantNode(Node):
         self.largest_u_hat = 0.0
         self.command_subs = []
         self.shared: Dict[str, str] = {}
+        self.shared_by: Set[str] = set()
+        """The publishers (names without hosts) of each line on :attr:`shared` logged."""
         self.last_publish_wall = 0.0
         self.started_wall: Optional[float] = None
         self.waiting = settings.wait_for_robots or self.lockstep
@@ -816,15 +818,16 @@ class PlantNode(Node):
                         if topic != self.clock_pub.topic_name}
         shared = self.graph.check(expected, now, self._alive)
         by_names: Dict[str, List[str]] = {}
-        for topic, names in shared.items():
-            by_names.setdefault(names, []).append(topic)
-        lines = {names: f'{_some(listed)} more than one publisher: {names} ('
+        for topic in shared:
+            by_names.setdefault(self.graph.others(topic, expected[topic]), []).append(topic)
+        lines = {names: f'{_some(listed)} more than one publisher: {shared[listed[0]]} ('
                  + ('a second node with this robot_id?' if listed[0] in self.command_index
                     else 'another team on this domain, or a node forging them?') + ')'
                  for names, listed in by_names.items()}
-        self.once.follow('publishers', lines, self.shared.values(),
+        self.once.follow('publishers', lines, self.shared_by,
                          lambda names: f'{names}: no longer publishing here')
         self.shared = shared
+        self.shared_by = set(lines)
         return shared
 
     def _doubled_robots(self, now: float) -> Dict[str, str]:

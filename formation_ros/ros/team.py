@@ -134,7 +134,12 @@ class TeamCheck:
         """Name a node with its host and process, where it announced them; else say so."""
         found = self.running(node_name, now)
         if not found:
-            return f'{node_name} (host unknown: it announces none on /diagnostics)'
+            heard = self.processes.get(node_name, {})
+            if not heard:
+                return f'{node_name} (host unknown: it announces none on /diagnostics)'
+            (host, pid), when = max(heard.items(), key=lambda item: item[1])
+            return (f'{node_name} (silent on /diagnostics for {now - when:.0f} s; last on host '
+                    f'{host} (process {pid}))')
         return f'{node_name} on ' + ', '.join(f'host {host} (process {pid})'
                                               for host, pid in found)
 
@@ -177,6 +182,14 @@ def team_problems(check: TeamCheck, config: FormationConfig, shape: NDArray[np.f
         if name not in found:
             once.end(f'team-{name}', f'{name} agrees with the team again')
     return lines
+
+
+def _without(names: Sequence[str], own: Optional[str]) -> List[str]:
+    """Return ``names`` less one ``own`` (the expected publisher; None: keep all)."""
+    others = list(names)
+    if own is not None and own in others:
+        others.remove(own)
+    return others
 
 
 class PublisherWatch:
@@ -264,11 +277,18 @@ class PublisherWatch:
                 due[topic] = self.name_others(names, own, now)
         return due
 
+    def others(self, topic: str, own: Optional[str]) -> str:
+        """
+        Name the publishers of ``topic`` other than ``own`` as last looked at, without hosts.
+
+        A condition's key: the hosts :meth:`name_others` adds come and go with the
+        announcements on ``/diagnostics`` (late on a busy machine), the names do not.
+        """
+        return ', '.join(sorted(set(_without(self.listed.get(topic, []), own))))
+
     def name_others(self, names: Sequence[str], own: Optional[str], now: float) -> str:
         """Describe the publishers of a topic other than ``own`` (all of them if it is None)."""
-        others = list(names)
-        if own is not None and own in others:
-            others.remove(own)
+        others = _without(names, own)
         described = []
         for name in sorted(set(others)):
             text = self.team.describe(name, now) if self.team is not None else name

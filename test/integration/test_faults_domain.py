@@ -5,6 +5,7 @@
 
 import os
 import re
+from signal import SIGCONT, SIGSTOP
 import socket
 
 from diagnostic_msgs.msg import DiagnosticStatus
@@ -77,18 +78,18 @@ def test_a_plant_refuses_a_domain_with_another_clock(processes, install, probe):
 
 
 def start_plant_and_robot_1(processes, install, probe):
-    """Start a plant that does not wait for robots and robot 1; return the clock once it runs."""
+    """Start a plant that does not wait for robots and robot 1; return robot 1 once time runs."""
     processes.start(node(install, 'plant', SQUARE, '-p', 'plant.wait_for_robots:=false'))
-    processes.start(node(install, 'robot', SQUARE, '-r', '__ns:=/robot_1',
-                         '-p', 'use_sim_time:=true', process='robot_1'))
+    robot = processes.start(node(install, 'robot', SQUARE, '-r', '__ns:=/robot_1',
+                                 '-p', 'use_sim_time:=true', process='robot_1'))
     clock = SimClock(probe)
     assert probe.spin_until(lambda: clock.seconds > 0.5, START_UP), processes.log('plant')
-    return clock
+    return robot
 
 
 def test_a_running_plant_names_a_second_publisher_on_pose_and_cmd_vel(processes, install, probe):
     statuses = Statuses(probe)
-    start_plant_and_robot_1(processes, install, probe)
+    robot = start_plant_and_robot_1(processes, install, probe)
     commands = probe.create_publisher(TwistStamped, '/robot_1/cmd_vel', qos.COMMAND)
     poses = probe.create_publisher(PoseStamped, '/robot_1/pose', qos.STATE)
 
@@ -100,10 +101,28 @@ def test_a_running_plant_names_a_second_publisher_on_pose_and_cmd_vel(processes,
                                          processes.log('plant'))
     text = value(statuses, 'formation_ros/plant', 'topics with more than one publisher')
     assert '/robot_1/robot' in text.split('/robot_1/cmd_vel: ')[1], text
-    for text in ('/robot_1/pose has more than one publisher: /probe',
-                 '/robot_1/cmd_vel has more than one publisher: /probe'):
+    lines = ('/robot_1/pose has more than one publisher: /probe',
+             '/robot_1/cmd_vel has more than one publisher: /probe')
+    for text in lines:
         assert said_once(probe, processes, 'plant', text, statuses,
                          'formation_ros/plant') == 1, processes.log('plant')
+
+    def described(host):
+        text = value(statuses, 'formation_ros/plant', 'topics with more than one publisher')
+        return f'/robot_1/robot {host}' in text
+
+    # A robot whose announcements lapse (a busy machine) is the same publisher still.
+    os.kill(robot.pid, SIGSTOP)
+    try:
+        assert probe.spin_until(lambda: described('(silent on /diagnostics for'), 60), \
+            processes.log('plant')
+    finally:
+        os.kill(robot.pid, SIGCONT)
+    assert probe.spin_until(lambda: described(f'on host {HOST}'), 60), processes.log('plant')
+    for text in lines:
+        assert said_once(probe, processes, 'plant', text, statuses,
+                         'formation_ros/plant') == 1, processes.log('plant')
+    assert 'no longer publishing here' not in processes.log('plant')
     assert commands.topic_name == '/robot_1/cmd_vel' and poses.topic_name == '/robot_1/pose'
 
 

@@ -51,3 +51,17 @@ def test_a_later_array_replaces_what_a_node_said_before():
     check.store(DiagnosticArray(status=[status('formation_ros/robot_2', '1', '/robot_2/robot',
                                                num_robots='4')]))
     assert check.disagreeing({'num_robots': '4'}) == {}
+
+
+def test_a_node_is_named_with_its_host_then_as_silent_once_its_announcements_lapse():
+    check = TeamCheck(Node(), 'formation_ros/plant')
+    check.store(DiagnosticArray(status=[status('formation_ros/robot_2', '4242',
+                                               '/robot_2/robot')]))
+    check.running('/robot_2/robot', 0.0)
+    heard = check.processes['/robot_2/robot'][('elsewhere', '4242')]
+    assert check.describe('/robot_2/robot', heard + 1.0) == \
+        '/robot_2/robot on host elsewhere (process 4242)'
+    assert check.describe('/robot_2/robot', heard + 7.2) == (
+        '/robot_2/robot (silent on /diagnostics for 7 s; last on host elsewhere (process 4242))')
+    assert check.describe('/robot_9/robot', heard) == \
+        '/robot_9/robot (host unknown: it announces none on /diagnostics)'
