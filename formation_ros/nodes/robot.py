@@ -23,6 +23,12 @@ it answers). On simulated time (``use_sim_time:=true``, beside a plant) a robot'
 from the stamps of the poses it accepts, which carry the plant's simulated time
 (``formation_ros.ros.sim_clock.StateClock``; forward only while they come): no ``/clock``
 subscription, one message less per state; its ``use_sim_time`` is then fixed while it runs.
+There it also evaluates the reference frame at each state's stamp itself, from the reference's
+parameters and the changes announced on ``/formation/status`` (the function the reference node
+publishes from), and checks the reference node's samples against it: they show the reference
+runs on the plant's time, but need not come with every state (``reference.rate`` below the
+control rate costs nothing). On the wall clock it carries the newest sample to the state's
+stamp.
 Every input is read from its serialized bytes and the command written as bytes
 (``formation_ros.ros.cdr``): rclpy's own conversions were most of a robot's time.
 
@@ -205,6 +211,10 @@ class RobotNode(Node):
                               else self.world_frame)
         self.last_body_command: Optional[NDArray[np.float64]] = None
         self.sim_time = bool(self.get_parameter('use_sim_time').value)
+        self.evaluates = config.team_transport or self.sim_time
+        """Whether this robot evaluates the reference at each state's stamp itself (the team
+        transport, and simulated time: the reference node's time is then the plant's) and
+        checks the samples against it; else it carries the newest sample to the stamp."""
         self.once = OnceLog(self.get_logger())
         self.steady = Clock(clock_type=ClockType.STEADY_TIME)
 
@@ -476,11 +486,11 @@ class RobotNode(Node):
             self._reject('reference', Reason.NON_FINITE)
         elif not self._plausible(msg) and not (self.changes.take() and self._plausible(msg)):
             self._reject('reference', Reason.TOO_FAST)
-        elif self.team is not None and not self._same_reference(msg):
+        elif self.evaluates and not self._same_reference(msg):
             self._reject('reference', Reason.OTHER_REFERENCE, ' (another parameters file or '
                                                               'reference.* on one of them?)')
         else:
-            if self.team is not None:
+            if self.evaluates:
                 self.once.end(f'reference-{Reason.OTHER_REFERENCE.name}',
                               'the reference is the one this robot evaluates again')
             self.references.append(msg)
@@ -513,7 +523,7 @@ class RobotNode(Node):
 
     def _same_reference(self, msg: OdometryData) -> bool:
         """
-        Team transport: whether a sample is the frame this robot evaluates for its stamp.
+        Whether a sample is the frame this robot evaluates for its stamp (:attr:`evaluates`).
 
         A sample far from this node's clock is let through (the states' clock check refuses
         it where it is used); a mismatch is looked at again after taking changes not yet taken.
@@ -534,15 +544,15 @@ class RobotNode(Node):
         """
         Return the reference frame at ``stamp_ns``: that sample, else the newest carried on.
 
-        Team transport: the frame this robot evaluates for ``stamp_ns`` from the reference's
-        parameters and the changes announced (``ReferenceTimeline.frame_at``, what the
-        reference node publishes), once a sample of that stamp (``exact``: lockstep) or a
+        Where this robot :attr:`evaluates` the reference: the frame at ``stamp_ns`` from the
+        reference's parameters and the changes announced (``ReferenceTimeline.frame_at``, what
+        the reference node publishes), once a sample of that stamp (``exact``: lockstep) or a
         recent sample on the states' clock shows the reference node runs on this team's time.
         """
         for msg in reversed(self.references):
             if msg.stamp_ns == stamp_ns:
-                return (msg.frame(self.dim) if self.team is None
-                        else self.changes.reference.frame_at(stamp_ns))
+                return (self.changes.reference.frame_at(stamp_ns) if self.evaluates
+                        else msg.frame(self.dim))
         if exact or not self.references:
             return None
         newest = self.references[-1]
@@ -553,7 +563,7 @@ class RobotNode(Node):
                                                     f'{advice})', log=advice is not None)
             return None
         self.once.end(f'reference-{Reason.CLOCK.name}', 'reference on the clock of the states')
-        if self.team is not None:
+        if self.evaluates:
             return self.changes.reference.frame_at(stamp_ns)
         return advance(newest.frame(self.dim), ahead)
 

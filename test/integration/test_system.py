@@ -60,6 +60,24 @@ def test_tracking_follows_a_circle(processes, install, probe, tmp_path):
     assert metrics['bound_violations'] == 0 and metrics['collisions'] == 0
 
 
+def test_robots_on_sim_time_track_a_fast_circle_from_one_reference_sample_a_second(
+        processes, install, probe, tmp_path):
+    """Carried forward, a sample a second old would put q_od 0.25 m off this circle."""
+    statuses = Statuses(probe)
+    out = tmp_path / 'fast'
+    fast = {'reference.radius': 2.0, 'reference.speed': 1.0, 'reference.rate': 1.0,
+            'input_timeout': 1.5}
+    launch(processes, install, write_params(tmp_path, 'circle_2d.yaml', fast), out=out,
+           per_process=6)
+    info = stop_when(probe, processes, lambda: plant_value(
+        statuses, 'steps with fresh commands') >= 1000, timeout=300)
+    assert info.returncode == 0, processes.log('launcher')
+    metrics = json.loads((out / 'metrics.json').read_text())
+    assert metrics['settle_time'] is not None
+    assert metrics['final_max_error'] < 0.02, metrics
+    assert metrics['bound_violations'] == 0 and metrics['collisions'] == 0
+
+
 def test_robot_publishes_zero_when_its_plant_stops(processes, install, probe):
     heard, _ = watch_commands(probe, 1)
     start_system(processes, install, SQUARE, 4)
