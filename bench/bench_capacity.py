@@ -6,12 +6,13 @@ Capacity benchmark: how many robots, at what rate, on this machine (on demand, n
 
 Usage: python bench/bench_capacity.py [--sizes 10 20 50 100] [--rates 20 50]
 [--modes process fleet] [--transport robot team] [--robots-per-process 25] [--measure 20]
-[--lockstep] [--prefix INSTALL] [--out DIR] [--keep]
+[--reference-rate 10] [--lockstep] [--prefix INSTALL] [--out DIR] [--keep]
 or:    python bench/bench_capacity.py --figure JSON... --out DIR
 
 For each transport, mode, team size N and control rate it runs scripts/launch_formation.sh on
 the Section 5 constants with N robots (random start at about 10 robots per m^2, lattice goal 2 m
-apart), control_rate, plant.publish_rate and reference.rate = RATE, plant.rate 100 Hz, one
+apart), control_rate and plant.publish_rate = RATE, reference.rate 10 Hz (robots on simulated
+time evaluate the reference themselves and only check its samples), plant.rate 100 Hz, one
 process per robot ('process') or --robots-per-process robots per 'fleet' process ('fleet'),
 with the per-robot topics ('robot', the default) or the team messages ('team': one state message,
 one command message per process per state; parameter transport). It byte-compiles the
@@ -53,6 +54,8 @@ from formation_ros.core.params_file import write_params_file  # noqa: E402, I100
 from formation_ros.ros.watch import stat_fields  # noqa: E402
 
 PLANT_RATE = 100.0
+REFERENCE_RATE = 10.0
+"""reference.rate, Hz: a check that the reference node runs, not a sample per state."""
 MODES = ('process', 'fleet')
 TRANSPORTS = ('robot', 'team')
 CLOCK_STARTED = 'starting the clock'
@@ -85,6 +88,9 @@ def build_parser() -> argparse.ArgumentParser:
                         dest='parameter_services',
                         help="fleet.parameter_services false: a fleet's first robot alone "
                              'offers the parameter services (fewer DDS endpoints)')
+    parser.add_argument('--reference-rate', type=float, default=REFERENCE_RATE,
+                        help='reference.rate, Hz; 0: the control rate, a sample per state '
+                             '(default: %(default)g)')
     parser.add_argument('--lockstep', action='store_true',
                         help='run the plant in lockstep and report steps per second')
     parser.add_argument('--prefix', default=os.path.join(ROOT, 'install', 'formation_ros'),
@@ -110,6 +116,8 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
         parser.error(f'--rates must be > 0 and at most the plant rate, {PLANT_RATE:g} Hz')
     if not args.measure > 0.0 or not args.startup_timeout > 0.0:
         parser.error('--measure and --startup-timeout must be > 0')
+    if not 0.0 <= args.reference_rate <= 1e4:
+        parser.error('--reference-rate must be within [0, 10000] Hz (0: the control rate)')
     if args.figure:
         unreadable = [path for path in args.figure if not os.path.isfile(path)]
         if unreadable:
@@ -145,11 +153,17 @@ def fresh_fraction(age_steps: Sequence[int], max_age: int) -> Optional[float]:
 
 
 def case_params(n: int, rate: float, lockstep: bool, transport: str = 'robot',
-                parameter_services: bool = True) -> Dict[str, Any]:
-    """Parameters of one case (Section 5 constants, N robots, control and publish at RATE)."""
+                parameter_services: bool = True,
+                reference_rate: float = REFERENCE_RATE) -> Dict[str, Any]:
+    """
+    Parameters of one case (Section 5 constants, N robots, control and publish at RATE).
+
+    reference_rate: reference.rate, Hz (0: RATE).
+    """
     params = params_for(n)
     params.update({'control_rate': float(rate), 'plant.publish_rate': float(rate),
-                   'reference.rate': float(rate), 'plant.rate': PLANT_RATE, 'duration': 1e4,
+                   'reference.rate': float(reference_rate or rate), 'plant.rate': PLANT_RATE,
+                   'duration': 1e4,
                    'transport': transport, 'fleet.parameter_services': parameter_services})
     if lockstep:
         params.update({'plant.lockstep': True, 'plant.realtime_factor': 1e3})
@@ -193,7 +207,7 @@ def run_case(args: argparse.Namespace, mode: str, n: int, rate: float,
     """Run one case and return its row."""
     params = os.path.join(folder, 'params.yaml')
     write_params_file(params, case_params(n, rate, args.lockstep, transport,
-                                          args.parameter_services))
+                                          args.parameter_services, args.reference_rate))
     run_dir = os.path.join(folder, 'run')
     log = os.path.join(folder, 'launcher.txt')
     command = ['bash', os.path.join(ROOT, 'scripts', 'launch_formation.sh'), params,
@@ -202,6 +216,7 @@ def run_case(args: argparse.Namespace, mode: str, n: int, rate: float,
         command += ['--robots-per-process', str(args.robots_per_process)]
     row: Dict[str, Any] = {'transport': transport, 'mode': mode, 'robots': n, 'rate_hz': rate,
                            'lockstep': args.lockstep,
+                           'reference_rate_hz': args.reference_rate or rate,
                            'parameter_services': args.parameter_services}
     with open(log, 'wb') as output:
         started = time.monotonic()

@@ -8,6 +8,7 @@ import os
 import subprocess
 import sys
 
+from formation_ros.core.params import load_config
 from helpers import ROOT
 
 
@@ -27,9 +28,11 @@ def test_capacity_benchmark_runs_both_modes_on_two_robots(install, ros_env, tmp_
         assert 0.0 < row['fresh_fraction'] <= 1.0, row
         assert row['latency_ms']['count'] > 0 and row['startup_s'] > 0.0, row
         assert row['rss_mib']['plant'] > 10.0 and 'launcher' in row['cpu_percent'], row
+        assert row['reference_rate_hz'] == 10.0, row
     assert (out / 'capacity_fresh.png').exists()
     for mode in ('process', 'fleet'):
         kept = out / f'robot-{mode}-2-20'
         assert 'starting the clock' in (kept / 'launcher.txt').read_text()
         stats = json.loads((kept / 'run' / 'plant_stats.json').read_text())
+        assert load_config(str(kept / 'params.yaml'), 'reference').reference_node.rate == 10.0
         assert stats['steps'] == next(row['steps'] for row in rows if row['mode'] == mode)
