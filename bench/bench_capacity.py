@@ -264,9 +264,17 @@ def _sum_where(values: Mapping[str, float], robots: bool) -> float:
 
 
 def format_row(row: Mapping[str, Any]) -> str:
-    """One Markdown table row (mode 'fleet -ps': without its robots' parameter services)."""
+    """
+    One Markdown table row (mode 'fleet -ps': without its robots' parameter services).
+
+    The rate reads '50, reference 10' where reference.rate was not the control rate (rows of
+    runs before --reference-rate have none: it was the control rate).
+    """
     lean = ' -ps' if row.get('parameter_services') is False else ''
-    head = f"| {row['mode']}{lean} | {row['robots']} | {row['rate_hz']:g} |"
+    rate = row['rate_hz']
+    reference = row.get('reference_rate_hz', rate)
+    shown = f'{rate:g}' + (f', reference {reference:g}' if reference != rate else '')
+    head = f"| {row['mode']}{lean} | {row['robots']} | {shown} |"
     transport = f" {row.get('transport', 'robot')} |"
     if 'error' in row:
         return head + f" {row['error']} |" + ' |' * 9 + transport

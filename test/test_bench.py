@@ -274,6 +274,21 @@ def test_capacity_benchmark_refuses_bad_arguments(fake_install, tmp_path):
                                      text=True, timeout=120).stdout
 
 
+def test_capacity_rows_name_a_reference_rate_other_than_the_control_rate():
+    capacity = load_bench(os.path.join(ROOT, 'bench', 'bench_capacity.py'))
+    row = {'mode': 'process', 'robots': 20, 'rate_hz': 50.0, 'processes': 22, 'startup_s': 7.0,
+           'step_rate': 97.5, 'fresh_fraction': 0.991, 'cpu_percent': {'plant': 24.0},
+           'rss_mib': {'plant': 116.0},
+           'latency_ms': {'p50_ms': 12.7, 'p99_ms': 26.3, 'max_ms': 234.0}}
+    assert capacity.format_row(row).startswith('| process | 20 | 50 | 22 |')
+    same = capacity.format_row({**row, 'reference_rate_hz': 50.0})
+    assert same.startswith('| process | 20 | 50 | 22 |')
+    assert capacity.format_row({**row, 'reference_rate_hz': 10.0}).startswith(
+        '| process | 20 | 50, reference 10 | 22 |')
+    assert capacity.case_params(20, 50.0, False)['reference.rate'] == 10.0
+    assert capacity.case_params(20, 50.0, False, reference_rate=0.0)['reference.rate'] == 50.0
+
+
 def test_capacity_figure_is_drawn_from_earlier_results_alone(tmp_path):
     script = os.path.join(ROOT, 'bench', 'bench_capacity.py')
     rows = [{'mode': mode, 'robots': n, 'rate_hz': 20.0, 'fresh_fraction': 0.5 + n / 400.0}
