@@ -416,6 +416,8 @@ DECLARATIONS = (
 )
 BY_NAME = {param.name: param for param in DECLARATIONS}
 ROS_OWN = ('use_sim_time', 'start_type_description_service', 'qos_overrides.')
+ROS_OWN_BOOLS = ('use_sim_time', 'start_type_description_service')
+"""rclpy's own parameters that it declares as bools as a node is made."""
 RECORDER_ONLY = ('record.path', 'record.overwrite', 'record.markers')
 
 
@@ -521,6 +523,8 @@ def check_values(raw: Mapping[str, Any], exe: Exe) -> Dict[str, Any]:
     """
     problems = [(name, f'unknown parameter{did_you_mean(name)}') for name in raw
                 if not is_known(name)]
+    problems += [(name, f'must be true or false, got {raw[name]!r}') for name in ROS_OWN_BOOLS
+                 if name in raw and not isinstance(raw[name], bool)]
     values: Dict[str, Any] = {}
     shapes = BY_NAME[SHAPE_VERTICES]
     for name in raw:

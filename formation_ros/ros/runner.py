@@ -36,6 +36,7 @@ from formation_ros.core.file_guard import (check_params_text, ParamsFileError,
                                            read_params_file_text)
 from formation_ros.ros.watch import LAUNCHER_PID_ENV, LAUNCHER_START_ENV, process_start
 import rclpy
+from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
 from rclpy.executors import Executor, ExternalShutdownException, SingleThreadedExecutor
 from rclpy.node import Node
 from rclpy.signals import SignalHandlerOptions
@@ -249,6 +250,10 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
         logger = rclpy.logging.get_logger(name)
         for line in str(exc).splitlines():
             logger.error(f'invalid {line}')
+        code = REFUSED
+    except (InvalidParameterTypeException, InvalidParameterValueException) as exc:
+        # A parameter rclpy declares itself as the node is made (use_sim_time).
+        rclpy.logging.get_logger(name).error(f'invalid parameter: {exc}')
         code = REFUSED
     except (KeyboardInterrupt, ExternalShutdownException):
         pass

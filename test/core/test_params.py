@@ -92,6 +92,9 @@ BAD_CASES = [
     ('sensing_radius', {'sensing_radius': None}, 'is required'),
     ('duration', {'duration': 0.0}, 'must be > 0'),
     ('jump.order', {'jump.order': 51}, 'must be <= 50'),
+    ('use_sim_time', {'use_sim_time': 1}, 'must be true or false, got 1'),
+    ('start_type_description_service', {'start_type_description_service': 'no'},
+     "must be true or false, got 'no'"),
 ]
 
 

@@ -189,6 +189,18 @@ def test_a_bad_parameters_file_is_one_line_and_exit_2(install, ros_env, tmp_path
         assert len(lines) == 1 and str(path) in lines[0], (name, lines)
 
 
+def test_use_sim_time_that_is_not_a_bool_is_one_line_and_exit_2(install, ros_env):
+    """A use_sim_time rclpy refuses as it makes the node is one line too (exit 2)."""
+    for name, extra in (('plant', []), ('robot', []), ('reference', []), ('record', []),
+                        ('relay', []), ('fleet', ['--robots', '1-2'])):
+        result = subprocess.run([exe(install, name), *extra, '--ros-args', '--params-file',
+                                 SQUARE, '-p', 'use_sim_time:=1'],
+                                env=ros_env, capture_output=True, text=True, timeout=60)
+        assert result.returncode == 2, (name, result.stderr)
+        lines = [line for line in (result.stdout + result.stderr).splitlines() if line]
+        assert len(lines) == 1 and "parameter 'use_sim_time'" in lines[0], (name, lines)
+
+
 def test_a_killed_plant_loses_at_most_its_last_second(processes, install, probe, tmp_path):
     """SIGKILL of the plant: formation_report rebuilds the run from the chunks it wrote."""
     out = tmp_path / 'run'
