@@ -99,7 +99,7 @@ from formation_ros.ros.diagnostics import encode_statuses, make_status, PERIOD
 from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
 from formation_ros.ros.runner import run
-from formation_ros.ros.sim_clock import StateClock
+from formation_ros.ros.sim_clock import sim_time_without_clock, StateClock, wall_clock_overrides
 from formation_ros.ros.team import announced, PublisherWatch
 from formation_ros.ros.wake import Wake
 from geometry_msgs.msg import PoseArray, PoseStamped, Twist, TwistStamped
@@ -186,7 +186,9 @@ class RobotNode(Node):
         ``reports``: whether this node publishes on /diagnostics itself; a fleet's other robots
         do not, its first robot publishes their statuses with its own (:attr:`reported`).
         """
-        super().__init__('robot', **kwargs)
+        given = list(kwargs.pop('parameter_overrides', None) or [])
+        super().__init__('robot', parameter_overrides=wall_clock_overrides(given), **kwargs)
+        self.sim_time = sim_time_without_clock(self, given)
         config = declare_parameters(self, Exe.ROBOT)
         settings = config.robot
         assert settings is not None
@@ -210,7 +212,6 @@ class RobotNode(Node):
         self.command_frame = (messages.body_frame(settings.robot_id) if self.body_frame
                               else self.world_frame)
         self.last_body_command: Optional[NDArray[np.float64]] = None
-        self.sim_time = bool(self.get_parameter('use_sim_time').value)
         self.evaluates = config.team_transport or self.sim_time
         """Whether this robot evaluates the reference at each state's stamp itself (the team
         transport, and simulated time: the reference node's time is then the plant's) and

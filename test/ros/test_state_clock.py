@@ -11,6 +11,7 @@ callback would give them; its clock is then read as its timers and checks read i
 import os
 import time
 
+from formation_ros.core.declarations import ParamError
 from formation_ros.core.units import NS_PER_S
 from formation_ros.nodes.robot import RobotNode, TeamLink
 from geometry_msgs.msg import Point, Pose, PoseArray
@@ -89,6 +90,43 @@ def test_a_robot_on_simulated_time_has_no_clock_subscription(sim_robot):
     assert '/clock' not in topics
     assert {'/robot_1/pose', '/robot_1/neighbors', '/formation/reference'} <= topics
     assert now_s(sim_robot) == 0.0
+    assert sim_robot.get_clock().ros_time_is_active
+    assert sim_robot.get_parameter('use_sim_time').value is True
+
+
+@pytest.mark.parametrize('given', [None, [Parameter('use_sim_time', value=True)]],
+                         ids=['command line', 'node overrides'])
+def test_a_robot_on_simulated_time_never_makes_a_clock_subscription(monkeypatch, given):
+    """Not even for a moment: every participant would hear of it (1000 robots, 1000 readers)."""
+    made = []
+    create = RobotNode.create_subscription
+
+    def spy(self, msg_type, topic, *args, **kwargs):
+        made.append(topic)
+        return create(self, msg_type, topic, *args, **kwargs)
+
+    monkeypatch.setattr(RobotNode, 'create_subscription', spy)
+    context = rclpy.Context()
+    rclpy.init(context=context, args=['--ros-args', '--params-file', SQUARE, '-p',
+                                      f"use_sim_time:={'false' if given else 'true'}"])
+    try:
+        node = RobotNode(namespace='/robot_1', context=context, parameter_overrides=given)
+        assert node.sim_time and node.get_clock().ros_time_is_active
+        assert 'pose' in made and '/clock' not in made, made
+        node.destroy_node()
+    finally:
+        rclpy.shutdown(context=context)
+
+
+def test_a_use_sim_time_that_is_not_a_bool_is_refused():
+    context = rclpy.Context()
+    rclpy.init(context=context, args=['--ros-args', '--params-file', SQUARE,
+                                      '-p', 'use_sim_time:=1'])
+    try:
+        with pytest.raises(ParamError, match="parameter 'use_sim_time': must be true or false"):
+            RobotNode(namespace='/robot_1', context=context)
+    finally:
+        rclpy.shutdown(context=context)
 
 
 def test_its_clock_follows_the_poses_it_accepts_forward_only(sim_robot):
