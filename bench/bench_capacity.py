@@ -50,11 +50,14 @@ sys.path[:0] = [ROOT, BENCH]
 from bench_core import params_for  # noqa: E402
 from bench_soak import (find_run_processes, LAUNCHER, read_pss_kib,  # noqa: E402
                         read_rss_kib)
-from formation_ros.core.params_file import write_params_file  # noqa: E402, I100
+from formation_ros.core.declarations import BY_NAME  # noqa: E402, I100
+from formation_ros.core.params_file import write_params_file  # noqa: E402
 from formation_ros.ros.watch import stat_fields  # noqa: E402
 
 PLANT_RATE = 100.0
 REFERENCE_RATE = 10.0
+INPUT_TIMEOUT = BY_NAME['input_timeout'].default
+"""The robots' input_timeout in every case, s: a reference sample must come within it."""
 """reference.rate, Hz: a check that the reference node runs, not a sample per state."""
 MODES = ('process', 'fleet')
 TRANSPORTS = ('robot', 'team')
@@ -116,8 +119,10 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
         parser.error(f'--rates must be > 0 and at most the plant rate, {PLANT_RATE:g} Hz')
     if not args.measure > 0.0 or not args.startup_timeout > 0.0:
         parser.error('--measure and --startup-timeout must be > 0')
-    if not 0.0 <= args.reference_rate <= 1e4:
-        parser.error('--reference-rate must be within [0, 10000] Hz (0: the control rate)')
+    if not (args.reference_rate == 0.0 or 1.0 / INPUT_TIMEOUT < args.reference_rate <= 1e4):
+        parser.error(f'--reference-rate must be 0 (the control rate) or above '
+                     f'{1.0 / INPUT_TIMEOUT:g} Hz (a sample within input_timeout, '
+                     f'{INPUT_TIMEOUT:g} s) and at most 10000 Hz')
     if args.figure:
         unreadable = [path for path in args.figure if not os.path.isfile(path)]
         if unreadable:

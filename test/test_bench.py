@@ -265,7 +265,8 @@ def test_capacity_benchmark_refuses_bad_arguments(fake_install, tmp_path):
                        (['--rates', '500'], '--rates must be > 0'),
                        (['--sizes', '0'], '--sizes and --robots-per-process must be >= 1'),
                        (['--measure', '0'], '--measure and --startup-timeout must be > 0'),
-                       (['--reference-rate', '-1'], '--reference-rate must be within')):
+                       (['--reference-rate', '-1'], '--reference-rate must be 0'),
+                       (['--reference-rate', '2'], 'above 2 Hz')):
         result = subprocess.run([sys.executable, script, *args, '--prefix', str(fake_install),
                                  '--out', str(tmp_path / 'out')],
                                 capture_output=True, text=True, timeout=120)

@@ -123,6 +123,10 @@ SAME_REFERENCE = 1e-6
 """Team transport: how far (m, m/s, 1, 1/s) a heard reference sample may be from the frame a
 robot evaluates for its stamp (float rounding in the message is ~1e-15)."""
 INPUTS = ('pose', 'neighbour', 'reference')
+OTHER_IN_ROW = 2
+"""A sample unlike the frame a robot evaluates may only be ahead of the change announced with
+it (the callbacks of the two topics run in either order): it is refused and counted, and the
+refusal logged once so many in a row differ."""
 COPY_GAP_NS = 25_000_000
 """A copy of the state answered last that arrives sooner than this after the previous state is
 a fast copy (the plant sends a state again 0.05 s after the last while it waits, and once more
@@ -226,6 +230,8 @@ class RobotNode(Node):
         self.pose_count = 0
         self.answered_count = 0
         self.rejected: Dict[Tuple[str, Reason], int] = {}
+        self.others_in_row = 0
+        """Reference samples in a row unlike the frame this robot evaluates (OTHER_IN_ROW)."""
         self.last: Optional[Command] = None
         self.waiting = True
         self.wait_subscribers = settings.wait_for_subscribers
@@ -488,9 +494,12 @@ class RobotNode(Node):
         elif not self._plausible(msg) and not (self.changes.take() and self._plausible(msg)):
             self._reject('reference', Reason.TOO_FAST)
         elif self.evaluates and not self._same_reference(msg):
+            self.others_in_row += 1
             self._reject('reference', Reason.OTHER_REFERENCE, ' (another parameters file or '
-                                                              'reference.* on one of them?)')
+                                                              'reference.* on one of them?)',
+                         log=self.others_in_row >= OTHER_IN_ROW)
         else:
+            self.others_in_row = 0
             if self.evaluates:
                 self.once.end(f'reference-{Reason.OTHER_REFERENCE.name}',
                               'the reference is the one this robot evaluates again')

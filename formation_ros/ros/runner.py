@@ -252,7 +252,9 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
             logger.error(f'invalid {line}')
         code = REFUSED
     except (InvalidParameterTypeException, InvalidParameterValueException) as exc:
-        # A parameter rclpy declares itself as the node is made (use_sim_time).
+        if nodes:
+            raise
+        # A parameter rclpy declares itself as a node is made (use_sim_time).
         rclpy.logging.get_logger(name).error(f'invalid parameter: {exc}')
         code = REFUSED
     except (KeyboardInterrupt, ExternalShutdownException):

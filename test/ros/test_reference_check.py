@@ -1,0 +1,61 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""A robot on simulated time checks reference samples against the frame it evaluates."""
+
+import os
+
+from formation_ros.core.frames import FrameSample
+from formation_ros.core.units import NS_PER_S
+from formation_ros.nodes.robot import Reason, RobotNode
+import pytest
+import rclpy
+from rclpy.serialization import serialize_message
+import wire
+
+SQUARE = os.path.join(os.path.dirname(__file__), '..', '..', 'config', 'square_4.yaml')
+LOGGED = f'reference-{Reason.OTHER_REFERENCE.name}'
+
+
+@pytest.fixture
+def robot():
+    """Yield robot 1 of the square on simulated time, following a circle, its clock at 5 s."""
+    context = rclpy.Context()
+    rclpy.init(context=context, args=[
+        '--ros-args', '--params-file', SQUARE, '-p', 'use_sim_time:=true',
+        '-p', 'reference.kind:=circle', '-p', 'reference.radius:=1.0',
+        '-p', 'reference.speed:=0.5'])
+    node = RobotNode(namespace='/robot_1', context=context)
+    try:
+        node.on_pose(wire.pose_stamped_bytes(5 * NS_PER_S, 'world', (-2.0, -2.0)))
+        yield node
+    finally:
+        node.destroy_node()
+        rclpy.shutdown(context=context)
+
+
+def sample(node, stamp_s, shift=0.0):
+    """Return the bytes of the sample the robot evaluates at ``stamp_s``, moved by ``shift`` m."""
+    stamp_ns = int(round(stamp_s * NS_PER_S))
+    frame = node.changes.reference.frame_at(stamp_ns)
+    moved = FrameSample(frame.t, frame.q_od + shift, frame.qdot_od, frame.J, frame.Jdot)
+    return serialize_message(wire.reference_odometry(moved, stamp_ns, 2))
+
+
+def refused(node):
+    return node.rejected.get(('reference', Reason.OTHER_REFERENCE), 0)
+
+
+def test_one_sample_unlike_the_frame_is_refused_and_logged_only_if_the_next_is_too(robot):
+    robot.on_reference(sample(robot, 5.0))
+    assert refused(robot) == 0 and len(robot.references) == 1
+    robot.on_reference(sample(robot, 5.02, shift=0.5))
+    assert refused(robot) == 1 and len(robot.references) == 1
+    assert not robot.once.is_active(LOGGED)
+    robot.on_reference(sample(robot, 5.04))
+    robot.on_reference(sample(robot, 5.06, shift=0.5))
+    assert refused(robot) == 2 and not robot.once.is_active(LOGGED)
+    robot.on_reference(sample(robot, 5.08, shift=0.5))
+    assert refused(robot) == 3 and robot.once.is_active(LOGGED)
+    robot.on_reference(sample(robot, 5.10))
+    assert len(robot.references) == 3 and not robot.once.is_active(LOGGED)
