@@ -558,6 +558,9 @@ class RobotNode(Node):
         reference's parameters and the changes announced (``ReferenceTimeline.frame_at``, what
         the reference node publishes), once a sample of that stamp (``exact``: lockstep) or a
         recent sample on the states' clock shows the reference node runs on this team's time.
+        A newest sample far from ``stamp_ns`` is refused as from another clock only if it came
+        within ``input_timeout``; else the reference node is silent (starved, or gone), and the
+        watchdog reports the reference as stale instead.
         """
         for msg in reversed(self.references):
             if msg.stamp_ns == stamp_ns:
@@ -568,6 +571,9 @@ class RobotNode(Node):
         newest = self.references[-1]
         ahead = (stamp_ns - newest.stamp_ns) / NS_PER_S
         if abs(ahead) * NS_PER_S > self.timeout_ns:
+            heard = self.received_ns['reference']
+            if heard is None or self._now_ns() - heard > self.timeout_ns:
+                return None
             advice = self._clock_advice('reference', 'the reference')
             self._reject('reference', Reason.CLOCK, f' ({-ahead:+.3g} s from the state: '
                                                     f'{advice})', log=advice is not None)

@@ -18,14 +18,17 @@ LOGGED = f'reference-{Reason.OTHER_REFERENCE.name}'
 
 
 @pytest.fixture
-def robot():
+def robot(monkeypatch):
     """Yield robot 1 of the square on simulated time, following a circle, its clock at 5 s."""
     context = rclpy.Context()
     rclpy.init(context=context, args=[
         '--ros-args', '--params-file', SQUARE, '-p', 'use_sim_time:=true',
         '-p', 'reference.kind:=circle', '-p', 'reference.radius:=1.0',
         '-p', 'reference.speed:=0.5'])
+    steady = [10 ** 12]
+    monkeypatch.setattr(RobotNode, '_now_ns', staticmethod(lambda: steady[0]))
     node = RobotNode(namespace='/robot_1', context=context)
+    node.steady_ns = steady
     try:
         node.on_pose(wire.pose_stamped_bytes(5 * NS_PER_S, 'world', (-2.0, -2.0)))
         yield node
@@ -59,3 +62,14 @@ def test_one_sample_unlike_the_frame_is_refused_and_logged_only_if_the_next_is_t
     assert refused(robot) == 3 and robot.once.is_active(LOGGED)
     robot.on_reference(sample(robot, 5.10))
     assert len(robot.references) == 3 and not robot.once.is_active(LOGGED)
+
+
+def test_a_silent_reference_is_stale_not_from_another_clock(robot):
+    robot.on_reference(sample(robot, 5.0))
+    later = int(round(5.6 * NS_PER_S))
+    robot.steady_ns[0] += robot.timeout_ns + 1
+    assert robot._reference_for(later, exact=False) is None
+    assert ('reference', Reason.CLOCK) not in robot.rejected
+    robot.on_reference(sample(robot, 5.0))
+    assert robot._reference_for(later, exact=False) is None
+    assert robot.rejected[('reference', Reason.CLOCK)] == 1
