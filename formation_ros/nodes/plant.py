@@ -121,6 +121,12 @@ LOOK_LIMIT = 5.0
 LOOK_PERIOD = 0.5
 """Seconds between looks at the graph while the clock waits for the robots."""
 REFUSAL_HEARD = 2.0
+CLOCK_MATCH_WAIT = 5.0
+"""Once every robot is up, how long the clock waits at most for each /clock subscriber the
+graph shows (the reference node) to be matched to its publisher, s: one not yet matched when
+the clock starts stamps its samples on the old time for as long as discovery takes (seen:
+1.3 s on a busy machine, the robots refusing the samples meanwhile). One that never matches
+(a subscriber asking for a QoS /clock does not offer) does not hold the team for ever."""
 """How long a refusing plant waits for its last status to be acknowledged, s."""
 FRESH_PERIODS = 2
 """A command is fresh (diagnostics' ``steps with fresh commands``) while the state it answers
@@ -194,6 +200,7 @@ class PlantNode(Node):
         self.last_publish_wall = 0.0
         self.started_wall: Optional[float] = None
         self.waiting = settings.wait_for_robots or self.lockstep
+        self.clock_match_since: Optional[float] = None
         self.paths = Paths(self.n, PATH_LENGTH)
         self.published_ns: 'OrderedDict[int, int]' = OrderedDict()
         self.arrived_ns = np.zeros(self.n, dtype=np.int64)
@@ -655,6 +662,25 @@ class PlantNode(Node):
         if time.monotonic() - self.last_publish_wall > RESEND_AFTER:
             self._publish()
 
+    def _clock_unmatched(self) -> bool:
+        """
+        Whether a /clock subscriber the graph shows is not matched to this plant's publisher.
+
+        For at most CLOCK_MATCH_WAIT s from the first call (steady clock), then False; the
+        plant's own subscription, while it looks, counts on both sides.
+        """
+        now = time.monotonic()
+        if self.clock_match_since is None:
+            self.clock_match_since = now
+        unmatched = (self.clock_pub.get_subscription_count()
+                     < self.count_subscribers(topics.CLOCK))
+        if unmatched and now - self.clock_match_since >= CLOCK_MATCH_WAIT:
+            self.get_logger().warning(
+                f'a /clock subscriber is still not matched after {CLOCK_MATCH_WAIT:g} s '
+                '(a QoS /clock does not offer?): starting the clock all the same')
+            return False
+        return unmatched
+
     def _all_robots_up(self) -> bool:
         """While waiting: start the clock once every robot has sent a command."""
         missing = (np.flatnonzero(~self.commands.present) + 1).tolist()
@@ -664,15 +690,20 @@ class PlantNode(Node):
                    if wanted > 0 else [])
         if self.team_transport and self.states_pub.get_subscription_count() < 1:
             unheard.append(self.states_pub)
-        if missing or unheard:
+        clock_unmatched = not missing and not unheard and self._clock_unmatched()
+        if missing or unheard or clock_unmatched:
             more = '...' if len(missing) > 10 else ''
             listeners = f'{wanted} subscribers on every pose topic'
             if self.team_transport:
                 listeners = (f'a subscriber of {topics.STATES}'
                              + (f' and {listeners}' if wanted > 0 else ''))
-            self.once.start('waiting', f'waiting for {len(missing)} of {self.n} robots to send '
-                                       f'a command (robots {missing[:10]}{more}) and for '
-                                       f'{listeners}', 'info')
+            if clock_unmatched:
+                self.once.start('clock-match', 'every robot is up: waiting for /clock to reach '
+                                               'its subscribers', 'info')
+            else:
+                self.once.start('waiting', f'waiting for {len(missing)} of {self.n} robots to '
+                                           f'send a command (robots {missing[:10]}{more}) and '
+                                           f'for {listeners}', 'info')
             self._resend_if_due()
             return False
         self.waiting = False
@@ -681,6 +712,7 @@ class PlantNode(Node):
         self.started_wall = time.monotonic()
         self.rate_window = (self.started_wall, self.model.counts.steps)
         started = f'all {self.n} robots are up: starting the clock'
+        self.once.end('clock-match')
         if self.once.is_active('waiting'):
             self.once.end('waiting', started)
         else:

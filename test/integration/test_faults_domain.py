@@ -12,10 +12,11 @@ from diagnostic_msgs.msg import DiagnosticStatus
 from formation_ros.ros import messages, qos
 from formation_ros.tools import domain
 from geometry_msgs.msg import PoseStamped, TwistStamped
-from helpers import (launch, node, said_once, SimClock, SQUARE, Statuses, stop_when,
+from helpers import (launch, logged, node, said_once, SimClock, SQUARE, Statuses, stop_when,
                      wait_exit, write_params)
 from nav_msgs.msg import Odometry
 import pytest
+from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
 from rosgraph_msgs.msg import Clock as ClockMsg
 import wire
 
@@ -124,6 +125,28 @@ def test_a_running_plant_names_a_second_publisher_on_pose_and_cmd_vel(processes,
                          'formation_ros/plant') == 1, processes.log('plant')
     assert 'no longer publishing here' not in processes.log('plant')
     assert commands.topic_name == '/robot_1/cmd_vel' and poses.topic_name == '/robot_1/pose'
+
+
+def test_the_clock_waits_for_its_subscribers_to_be_matched_then_not_for_ever(
+        processes, install, probe):
+    """A /clock reader asking for more than /clock offers is never matched: 5 s, then go."""
+    unmatchable = QoSProfile(depth=1, reliability=ReliabilityPolicy.RELIABLE,
+                             durability=DurabilityPolicy.TRANSIENT_LOCAL)
+    probe.create_subscription(ClockMsg, '/clock', lambda message: None, unmatchable)
+    clock = SimClock(probe)
+    processes.start(node(install, 'plant', SQUARE))
+    logged(probe, processes, 'plant', "subscription discovered on topic '/clock'",
+           timeout=START_UP)
+    processes.start(node(install, 'reference', SQUARE, '-p', 'use_sim_time:=true'))
+    for i in range(1, 5):
+        processes.start(node(install, 'robot', SQUARE, '-r', f'__ns:=/robot_{i}',
+                             '-p', 'use_sim_time:=true', process=f'robot_{i}'))
+    waiting = 'every robot is up: waiting for /clock to reach its subscribers'
+    going = 'a /clock subscriber is still not matched after 5 s'
+    log = logged(probe, processes, 'plant', waiting, going, timeout=START_UP)
+    assert log.index(waiting) < log.index(going) < log.index('starting the clock'), log
+    assert log.count(waiting) == 1 and log.count(going) == 1, log
+    assert probe.spin_until(lambda: clock.seconds > 0.5, START_UP), processes.log('plant')
 
 
 def test_a_robot_names_a_second_reference_publisher(processes, install, probe):
