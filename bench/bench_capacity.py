@@ -56,9 +56,9 @@ from formation_ros.ros.watch import stat_fields  # noqa: E402
 
 PLANT_RATE = 100.0
 REFERENCE_RATE = 10.0
+"""reference.rate, Hz: a check that the reference node runs, not a sample per state."""
 INPUT_TIMEOUT = BY_NAME['input_timeout'].default
 """The robots' input_timeout in every case, s: a reference sample must come within it."""
-"""reference.rate, Hz: a check that the reference node runs, not a sample per state."""
 MODES = ('process', 'fleet')
 TRANSPORTS = ('robot', 'team')
 CLOCK_STARTED = 'starting the clock'

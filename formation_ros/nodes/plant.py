@@ -121,13 +121,13 @@ LOOK_LIMIT = 5.0
 LOOK_PERIOD = 0.5
 """Seconds between looks at the graph while the clock waits for the robots."""
 REFUSAL_HEARD = 2.0
+"""How long a refusing plant waits for its last status to be acknowledged, s."""
 CLOCK_MATCH_WAIT = 5.0
 """Once every robot is up, how long the clock waits at most for each /clock subscriber the
 graph shows (the reference node) to be matched to its publisher, s: one not yet matched when
 the clock starts stamps its samples on the old time for as long as discovery takes (seen:
 1.3 s on a busy machine, the robots refusing the samples meanwhile). One that never matches
 (a subscriber asking for a QoS /clock does not offer) does not hold the team for ever."""
-"""How long a refusing plant waits for its last status to be acknowledged, s."""
 FRESH_PERIODS = 2
 """A command is fresh (diagnostics' ``steps with fresh commands``) while the state it answers
 is at most this many state periods old (as bench_capacity's fresh share)."""

@@ -120,8 +120,8 @@ LAST_WORD = 0.5
 """How long a stopping robot waits for its last (zero) command to be received, s."""
 RATE_TOLERANCE = 1e-3
 SAME_REFERENCE = 1e-6
-"""Team transport: how far (m, m/s, 1, 1/s) a heard reference sample may be from the frame a
-robot evaluates for its stamp (float rounding in the message is ~1e-15)."""
+"""How far (m, m/s, 1, 1/s) a heard reference sample may be from the frame a robot evaluates
+for its stamp (float rounding in the message is ~1e-15)."""
 INPUTS = ('pose', 'neighbour', 'reference')
 OTHER_IN_ROW = 2
 """A sample unlike the frame a robot evaluates may only be ahead of the change announced with
@@ -558,9 +558,6 @@ class RobotNode(Node):
         reference's parameters and the changes announced (``ReferenceTimeline.frame_at``, what
         the reference node publishes), once a sample of that stamp (``exact``: lockstep) or a
         recent sample on the states' clock shows the reference node runs on this team's time.
-        A newest sample far from ``stamp_ns`` is refused as from another clock only if it came
-        within ``input_timeout``; else the reference node is silent (starved, or gone), and the
-        watchdog reports the reference as stale instead.
         """
         for msg in reversed(self.references):
             if msg.stamp_ns == stamp_ns:
@@ -571,9 +568,6 @@ class RobotNode(Node):
         newest = self.references[-1]
         ahead = (stamp_ns - newest.stamp_ns) / NS_PER_S
         if abs(ahead) * NS_PER_S > self.timeout_ns:
-            heard = self.received_ns['reference']
-            if heard is None or self._now_ns() - heard > self.timeout_ns:
-                return None
             advice = self._clock_advice('reference', 'the reference')
             self._reject('reference', Reason.CLOCK, f' ({-ahead:+.3g} s from the state: '
                                                     f'{advice})', log=advice is not None)

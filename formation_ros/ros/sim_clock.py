@@ -28,15 +28,12 @@ from rclpy.clock import ROSClock
 from rclpy.node import Node
 from rclpy.parameter import Parameter
 from rclpy.time import Time
-from rclpy.time_source import TimeSource
-
-
-USE_SIM_TIME = 'use_sim_time'
+from rclpy.time_source import TimeSource, USE_SIM_TIME_NAME
 
 
 def wall_clock_overrides(given: Sequence[Parameter]) -> List[Parameter]:
     """Return a node's parameter overrides ``given`` with ``use_sim_time`` false."""
-    return [*given, Parameter(USE_SIM_TIME, value=False)]
+    return [*given, Parameter(USE_SIM_TIME_NAME, value=False)]
 
 
 def sim_time_without_clock(node: Node, given: Sequence[Parameter]) -> bool:
@@ -49,18 +46,18 @@ def sim_time_without_clock(node: Node, given: Sequence[Parameter]) -> bool:
     Returns it; raises :class:`ParamError` if it is not a bool.
     """
     asked: Any = next((parameter.value for parameter in given
-                       if parameter.name == USE_SIM_TIME), None)
+                       if parameter.name == USE_SIM_TIME_NAME), None)
     if asked is None:
         with node.handle:
-            found = node.handle.get_parameters(Parameter).get(USE_SIM_TIME)
+            found = node.handle.get_parameters(Parameter).get(USE_SIM_TIME_NAME)
         asked = False if found is None else found.value
     if not isinstance(asked, bool):
-        raise ParamError([(USE_SIM_TIME, f'must be true or false, got {asked!r}')])
+        raise ParamError([(USE_SIM_TIME_NAME, f'must be true or false, got {asked!r}')])
     if asked:
         source = getattr(node, '_time_source', None)
         if source is not None:
             source.detach_node()
-        node.set_parameters([Parameter(USE_SIM_TIME, value=True)])
+        node.set_parameters([Parameter(USE_SIM_TIME_NAME, value=True)])
     return asked
 
 
@@ -74,7 +71,7 @@ def _active_source(node: Node) -> Optional[TimeSource]:
 
 def keep_sim_time(parameters: List[Parameter]) -> SetParametersResult:
     """Refuse to change ``use_sim_time`` of a robot whose clock is driven for it."""
-    if any(parameter.name == 'use_sim_time' for parameter in parameters):
+    if any(parameter.name == USE_SIM_TIME_NAME for parameter in parameters):
         return SetParametersResult(successful=False, reason='use_sim_time of this robot is '
                                    'fixed at start (its clock is set from the stamps of the '
                                    'states it hears)')

@@ -8,6 +8,7 @@ import os
 from formation_ros.core.frames import FrameSample
 from formation_ros.core.units import NS_PER_S
 from formation_ros.nodes.robot import Reason, RobotNode
+from geometry_msgs.msg import Point, Pose, PoseArray
 import pytest
 import rclpy
 from rclpy.serialization import serialize_message
@@ -24,7 +25,7 @@ def robot(monkeypatch):
     rclpy.init(context=context, args=[
         '--ros-args', '--params-file', SQUARE, '-p', 'use_sim_time:=true',
         '-p', 'reference.kind:=circle', '-p', 'reference.radius:=1.0',
-        '-p', 'reference.speed:=0.5'])
+        '-p', 'reference.speed:=0.5', '-p', 'wait_for_subscribers:=0'])
     steady = [10 ** 12]
     monkeypatch.setattr(RobotNode, '_now_ns', staticmethod(lambda: steady[0]))
     node = RobotNode(namespace='/robot_1', context=context)
@@ -64,12 +65,26 @@ def test_one_sample_unlike_the_frame_is_refused_and_logged_only_if_the_next_is_t
     assert len(robot.references) == 3 and not robot.once.is_active(LOGGED)
 
 
+def neighbours(stamp_s):
+    """Return the bytes of what robot 1 senses, robots 2 to 4 of the square, at ``stamp_s``."""
+    message = PoseArray()
+    message.header.frame_id = 'world'
+    message.header.stamp.sec = int(stamp_s)
+    message.header.stamp.nanosec = int(round((stamp_s % 1.0) * NS_PER_S))
+    message.poses = [Pose(position=Point(x=x, y=y)) for x, y in ((2.0, -2.0), (2.0, 2.0),
+                                                                 (-2.0, 2.0))]
+    return serialize_message(message)
+
+
 def test_a_silent_reference_is_stale_not_from_another_clock(robot):
     robot.on_reference(sample(robot, 5.0))
-    later = int(round(5.6 * NS_PER_S))
+    robot.on_neighbours(neighbours(5.0))
     robot.steady_ns[0] += robot.timeout_ns + 1
-    assert robot._reference_for(later, exact=False) is None
+    robot.on_pose(wire.pose_stamped_bytes(int(5.6 * NS_PER_S), 'world', (-2.0, -2.0)))
+    robot.on_neighbours(neighbours(5.6))
+    robot._answer_newest()
+    assert robot.once.is_active('stale')
     assert ('reference', Reason.CLOCK) not in robot.rejected
     robot.on_reference(sample(robot, 5.0))
-    assert robot._reference_for(later, exact=False) is None
+    robot._answer_newest()
     assert robot.rejected[('reference', Reason.CLOCK)] == 1
