@@ -3,7 +3,9 @@
 
 """Log a condition once when it starts and once when it ends, not every cycle."""
 
-from typing import Any, Callable, Iterable, List, Mapping, Sequence, Set
+from typing import Any, Callable, Generic, Iterable, List, Mapping, Sequence, Set
+
+from formation_ros.core.admission import Reason, Refusals, Source
 
 
 class OnceLog:
@@ -76,6 +78,37 @@ class OnceLog:
     def is_active(self, key: str) -> bool:
         """Whether ``key`` is active."""
         return key in self._active
+
+
+class RefusalLog(Generic[Source]):
+    """
+    Count every refused message; log each (source, reason) once while it lasts.
+
+    The counts (:attr:`refusals`, ``core.admission.Refusals``) are what a node reports and
+    decides by; the log only keeps a line from repeating.
+    """
+
+    def __init__(self, once: OnceLog, line: Callable[[Source, Reason, str], str]) -> None:
+        """Log through ``once``; ``line(source, reason, detail)`` is the line of a refusal."""
+        self.once = once
+        self.line = line
+        self.refusals: Refusals[Source] = Refusals()
+
+    @staticmethod
+    def key(source: Source, reason: Reason) -> str:
+        """Return the OnceLog key of refusals of ``source`` for ``reason``."""
+        return f'{source}-{reason.name}'
+
+    def refuse(self, source: Source, reason: Reason, detail: str = '', log: bool = True) -> bool:
+        """Count one refusal and (with ``log``, once while it lasts) log it; return False."""
+        self.refusals.add(source, reason)
+        if log:
+            self.once.start(self.key(source, reason), self.line(source, reason, detail), 'error')
+        return False
+
+    def admitted(self, source: Source, reason: Reason, message: str = '') -> None:
+        """End the refusal of ``source`` for ``reason``, logging ``message`` if it was logged."""
+        self.once.end(self.key(source, reason), message)
 
 
 def robots_named(indices: Sequence[int], shown: int = 5) -> str:

@@ -3,7 +3,8 @@
 
 """Conditions logged once when they start and once when they end, alone or many at once."""
 
-from formation_ros.ros.once import OnceLog, robots_named
+from formation_ros.core.admission import Reason
+from formation_ros.ros.once import OnceLog, RefusalLog, robots_named
 
 
 class Logger:
@@ -65,3 +66,21 @@ def test_followed_conditions_are_logged_as_they_start_and_end():
                             ('info', '/robot_1/robot ok')]
     assert once.is_active('doubled-/robot_2/robot')
     assert not once.is_active('doubled-/robot_1/robot')
+
+
+def test_a_refusal_is_counted_every_time_and_logged_once_while_it_lasts():
+    logger = Logger()
+    log = RefusalLog(OnceLog(logger), lambda source, reason, detail:
+                     f'ignoring {source} with {reason.value}{detail}')
+    assert log.refuse('pose', Reason.FRAME, ' (map)') is False
+    log.refuse('pose', Reason.FRAME, ' (map)')
+    log.refuse('pose', Reason.CLOCK, log=False)
+    assert log.refusals[('pose', Reason.FRAME)] == 2
+    assert log.refusals[('pose', Reason.CLOCK)] == 1
+    assert logger.lines == [('error', 'ignoring pose with a frame other than world_frame (map)')]
+    log.admitted('pose', Reason.FRAME, 'pose in world_frame again')
+    log.admitted('pose', Reason.CLOCK, 'never logged: not said')
+    log.refuse('pose', Reason.FRAME, ' (map)')
+    assert logger.lines[1:] == [('info', 'pose in world_frame again'),
+                                ('error', 'ignoring pose with a frame other than world_frame '
+                                          '(map)')]
