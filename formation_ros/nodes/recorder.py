@@ -4,22 +4,10 @@
 r"""
 Recorder node (executable ``record``): every formation topic into a rosbag2 (MCAP) directory.
 
-Subscribes with ``raw=True`` (the serialized CDR bytes, no deserialise/serialise round trip) and
-with the reliability and durability of each publisher (best effort for poses and neighbours,
-transient local for the reference) but a deep history, stores the bytes in its callbacks and
-writes them to the bag from a timer, every second, each time as a complete MCAP chunk handed
-to the operating system (and a new MCAP file every five minutes, as rosbag2 splits a bag, so
-that the recorder's memory stays flat however long it runs): a recorder killed with SIGKILL
-loses at most the last second, and ``formation_report`` recovers the rest (``--repair`` makes
-the bag whole again). Robot i's ``cmd_vel`` is subscribed only once the recorder's own readers
-of its ``pose`` and ``neighbors`` have matched a publisher: a robot that waits for the recorder
-on ``cmd_vel`` (``wait_for_subscribers``) then cannot start before its states are recorded,
-whichever side of the DDS discovery finishes first. The bag is finished (metadata.yaml written)
-when the node stops, on Ctrl-C or SIGTERM too. When a write fails (the disk is full), the
-recorder closes the bag as its files hold it (readable, metadata.yaml written when it fits),
-logs one line saying how much it holds and up to which simulated time, and ends with exit code
-:data:`formation_ros.core.exits.RECORDING_FAILED`. It carries the run's
-parameters on /formation/params and in params.yaml, for ``formation_report``::
+It stores the serialized bytes in its callbacks and writes them from a timer, a whole MCAP
+chunk a second (``ros.bag_writer``), so a killed recorder loses at most the last second; a
+robot's ``cmd_vel`` is subscribed once its states are. What it records, how a failed write or a
+kill ends, and ``formation_report --repair``: docs/recording.md, "Recording a run"::
 
     ros2 run formation_ros record --ros-args --params-file config/paper_section5.yaml \\
         -p record.path:=runs/section5_bag

@@ -4,37 +4,12 @@
 r"""
 Reference node (executable ``reference``): the desired formation and what changes it (Section 6).
 
-Publishes ``/formation/reference`` (nav_msgs/Odometry) at ``reference.rate``: pose.position =
-q_od(t), orientation = the frame J as a quaternion (the rotation J^T from formation axes to world
-axes), twist.linear = qdot_od and twist.angular = the frame's angular velocity w, both in the
-world frame (``world_frame``, the header's frame_id), with ``Jdot = -J [w]x``, so a robot has J
-and Jdot without differentiating. header.stamp is the time t of the sample. With
-``use_sim_time`` t is the plant's simulated time; without it, t counts from the node's start.
-The timer runs on the wall clock at ``reference.rate``, so samples keep coming (with the same
-stamp) while the plant holds its clock, e.g. while it waits for the robots. In lockstep it
-publishes one sample for every new value of the simulated clock as soon as the clock moves (a
-jump callback of its clock arms a one-shot timer, ``formation_ros.ros.wake``; the timer at
-``reference.rate`` publishes the first sample and any it missed), together with the sample of
-the next step (``plant.rate`` gives it), so the robots have it before the state it belongs to.
-The topic is transient local: a late robot gets the latest sample.
-
-The formation can change while it runs; every change holds from its stamp on
-(``core.timeline``), is published on a transient-local topic, and every node answers each state
-with the change in force at the state's stamp:
-
-* ``/formation/shape`` (geometry_msgs/PoseArray, one pose per robot, stamped with the time from
-  which the shape holds): the shape at the start, each scheduled switch
-  (``formation.schedule.*``, sent at the start), and each switch made with
-  ``ros2 param set /reference formation.vertices "[...]"`` or ``formation.name``. A shape is
-  checked by the file's rules (num_robots x dim finite values, vertices at least b apart); one
-  that fails is refused through the parameter service with the reason, and nothing changes.
-* ``/formation/status`` (diagnostic_msgs/DiagnosticArray, stamped likewise): the team's mode,
-  running or stopped (services ``/formation/stop`` and ``/formation/start``, std_srvs/Trigger),
-  the shape's name and the reference's origin, speed and phase in force.
-  ``ros2 param set /reference reference.origin "[x, y]"`` moves a fixed reference (the formation
-  follows at the law's pace); ``reference.speed`` continues a circle, figure eight or helix from
-  where its frame is (no jump in q_od), refused where unicycles could not keep up.
-
+Publishes ``/formation/reference`` (the formation frame q_od, J, qdot_od and its angular
+velocity at ``reference.rate``), ``/formation/shape`` and ``/formation/status`` (every change,
+holding from its stamp on), and serves ``/formation/stop`` and ``/formation/start``. The
+messages: docs/ros_interface.md, "Topics"; when samples go out (plant time, lockstep, a held
+clock): docs/ros_interface.md, "Behaviour of the nodes"; changes at run time and the rules a new
+shape or reference must keep: docs/changes.md. The frame itself is ``core.reference``'s.
 Start it beside a plant with ``use_sim_time:=true``::
 
     ros2 run formation_ros reference --ros-args --params-file config/square_4.yaml \\
