@@ -1,0 +1,99 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+The commands of K >= 1 robots of one process: their points, the law, their command frames.
+
+:class:`Control` is the one path from what the robots sensed to what they publish: the points
+the law acts on (positions, or hand points for unicycles: docs/equations.md U1-U5), u of eqs.
+(14), (25) from ``core.law.robot_commands``, then (v, w) for unicycles or u turned into the
+body frame (``command.frame: body``). A robot process is K = 1, a team link K robots.
+"""
+
+from dataclasses import dataclass
+from typing import Optional, Tuple
+
+from formation_ros.core.frames import FrameSample, to_body_frame
+from formation_ros.core.law import Command, LawParams, robot_commands
+from formation_ros.core.unicycle import (hand_points, headings_from_quaternions,
+                                         unicycle_commands)
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+Float = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Commands:
+    """
+    The commands of K robots: ``law`` (u, u_hat, omega: (K, dim) m/s) and what is published.
+
+    body: (K, 2) (v, w) in m/s and rad/s for unicycles, (K, dim) u in the body frame with
+    ``command.frame: body``, None when u is published in the world frame.
+    """
+
+    law: Command
+    body: Optional[Float]
+
+    @property
+    def published(self) -> Float:
+        """Return the commands as published: (K, width), in their command frames."""
+        return self.law.u if self.body is None else self.body
+
+
+class Control:
+    """
+    The law of K robots and the map of its commands to their command frames.
+
+    law: the law's constants; radii: (K,) R_i of the robots, m; dim: 2 or 3; unicycle, with
+    hand_distance (m): the law acts on hand points and commands are (v, w); body_frame: u is
+    published in each robot's body frame.
+    """
+
+    def __init__(self, law: LawParams, radii: ArrayLike, dim: int, unicycle: bool,
+                 hand_distance: float, body_frame: bool) -> None:
+        """Keep the constants; ``radii`` is copied."""
+        self.law = law
+        self.radii = np.array(radii, dtype=float)
+        self.dim = dim
+        self.unicycle = unicycle
+        self.hand_distance = hand_distance
+        self.body_frame = body_frame
+        self.width = 2 if unicycle else dim
+
+    def points(self, positions: ArrayLike, orientations: ArrayLike) -> Tuple[Float, Float]:
+        """
+        Return (points, headings) of M robots' poses: the points the law acts on.
+
+        positions: (M, >= dim) m; orientations: (M, 4) quaternions (x, y, z, w). points:
+        (M, dim), the positions or (unicycles) the hand points; headings: (M,) rad (zeros
+        but for unicycles).
+        """
+        q = np.asarray(positions, dtype=float)[:, :self.dim]
+        if not self.unicycle:
+            return q, np.zeros(len(q))
+        headings = np.asarray(headings_from_quaternions(orientations), dtype=float)
+        return hand_points(q, headings, self.hand_distance), headings
+
+    def zero(self) -> Float:
+        """Return the K robots' zero commands: (K, width)."""
+        return np.zeros((len(self.radii), self.width))
+
+    def commands(self, own: Float, headings: Float, orientations: ArrayLike, vertices: ArrayLike,
+                 observer: ArrayLike, neighbours: ArrayLike,
+                 frame: Optional[FrameSample]) -> Commands:
+        """
+        Return the K robots' commands.
+
+        own: (K, dim) their points (:meth:`points`); headings: (K,) rad; orientations: (K, 4)
+        quaternions (the body frame); vertices: (K, dim) their places in the formation frame;
+        (observer, neighbours): (P,) indices into the K robots and (P, dim) the points each
+        sensed (``core.law.robot_commands``); frame: the reference's frame at the state.
+        """
+        law = robot_commands(own, vertices, observer, neighbours, self.radii, self.law, frame)
+        body: Optional[Float] = None
+        if self.unicycle:
+            body = unicycle_commands(law.u, headings, self.hand_distance)
+        elif self.body_frame:
+            body = to_body_frame(law.u, orientations)
+        return Commands(law, body)
