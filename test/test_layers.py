@@ -17,7 +17,9 @@ ROS_MODULES = ('rclpy', 'rcl_interfaces', 'builtin_interfaces', 'geometry_msgs',
                'std_msgs', 'rosgraph_msgs', 'diagnostic_msgs', 'visualization_msgs', 'rosbags')
 FORBIDDEN = {
     'core': ROS_MODULES + ('formation_ros.ros', 'formation_ros.nodes', 'formation_ros.tools',
-                           'matplotlib'),
+                           'formation_ros.physics', 'mujoco', 'matplotlib'),
+    'physics': ROS_MODULES + ('formation_ros.ros', 'formation_ros.nodes', 'formation_ros.tools',
+                              'matplotlib'),
     'ros': ('formation_ros.nodes', 'formation_ros.tools', 'matplotlib'),
     'nodes': ('formation_ros.tools', 'matplotlib'),
     'tools': ('formation_ros.nodes',),
@@ -79,3 +81,16 @@ def test_a_node_loads_only_what_it_uses(node):
                  + (NOT_IN_A_ROBOT if node in ('robot', 'fleet') else ()))
     wrong = [name for name in loaded if name.startswith(forbidden)]
     assert not wrong, wrong
+
+
+def test_the_package_works_without_mujoco():
+    """Only formation_ros.physics needs mujoco: the simulator loads and checks a file without."""
+    code = ('import sys, json\nsys.modules["mujoco"] = None\n'
+            'from formation_ros.tools import sim\n'
+            'config = sim.load_config("config/unicycle_2d.yaml")\n'
+            'print(json.dumps([config.world.timestep, "mujoco" in sys.modules and '
+            'sys.modules["mujoco"] is not None]))')
+    result = subprocess.run([sys.executable, '-c', code], capture_output=True, text=True,
+                            cwd=ROOT, timeout=120)
+    assert result.returncode == 0, result.stderr
+    assert json.loads(result.stdout.strip().splitlines()[-1]) == [0.002, False]

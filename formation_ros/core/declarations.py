@@ -142,6 +142,8 @@ ROBOT = frozenset({Exe.ROBOT, Exe.RECORD})
 COMMAND = frozenset({Exe.SIM, Exe.ROBOT, Exe.PLANT, Exe.RECORD})
 RELAY = frozenset({Exe.RELAY})
 SCHEDULE = frozenset({Exe.SIM, Exe.REFERENCE, Exe.RECORD})
+PHYSICS = frozenset({Exe.SIM})
+"""The readers of ``world.*``: ``formation_sim --engine mujoco`` (formation_ros/physics)."""
 SHAPE_VERTICES = 'formations.<name>.vertices'
 """The declaration of every named shape's vertices: ``formations.line.vertices`` and so on."""
 SHAPE_NAME = re.compile(r'[A-Za-z][A-Za-z0-9_]*')
@@ -413,6 +415,52 @@ DECLARATIONS = (
           'A robot whose latest measurement is older than this is stale, s: it gets no pose '
           "(its watchdog stops it) but stays in the others' neighbour lists at its last "
           'measured position.', low=above(0.0), high=at_least(1000.0), users=RELAY),
+    Param('world.timestep', Kind.DOUBLE, 0.002,
+          'Step of the physics engine (MuJoCo), s of simulated time; a whole number of '
+          'nanoseconds.', low=at_least(1e-5), high=at_least(0.05), users=PHYSICS),
+    Param('world.realtime_factor', Kind.DOUBLE, 1.0,
+          'Simulated seconds per wall-clock second the world aims at when it runs beside '
+          'processes (offline, formation_sim --engine mujoco runs as fast as it can).',
+          low=above(0.0), high=at_least(1000.0), users=PHYSICS),
+    Param('world.pose_rate', Kind.DOUBLE, 50.0,
+          "Rate of the world's measured poses, Hz of simulated time (at most 1 / "
+          'world.timestep).', low=above(0.0), high=at_least(100000.0), users=PHYSICS),
+    Param('world.pose_noise', Kind.DOUBLE, 0.0,
+          'Standard deviation of Gaussian noise on every measured position, m, seeded by '
+          'start.seed (0: the ground truth).', low=at_least(0.0), high=at_least(LENGTH_LIMIT),
+          users=PHYSICS),
+    Param('world.mass', Kind.DOUBLE, 1.0,
+          "Mass of each robot's body, kg (a TurtleBot3 Burger: about 1 kg).", low=above(0.0),
+          high=at_least(1e4), users=PHYSICS),
+    Param('world.wheel_radius', Kind.DOUBLE, 0.033,
+          "Unicycles: radius of a differential-drive base's two wheels, m (TurtleBot3 Burger: "
+          '0.033 m).', low=above(0.0), high=at_least(10.0), users=PHYSICS),
+    Param('world.wheel_track', Kind.DOUBLE, 0.16,
+          'Unicycles: distance between the two wheels, m (TurtleBot3 Burger: 0.160 m); '
+          'within the footprint 2 body.radius.', low=above(0.0), high=at_least(100.0),
+          users=PHYSICS),
+    Param('world.wheel_torque', Kind.DOUBLE, 0.2,
+          "Unicycles: torque limit of each wheel's velocity servo, N m: with the mass it sets "
+          'how fast a base can speed up or brake.', low=above(0.0), high=at_least(1e4),
+          users=PHYSICS),
+    Param('world.force_limit', Kind.DOUBLE, 5.0,
+          'Points: force limit of the velocity servo on each axis, N (in 2D at most '
+          'world.floor_friction x the weight: what the floor lets the wheels push); the thrust '
+          'that holds a 3D body against gravity comes on top.', low=above(0.0),
+          high=at_least(1e6), users=PHYSICS),
+    Param('world.torque_limit', Kind.DOUBLE, 0.5,
+          "Points: torque limit of the servo that holds a body's heading, N m.",
+          low=above(0.0), high=at_least(1e6), users=PHYSICS),
+    Param('world.floor_friction', Kind.DOUBLE, 1.0,
+          'Sliding friction coefficient between the floor and the wheels (unicycles) or the '
+          'traction of a holonomic base (2D points).', low=above(0.0), high=at_least(10.0),
+          users=PHYSICS),
+    Param('world.cmd_timeout', Kind.DOUBLE, 0.5,
+          "A robot's command older than this (by its stamp), or none for this long, stops its "
+          "motors, s of simulated time (diff_drive_controller's cmd_vel_timeout).",
+          low=above(0.0), high=at_least(1e7), users=PHYSICS),
+    Param('world.output_dir', Kind.STRING, '',
+          'If set, the world writes world.xml (and its results) there.', users=PHYSICS),
 )
 BY_NAME = {param.name: param for param in DECLARATIONS}
 ROS_OWN = ('use_sim_time', 'start_type_description_service', 'qos_overrides.')

@@ -171,6 +171,75 @@ class RecorderSettings:
 
 
 @dataclass(frozen=True)
+class WorldSettings:
+    """
+    The physics world's parameters (``world.*``; formation_ros/physics, beyond the paper).
+
+    timestep: engine step, s (a whole number of ns: :attr:`timestep_ns`); realtime_factor:
+    simulated s per wall s aimed at beside processes; pose_rate: measured poses, Hz;
+    pose_noise: standard deviation of the measured positions' noise, m; seed: its generator's
+    seed (``start.seed``); mass: each body, kg; wheel_radius, wheel_track: a differential-drive
+    base's wheels, m; wheel_torque: each wheel motor's torque limit, N m; force_limit: a point
+    body's servo force limit per axis, N; torque_limit: its heading servo's, N m;
+    floor_friction: sliding friction coefficient of the floor; cmd_timeout: a command older
+    than this stops the motors, s; output_dir: where world.xml and the results go ('' none).
+    """
+
+    timestep: float = 0.002
+    realtime_factor: float = 1.0
+    pose_rate: float = 50.0
+    pose_noise: float = 0.0
+    seed: int = 0
+    mass: float = 1.0
+    wheel_radius: float = 0.033
+    wheel_track: float = 0.16
+    wheel_torque: float = 0.2
+    force_limit: float = 5.0
+    torque_limit: float = 0.5
+    floor_friction: float = 1.0
+    cmd_timeout: float = 0.5
+    output_dir: str = ''
+
+    @property
+    def timestep_ns(self) -> int:
+        """``timestep`` in ns."""
+        return int(round(self.timestep * NS_PER_S))
+
+    @property
+    def cmd_timeout_ns(self) -> int:
+        """``cmd_timeout`` in ns."""
+        return int(round(self.cmd_timeout * NS_PER_S))
+
+    @property
+    def steps_per_pose(self) -> int:
+        """Return the engine steps between two measured poses: timestep x pose_rate, rounded."""
+        return max(1, int(round(1.0 / (self.pose_rate * self.timestep))))
+
+
+WORLD_FIELDS = ('timestep', 'realtime_factor', 'pose_rate', 'pose_noise', 'mass',
+                'wheel_radius', 'wheel_track', 'wheel_torque', 'force_limit', 'torque_limit',
+                'floor_friction', 'cmd_timeout', 'output_dir')
+"""The fields of :class:`WorldSettings` read from ``world.<field>``."""
+TIMESTEP_NS_TOLERANCE = 1e-6
+"""A timestep is a whole number of ns when within this many ns of one."""
+
+
+def world_settings(values: Mapping[str, Any], problems: Problems) -> WorldSettings:
+    """Build :class:`WorldSettings` from checked ``world.*`` values; add what does not fit."""
+    world = WorldSettings(seed=values['start.seed'],
+                          **{name: values[f'world.{name}'] for name in WORLD_FIELDS})
+    exact_ns = world.timestep * NS_PER_S
+    if abs(exact_ns - round(exact_ns)) > TIMESTEP_NS_TOLERANCE:
+        problems.append(('world.timestep', f'{world.timestep!r} s is not a whole number of '
+                                           'nanoseconds'))
+    if world.pose_rate * world.timestep > 1.0:
+        problems.append(('world.pose_rate', f'{world.pose_rate:g} Hz is faster than the '
+                                            f'engine steps (1 / world.timestep = '
+                                            f'{1.0 / world.timestep:g} Hz)'))
+    return world
+
+
+@dataclass(frozen=True)
 class FormationConfig:
     """
     Validated parameters of one formation run, for one executable.
@@ -189,7 +258,8 @@ class FormationConfig:
     imperfections: how the bodies differ from q' = u (``plant.actuator_lag`` ...: ideal for
     the executables that do not step bodies); relay: the relay's settings (None for the others);
     transport: per-robot topics or team messages (``transport``; robot for the executables that
-    do not read it).
+    do not read it); world: the physics world's settings (``world.*``; None for the
+    executables that do not read them).
     """
 
     num_robots: int
@@ -226,6 +296,7 @@ class FormationConfig:
     imperfections: Imperfections = IDEAL
     relay: Optional[RelaySettings] = None
     transport: Transport = Transport.ROBOT
+    world: Optional[WorldSettings] = None
 
     @property
     def team_transport(self) -> bool:
@@ -540,6 +611,8 @@ def _own_settings(values: Mapping[str, Any], exe: Exe, n: int,
         return {'recorder': RecorderSettings(path=values['record.path'],
                                              overwrite=values['record.overwrite'],
                                              markers=values['record.markers'])}
+    if exe is Exe.SIM:
+        return {'world': world_settings(values, problems)}
     return {}
 
 
@@ -780,4 +853,5 @@ def validate_for_every_executable(raw: Mapping[str, Any]) -> Dict[Exe, Formation
 
 __all__ = ['CommandSettings', 'fill_template', 'FormationConfig', 'load_config', 'ParamError',
            'PlantSettings', 'RecorderSettings', 'ReferenceSettings', 'RelaySettings',
-           'RobotSettings', 'template_problems', 'validate', 'validate_for_every_executable']
+           'RobotSettings', 'template_problems', 'validate', 'validate_for_every_executable',
+           'world_settings', 'WorldSettings']

@@ -1,0 +1,12 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+The physics engine of the robots' bodies on MuJoCo (beyond the paper; no ROS).
+
+``models`` holds the three bodies (a differential-drive base, a holonomic planar base, a flying
+body) and how a command becomes their motors' set points; ``scene`` builds the MJCF world from
+a validated :class:`~formation_ros.core.params.FormationConfig`; ``engine`` steps it, applies
+commands and reads ground truth, wheel odometry and contacts (``contacts``, ``odometry``). Only
+this group imports ``mujoco``; the numpy core never imports it.
+"""

@@ -1,0 +1,248 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+The physics engine of a formation's bodies (MuJoCo): step, apply commands, read the bodies.
+
+:class:`Engine` is the one interface the offline simulator and a world node drive, as
+crazyswarm2's simulator backends share one. It builds the scene of a validated configuration
+(:mod:`formation_ros.physics.scene`) and then
+
+* :meth:`Engine.apply` takes commands (N, width) in each robot's command frame ((v, w) of a
+  unicycle; the velocity of a point in the world or, with ``command.frame: body``, its body
+  frame), each stamped (ns of simulated time). A command is held until the next; one older
+  than ``world.cmd_timeout``, or none at all, stops the robot's motors (their set points are
+  zero), as ``diff_drive_controller`` does. Non-finite commands are refused (the robot keeps
+  its last command). A command beyond the motors is not refused: the motors are limited;
+* :meth:`Engine.step` advances ``world.timestep`` at a time (integer ns: :attr:`time_ns`);
+* :meth:`Engine.poses` is the ground truth (positions (N, 3) m, orientations (N, 4)
+  quaternions x, y, z, w), :meth:`Engine.measured_poses` the same with ``world.pose_noise``,
+  :meth:`Engine.odometry` the wheel-encoder odometry of differential-drive bases;
+* :attr:`Engine.contacts` counts contact events between robots from MuJoCo's contact list and
+  :attr:`Engine.closest` keeps the closest approach of two robots' positions.
+"""
+
+from dataclasses import dataclass
+import time
+from typing import Optional, Sequence, Tuple
+
+from formation_ros.core.dynamics import NOISE_SEED_OFFSET
+from formation_ros.core.params import FormationConfig, WorldSettings
+from formation_ros.core.unicycle import headings_from_quaternions
+from formation_ros.physics.contacts import ClosestApproach, ContactLog, RELEASE_GAP
+from formation_ros.physics.models import DiffDrive
+from formation_ros.physics.odometry import WheelOdometry
+from formation_ros.physics.scene import build_scene, Scene
+import mujoco
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+Float = NDArray[np.float64]
+WXYZ_TO_XYZW = (1, 2, 3, 0)
+"""MuJoCo's quaternions are (w, x, y, z), the package's (x, y, z, w)."""
+
+
+@dataclass(frozen=True)
+class Poses:
+    """Positions (N, 3) in m and orientations (N, 4) as unit quaternions (x, y, z, w)."""
+
+    positions: Float
+    orientations: Float
+
+    @property
+    def headings(self) -> Float:
+        """Return the yaw of each orientation (N,), rad."""
+        return headings_from_quaternions(self.orientations)
+
+
+@dataclass(frozen=True)
+class WorldStats:
+    """
+    What a run on the engine did (``world_stats.json``).
+
+    contacts: contact events between robots; min_body_distance: the closest approach of two
+    robots' positions, m; min_footprint_gap: that less twice the footprint radius, m (< 0:
+    they overlapped); steps: engine steps; simulated: s; wall: wall-clock s spent in
+    :meth:`Engine.step`; achieved_realtime_factor: simulated / wall.
+    """
+
+    contacts: int
+    min_body_distance: float
+    min_footprint_gap: float
+    steps: int
+    simulated: float
+    wall: float
+    achieved_realtime_factor: float
+
+
+class Engine:
+    """A formation's bodies on MuJoCo; see the module's docstring."""
+
+    def __init__(self, config: FormationConfig, world: Optional[WorldSettings] = None):
+        """Build the scene of ``config`` (validated with a start) with ``world`` (default its)."""
+        self.world = world or config.world or WorldSettings()
+        self.scene: Scene = build_scene(config, self.world)
+        self.model = self.scene.model
+        self.mj_model = mujoco.MjModel.from_xml_string(self.scene.xml)
+        self.data = mujoco.MjData(self.mj_model)
+        self.num_robots = len(self.scene.names)
+        self.dim = self.scene.dim
+        self.steps = 0
+        self.wall = 0.0
+        n, width = self.num_robots, self.model.command_width
+        self.command = np.zeros((n, width))
+        self.stamp_ns = np.zeros(n, dtype=np.int64)
+        self.present = np.zeros(n, dtype=bool)
+        self.timeout_ns = self.world.cmd_timeout_ns
+        self.step_ns = self.world.timestep_ns
+        self._pose_bodies = np.array([self._id(mujoco.mjtObj.mjOBJ_BODY, name)
+                                      for name in self.scene.names])
+        self._geom_robot = self._robots_of_geoms()
+        self._noise = np.random.default_rng([self.world.seed, NOISE_SEED_OFFSET])
+        mujoco.mj_forward(self.mj_model, self.data)
+        start = self.poses()
+        self.contacts = ContactLog(n, 2.0 * self.model.footprint + RELEASE_GAP)
+        self.closest = ClosestApproach(start.positions[:, :self.dim],
+                                       2.0 * self.model.footprint)
+        self._no_yaw = np.zeros(n)
+        self._live = np.zeros(n, dtype=bool)
+        self._changed = True
+        self.odometer: Optional[WheelOdometry] = None
+        if isinstance(self.model, DiffDrive):
+            self._wheel_dofs = np.array([[self._dof(f'{name}_{side}_wheel')
+                                          for side in ('left', 'right')]
+                                         for name in self.scene.names])
+            self.odometer = WheelOdometry(self.model, start.positions[:, :2], start.headings)
+
+    def _id(self, kind: 'mujoco.mjtObj', name: str) -> int:
+        index = int(mujoco.mj_name2id(self.mj_model, kind, name))
+        if index < 0:
+            raise KeyError(f'no {kind.name} {name!r} in the scene')
+        return index
+
+    def _dof(self, joint: str) -> int:
+        return int(self.mj_model.jnt_dofadr[self._id(mujoco.mjtObj.mjOBJ_JOINT, joint)])
+
+    def _robots_of_geoms(self) -> NDArray[np.intp]:
+        """Return the robot (0-based) each geom belongs to, -1 for the world's: (ngeom,)."""
+        robot_of_root = np.full(self.mj_model.nbody, -1, dtype=np.intp)
+        roots = self.mj_model.body_rootid[self._pose_bodies]
+        robot_of_root[roots] = np.arange(self.num_robots)
+        result: NDArray[np.intp] = robot_of_root[
+            self.mj_model.body_rootid[self.mj_model.geom_bodyid]]
+        return result
+
+    @property
+    def time_ns(self) -> int:
+        """Simulated time since the start, ns."""
+        return self.steps * self.step_ns
+
+    @property
+    def time_s(self) -> float:
+        """Simulated time since the start, s."""
+        return self.time_ns / 1e9
+
+    def apply(self, commands: ArrayLike, stamps_ns: Optional[ArrayLike] = None,
+              robots: Optional[Sequence[int]] = None) -> NDArray[np.bool_]:
+        """
+        Take commands (K, width) of ``robots`` (K 0-based indices; default all N, in order).
+
+        stamps_ns: (K,) the stamp of each command, ns of simulated time (default: now).
+        Returns which rows were refused (not finite), (K,); the others replace the robots'
+        commands.
+        """
+        rows = (np.arange(self.num_robots) if robots is None
+                else np.asarray(robots, dtype=np.intp))
+        given = np.asarray(commands, dtype=float).reshape(len(rows), self.model.command_width)
+        stamps = (np.full(len(rows), self.time_ns, dtype=np.int64) if stamps_ns is None
+                  else np.asarray(stamps_ns, dtype=np.int64).reshape(len(rows)))
+        finite = np.all(np.isfinite(given), axis=1)
+        kept = rows[finite]
+        self.command[kept] = given[finite]
+        self.stamp_ns[kept] = stamps[finite]
+        self.present[kept] = True
+        self._changed = True
+        refused: NDArray[np.bool_] = ~finite
+        return refused
+
+    def live(self) -> NDArray[np.bool_]:
+        """Tell which robots' commands drive their motors now: given, not stale (N,)."""
+        live: NDArray[np.bool_] = self.present & (self.time_ns - self.stamp_ns
+                                                  <= self.timeout_ns)
+        return live
+
+    def _controls(self) -> None:
+        """Set the motors' set points: from the live commands, zero for the others."""
+        live = self.live()
+        if not (self._changed or self.model.needs_yaw or np.any(live != self._live)):
+            return
+        self._changed, self._live = False, live
+        held = np.where(live[:, None], self.command, 0.0)
+        yaw = self.poses().headings if self.model.needs_yaw else self._no_yaw
+        self.data.ctrl[:] = self.model.controls(held, yaw).ravel()
+
+    def step(self, n_steps: int = 1) -> None:
+        """Advance ``n_steps`` engine steps, each ``world.timestep``."""
+        begun = time.perf_counter()
+        for _ in range(int(n_steps)):
+            self._controls()
+            mujoco.mj_step(self.mj_model, self.data)
+            self.steps += 1
+            self._observe()
+        self.wall += time.perf_counter() - begun
+
+    def _observe(self) -> None:
+        """After a step: odometry, contacts between robots, the closest approach."""
+        if self.odometer is not None:
+            self.odometer.advance(self.data.qvel[self._wheel_dofs], self.world.timestep)
+        robots = self._geom_robot[self.data.contact.geom]
+        between = ((robots[:, 0] >= 0) & (robots[:, 1] >= 0) & (robots[:, 0] != robots[:, 1])
+                   & (self.data.contact.dist <= 0.0))
+        positions = self.data.xpos[self._pose_bodies, :self.dim]
+        if np.any(between) or len(self.contacts.touching):
+            self.contacts.update(robots[between, 0], robots[between, 1], positions,
+                                 self.time_ns)
+        self.closest.update(positions, self.time_ns)
+
+    def poses(self) -> Poses:
+        """Return the ground truth: every robot's pose body (the axle centre of a base)."""
+        return Poses(self.data.xpos[self._pose_bodies].copy(),
+                     self.data.xquat[self._pose_bodies][:, WXYZ_TO_XYZW])
+
+    def measured_poses(self) -> Poses:
+        """Return the ground truth with Gaussian noise of ``world.pose_noise`` m on positions."""
+        truth = self.poses()
+        if self.world.pose_noise <= 0.0:
+            return truth
+        noisy = truth.positions.copy()
+        noisy[:, :self.dim] += self._noise.normal(0.0, self.world.pose_noise,
+                                                  (self.num_robots, self.dim))
+        return Poses(noisy, truth.orientations)
+
+    def planar_state(self) -> Tuple[Float, Float]:
+        """Return the true positions (N, dim), m, and headings (N,), rad."""
+        truth = self.poses()
+        return truth.positions[:, :self.dim], truth.headings
+
+    def odometry(self) -> Tuple[Float, Float]:
+        """Return the wheel odometry's positions (N, 2), m, and headings (N,), rad."""
+        if self.odometer is None:
+            raise ValueError('only differential-drive bases have wheel odometry')
+        return self.odometer.pose()
+
+    def velocities(self) -> Float:
+        """Return each pose body's world linear velocity (N, 3), m/s."""
+        result = np.empty((self.num_robots, 6))
+        for row, body in enumerate(self._pose_bodies):
+            mujoco.mj_objectVelocity(self.mj_model, self.data, mujoco.mjtObj.mjOBJ_XBODY,
+                                     int(body), result[row], 0)
+        return result[:, 3:]
+
+    def stats(self) -> WorldStats:
+        """Return what the run did so far."""
+        simulated = self.time_s
+        return WorldStats(
+            contacts=self.contacts.count, min_body_distance=self.closest.distance,
+            min_footprint_gap=self.closest.distance - 2.0 * self.model.footprint,
+            steps=self.steps, simulated=simulated, wall=self.wall,
+            achieved_realtime_factor=simulated / self.wall if self.wall > 0.0 else 0.0)
