@@ -4,8 +4,9 @@
 """
 The physics engine of the robots' bodies on MuJoCo (beyond the paper; no ROS).
 
-``models`` holds the three bodies (a differential-drive base, a holonomic planar base, a flying
-body) and how a command becomes their motors' set points; ``scene`` builds the MJCF world from
+``models`` chooses among the three bodies (``diff_drive``: a differential-drive base;
+``points``: a holonomic planar base, a flying body; made of the MJCF ``parts``), each of which
+says how a command becomes its motors' set points; ``scene`` builds the MJCF world from
 a validated :class:`~formation_ros.core.params.FormationConfig`; ``engine`` steps it, applies
 commands and reads ground truth, wheel odometry and contacts (``contacts``, ``odometry``). Only
 this group imports ``mujoco``; the numpy core never imports it.

@@ -30,7 +30,7 @@ from formation_ros.core.dynamics import NOISE_SEED_OFFSET
 from formation_ros.core.params import FormationConfig, WorldSettings
 from formation_ros.core.unicycle import headings_from_quaternions
 from formation_ros.physics.contacts import ClosestApproach, ContactLog, RELEASE_GAP
-from formation_ros.physics.models import DiffDrive
+from formation_ros.physics.diff_drive import DiffDrive
 from formation_ros.physics.odometry import WheelOdometry
 from formation_ros.physics.scene import build_scene, Scene
 import mujoco

@@ -14,7 +14,7 @@ pushed: what real odometry does.
 from typing import Tuple
 
 from formation_ros.core.unicycle import zoh_step
-from formation_ros.physics.models import DiffDrive
+from formation_ros.physics.diff_drive import DiffDrive
 import numpy as np
 from numpy.typing import NDArray
 

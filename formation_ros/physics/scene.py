@@ -20,8 +20,8 @@ from typing import Optional, Tuple
 from xml.etree import ElementTree
 
 from formation_ros.core.params import FormationConfig, WorldSettings
-from formation_ros.physics.models import (FLOOR_GROUP, GRAVITY, make_model, Model, number,
-                                          numbers)
+from formation_ros.physics.models import make_model, Model
+from formation_ros.physics.parts import FLOOR_GROUP, GRAVITY, number, numbers
 import numpy as np
 
 WORLD_FILE = 'world.xml'

@@ -11,7 +11,7 @@ import pytest
 pytest.importorskip('mujoco')
 
 from formation_ros.physics.engine import Engine  # noqa: E402, I100
-from formation_ros.physics.models import DiffDrive, WHEEL_ARMATURE  # noqa: E402, I100
+from formation_ros.physics.diff_drive import DiffDrive, WHEEL_ARMATURE  # noqa: E402, I100
 from physics_helpers import bases, forward_speed, run, tilt, yaw_difference  # noqa: E402, I100
 
 FAR = [[0.0, 0.0], [5.0, 5.0]]

@@ -11,7 +11,8 @@ import pytest
 pytest.importorskip('mujoco')
 
 from formation_ros.physics.engine import Engine  # noqa: E402, I100
-from formation_ros.physics.models import Flyer, GRAVITY, Holonomic  # noqa: E402, I100
+from formation_ros.physics.parts import GRAVITY  # noqa: E402, I100
+from formation_ros.physics.points import Flyer, Holonomic  # noqa: E402, I100
 from physics_helpers import run, team, yaw_difference  # noqa: E402, I100
 
 LIVE = {'world.cmd_timeout': 10.0}

@@ -12,7 +12,7 @@ mujoco = pytest.importorskip('mujoco')
 
 from formation_ros.core.params import load_config  # noqa: E402, I100
 from formation_ros.physics.engine import Engine  # noqa: E402, I100
-from formation_ros.physics.models import ModelKind  # noqa: E402, I100
+from formation_ros.physics.parts import ModelKind  # noqa: E402, I100
 from formation_ros.physics.scene import build_scene, WORLD_FILE  # noqa: E402, I100
 from physics_helpers import bases, team, yaw_difference  # noqa: E402, I100
 
