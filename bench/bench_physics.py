@@ -49,7 +49,7 @@ HEADER = ('| N | timestep (ms) | simulated (s) | engine wall (s) | CPU (s) | rea
 def build_parser() -> argparse.ArgumentParser:
     """Return the command line of the benchmark."""
     parser = argparse.ArgumentParser(
-        prog='bench_physics.py', description=__doc__.split('\n\n')[1].strip())
+        prog='bench_physics.py', description=__doc__.split('\n\n')[0].strip())
     parser.add_argument('--sizes', type=int, nargs='+', default=[100],
                         help='team sizes N (default %(default)s)')
     parser.add_argument('--duration', type=float, default=10.0,
@@ -77,8 +77,8 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
 def params_for(n: int, timestep: float, seed: int) -> Dict[str, Any]:
     """Return the parameters of N bases on a lattice SPACING apart, random headings."""
     side = math.ceil(math.sqrt(n))
-    lattice = [float(v) for i in range(n) for v in ((i % side) * SPACING,
-                                                      (i // side) * SPACING)]
+    lattice = [float(v) for i in range(n)
+               for v in ((i % side) * SPACING, (i // side) * SPACING)]
     headings = np.random.default_rng([seed, 0]).uniform(-math.pi, math.pi, n)
     return {'num_robots': n, 'dim': 2, 'sensing_radius': 0.9, 'repulsion_radius': 0.5,
             'formation.vertices': lattice, 'start.positions': lattice,
