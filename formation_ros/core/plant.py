@@ -252,43 +252,6 @@ class PlantCounts:
         return {int(i) + 1: int(row[i]) for i in np.flatnonzero(row)}
 
 
-class DurationHistogram:
-    """
-    Durations counted in bins of ``bin_ns`` up to ``limit_ns`` (longer ones in one more bin).
-
-    Percentiles are read back as the upper edge of their bin; the largest duration is kept
-    exactly. Memory is fixed however many durations are added.
-    """
-
-    def __init__(self, bin_ns: int = 100_000, limit_ns: int = 2 * NS_PER_S) -> None:
-        """Count durations of 0 to ``limit_ns`` in bins ``bin_ns`` wide (default 0.1 ms, 2 s)."""
-        self.bin_ns = int(bin_ns)
-        self.bins = np.zeros(-(-int(limit_ns) // self.bin_ns) + 1, dtype=np.int64)
-        self.largest_ns = 0
-
-    def add(self, durations_ns: ArrayLike) -> None:
-        """Count each of ``durations_ns`` (negative ones count as 0)."""
-        values = np.maximum(np.asarray(durations_ns, dtype=np.int64).ravel(), 0)
-        if values.size:
-            np.add.at(self.bins, np.minimum(values // self.bin_ns, len(self.bins) - 1), 1)
-            self.largest_ns = max(self.largest_ns, int(values.max()))
-
-    @property
-    def count(self) -> int:
-        """Return how many durations were added."""
-        return int(self.bins.sum())
-
-    def percentile_ns(self, percent: float) -> Optional[int]:
-        """Return the duration below which ``percent`` % of them fall (bin edge), or None."""
-        total = self.count
-        if total == 0:
-            return None
-        index = int(np.searchsorted(np.cumsum(self.bins), percent / 100.0 * total))
-        if index >= len(self.bins) - 1:
-            return self.largest_ns
-        return min((index + 1) * self.bin_ns, self.largest_ns)
-
-
 @dataclass(frozen=True)
 class StartSpec:
     """

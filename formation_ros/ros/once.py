@@ -6,6 +6,7 @@
 from typing import Any, Callable, Generic, Iterable, List, Mapping, Sequence, Set
 
 from formation_ros.core.admission import Reason, Refusals, Source
+from formation_ros.core.plant_status import robots_named  # noqa: F401 (its name here too)
 
 
 class OnceLog:
@@ -109,13 +110,3 @@ class RefusalLog(Generic[Source]):
     def admitted(self, source: Source, reason: Reason, message: str = '') -> None:
         """End the refusal of ``source`` for ``reason``, logging ``message`` if it was logged."""
         self.once.end(self.key(source, reason), message)
-
-
-def robots_named(indices: Sequence[int], shown: int = 5) -> str:
-    """Return 'robot 4', 'robots 1, 4 and 7' or 'robots 1, 2, 3, 4, 5 and 95 more' (0-based in)."""
-    ids = sorted(i + 1 for i in indices)
-    if len(ids) == 1:
-        return f'robot {ids[0]}'
-    if len(ids) <= shown:
-        return f"robots {', '.join(map(str, ids[:-1]))} and {ids[-1]}"
-    return f"robots {', '.join(map(str, ids[:shown]))} and {len(ids) - shown} more"

@@ -2,33 +2,30 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-One team: announce the values every node must agree on, and name the nodes that differ.
+One team per domain: the values every node must agree on, and the second publishers of a topic.
 
-Every formation node adds ``core.team.team_values`` to its ``/diagnostics`` status under keys
-``team: <name>``, and who it is: its host, process id and node name (:func:`announced`; the
-ROS graph names a node but not its host). The plant and the reference hear every node's status
-(:class:`TeamCheck`: the callback keeps each array, the node's diagnostics timer reads and
-compares) and name each node whose values differ from their own. The shape in force may
-differ for a moment after a switch (a node takes it a few milliseconds later, and announcements
-are a second apart), so a shape counts as different only when it is none of the shapes this
-node itself had in force in its last :data:`RECENT` checks.
-
-One team per domain: :class:`PublisherWatch` looks, on the node's timer, for publishers on a
-topic besides the one expected (:func:`formation_ros.core.team.duplicate_due` decides when one
-is reported) and names them, with their host where they announce it.
+Every formation node announces ``core.team.team_values`` and who it is (host, process, node) in
+its ``/diagnostics`` status (:func:`announced`); the plant and the reference hear them all and
+name each node whose values differ (:class:`TeamCheck`; a shape just switched counts as the
+same for :data:`RECENT` checks). :class:`PublisherWatch` looks up the graph for a second
+publisher of a topic (``core.team.duplicate_due`` decides when one is reported) and names it
+with its host; :class:`DomainWatch` is what the plant watches with them while it runs. The
+rules: docs/faults.md (two publishers on one cmd_vel; a second plant or publisher; nodes that
+disagree).
 """
 
 from collections import deque
 import os
 import socket
 import time
-from typing import Callable, Dict, List, Mapping, Optional, Sequence, Tuple
+from typing import Callable, Dict, List, Mapping, Optional, Sequence, Set, Tuple
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.params import FormationConfig
 from formation_ros.core.team import differences, duplicate_due, team_values
 from formation_ros.core.turns import Turns
 from formation_ros.ros import qos, topics
+from formation_ros.ros.liveliness import PeerLiveliness
 from formation_ros.ros.once import OnceLog
 import numpy as np
 from numpy.typing import NDArray
@@ -46,8 +43,11 @@ PENDING = 4096
 second from fleets of 25, one a second from each other node)."""
 Process = Tuple[str, str]
 """(host name, process id) as a node announces them."""
-
-
+GRAPH_LOOKS = 100
+"""Topics looked up in the graph per look for a second publisher (of 3N + 2, in turn)."""
+DOUBLED_WITHIN = 1.5
+"""Team transport: two processes that announced one robot node within this many seconds (their
+statuses come once a second) both run it."""
 UNKNOWN_NAME = '_NODE_NAME_UNKNOWN_'
 """What rmw calls a node whose ROS name has not reached this participant yet."""
 UNNAMED = 'a node not yet named in the ROS graph'
@@ -295,3 +295,92 @@ class PublisherWatch:
             count = others.count(name)
             described.append(text + (f' ({count} publishers)' if count > 1 else ''))
         return ', '.join(described)
+
+
+class DomainWatch:
+    """
+    The plant's topics, robot nodes and name, watched for a second of each.
+
+    expected: {topic: its one publisher (fully qualified), None for any one}; commands:
+    {cmd_vel topic: its subscription's liveliness} (robot transport); robot_nodes: the robot
+    nodes' names, watched for two processes (team transport; empty: not watched).
+    """
+
+    def __init__(self, node: Node, team_check: TeamCheck, once: OnceLog,
+                 expected: Mapping[str, Optional[str]], commands: Mapping[str, PeerLiveliness],
+                 robot_nodes: Sequence[str]) -> None:
+        """Watch the graph of ``node``, whose fully qualified name is the plant's."""
+        self.own_name = node.get_fully_qualified_name()
+        self.team_check = team_check
+        self.once = once
+        self.graph = PublisherWatch(node, team_check, GRAPH_LOOKS)
+        self.expected = dict(expected)
+        self.commands = dict(commands)
+        self.robot_nodes = list(robot_nodes)
+        self.shared_by: Set[str] = set()
+        """The publishers (names without hosts) of each line on shared topics logged."""
+        self.doubled: Dict[str, str] = {}
+
+    def shared_topics(self, now: float, clock: str, clock_runs: bool) -> Dict[str, str]:
+        """
+        Return {topic: its other publishers} now (steady clock, s); log each group once.
+
+        clock: the /clock topic, watched only once the clock runs (``clock_runs``).
+        """
+        expected = {topic: name for topic, name in self.expected.items()
+                    if topic != clock or clock_runs}
+        shared = self.graph.check(expected, now, self._alive)
+        by_names: Dict[str, List[str]] = {}
+        for topic in shared:
+            by_names.setdefault(self.graph.others(topic, expected[topic]), []).append(topic)
+        lines = {names: f'{_some(listed)} more than one publisher: {shared[listed[0]]} ('
+                 + ('a second node with this robot_id?' if listed[0] in self.commands
+                    else 'another team on this domain, or a node forging them?') + ')'
+                 for names, listed in by_names.items()}
+        self.once.follow('publishers', lines, self.shared_by,
+                         lambda names: f'{names}: no longer publishing here')
+        self.shared_by = set(lines)
+        return shared
+
+    def doubled_robots(self, now: float) -> Dict[str, str]:
+        """
+        Return {robot node: its processes} of those two processes announce; log each once.
+
+        Two processes that run one robot both answer for it on the team topic, where the plant
+        cannot tell them apart; their announcements on /diagnostics show them.
+        """
+        doubled = {name: self.team_check.describe(name, now) for name in self.robot_nodes
+                   if len(self.team_check.running(name, now, DOUBLED_WITHIN)) >= 2}
+        self.once.follow('doubled', {name: f'{name} runs in more than one process: {processes}'
+                                           ' (a second node with this robot_id?)'
+                                     for name, processes in doubled.items()},
+                         self.doubled, lambda name: f'{name} runs in one process again')
+        self.doubled = doubled
+        return doubled
+
+    def other_plants(self, now: float) -> str:
+        """Describe another process that announces this plant's name ('' for none); log once."""
+        if self.team_check.running(self.own_name, now):
+            plants = self.team_check.describe(self.own_name, now)
+            self.once.start('other-plant', f'another plant runs on this domain: {plants} '
+                                           '(another team? each needs a ROS_DOMAIN_ID of its own)',
+                            'error')
+            return plants
+        self.once.end('other-plant', 'the other plant is gone')
+        return ''
+
+    def _alive(self, topic: str, names: Sequence[str]) -> bool:
+        """Whether a same-named second publisher of ``topic`` is known to run."""
+        now = time.monotonic()
+        liveliness = self.commands.get(topic)
+        if liveliness is None:
+            return bool(self.team_check.running(self.own_name, now))
+        return liveliness.alive >= 2 or len(self.team_check.running(names[0], now)) >= 2
+
+
+def _some(topics: List[str], shown: int = 3) -> str:
+    """Return '/clock has' or '/clock, /robot_1/pose and 99 more topics have'."""
+    if len(topics) == 1:
+        return f'{topics[0]} has'
+    more = f' and {len(topics) - shown} more topics' if len(topics) > shown else ''
+    return f"{', '.join(topics[:shown])}{more} have"

@@ -168,23 +168,6 @@ def test_formation_sim_fixed_step_is_the_plant_model_answered_every_step(name):
     assert np.array_equal(plant.q, trajectory.q[50])
 
 
-def test_duration_histogram_percentiles_against_numpy():
-    from formation_ros.core.plant import DurationHistogram
-    rng = np.random.default_rng(3)
-    values = rng.exponential(2_000_000, 5000).astype(np.int64)
-    histogram = DurationHistogram(bin_ns=100_000, limit_ns=10_000_000)
-    assert histogram.percentile_ns(50) is None
-    histogram.add(values[:2500])
-    histogram.add(values[2500:])
-    assert histogram.count == 5000 and histogram.largest_ns == values.max()
-    for percent in (50, 90, 99):
-        exact = np.percentile(values, percent)
-        assert exact - 100_000 <= histogram.percentile_ns(percent) <= exact + 100_000, percent
-    assert histogram.percentile_ns(100) == values.max()
-    histogram.add([-5, 0])
-    assert histogram.bins[0] >= 2
-
-
 def brute_force_start(n, dim, radius, separation, seed):
     """Draw the random start the same way, comparing each candidate with every point placed."""
     rng = np.random.default_rng(seed)
