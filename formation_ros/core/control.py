@@ -24,6 +24,25 @@ Float = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
+class Sensed:
+    """
+    What K robots know at a state, as the law takes it.
+
+    indices: (K,) the robots' 0-based ids; points: (K, dim) the points the law acts on, m
+    (:meth:`Control.points`); headings: (K,) rad; orientations: (K, 4) quaternions (x, y, z,
+    w); (observer, neighbours): (P,) indices into the K robots and (P, dim) the points each
+    sensed, in order (``core.law.robot_commands``).
+    """
+
+    indices: NDArray[np.intp]
+    points: Float
+    headings: Float
+    orientations: Float
+    observer: NDArray[np.intp]
+    neighbours: Float
+
+
+@dataclass(frozen=True)
 class Commands:
     """
     The commands of K robots: ``law`` (u, u_hat, omega: (K, dim) m/s) and what is published.
@@ -79,21 +98,19 @@ class Control:
         """Return the K robots' zero commands: (K, width)."""
         return np.zeros((len(self.radii), self.width))
 
-    def commands(self, own: Float, headings: Float, orientations: ArrayLike, vertices: ArrayLike,
-                 observer: ArrayLike, neighbours: ArrayLike,
+    def commands(self, sensed: Sensed, vertices: ArrayLike,
                  frame: Optional[FrameSample]) -> Commands:
         """
-        Return the K robots' commands.
+        Return the K robots' commands: u of eqs. (14), (25), then in their command frames.
 
-        own: (K, dim) their points (:meth:`points`); headings: (K,) rad; orientations: (K, 4)
-        quaternions (the body frame); vertices: (K, dim) their places in the formation frame;
-        (observer, neighbours): (P,) indices into the K robots and (P, dim) the points each
-        sensed (``core.law.robot_commands``); frame: the reference's frame at the state.
+        sensed: what they know (:class:`Sensed`); vertices: (K, dim) their places in the
+        formation frame; frame: the reference's frame at the state.
         """
-        law = robot_commands(own, vertices, observer, neighbours, self.radii, self.law, frame)
+        law = robot_commands(sensed.points, vertices, sensed.observer, sensed.neighbours,
+                             self.radii, self.law, frame)
         body: Optional[Float] = None
         if self.unicycle:
-            body = unicycle_commands(law.u, headings, self.hand_distance)
+            body = unicycle_commands(law.u, sensed.headings, self.hand_distance)
         elif self.body_frame:
-            body = to_body_frame(law.u, orientations)
+            body = to_body_frame(law.u, sensed.orientations)
         return Commands(law, body)

@@ -92,16 +92,16 @@ class ReferenceTrack:
                    for a, b in ((mine.q_od, heard.q_od), (mine.qdot_od, heard.qdot_od),
                                 (mine.J, heard.J), (mine.Jdot, heard.Jdot)))
 
-    def refusal(self, sample: Sample, state_stamp_ns: Optional[int],
+    def refusal(self, sample: Sample, time_ns: int,
                 catch_up: Callable[[], bool]) -> Optional[Refused]:
         """
         Return why a sample is refused, or None and keep it.
 
-        state_stamp_ns: the stamp of the latest state taken (None: none yet); catch_up: takes
-        the changes heard but not yet taken, True if any (a sample may be ahead of them).
-        Where the frame is evaluated, a sample is compared with it only if a state was taken
-        and the sample is stamped within input_timeout of it: one far from it is on another
-        clock, refused where it is used (:meth:`frame_at`), not another reference.
+        time_ns: the robot's time, the stamp of its latest state (its clock before any), ns;
+        catch_up: takes the changes heard but not yet taken, True if any (a sample may be
+        ahead of them). Where the frame is evaluated, a sample is compared with it only if it
+        is stamped within input_timeout of the robot's time: one further is on another clock,
+        refused where it is used (:meth:`frame_at`), not another reference.
         """
         if sample.frame_id != self.world_frame:
             return Refused(Reason.FRAME, f' (got {sample.frame_id!r}, expected '
@@ -110,8 +110,7 @@ class ReferenceTrack:
             return Refused(Reason.NON_FINITE)
         if not self.plausible(sample) and not (catch_up() and self.plausible(sample)):
             return Refused(Reason.TOO_FAST)
-        if (self.evaluates and state_stamp_ns is not None
-                and abs(sample.stamp_ns - state_stamp_ns) <= self.timeout_ns
+        if (self.evaluates and abs(sample.stamp_ns - time_ns) <= self.timeout_ns
                 and not self.same(sample) and not (catch_up() and self.same(sample))):
             self.others_in_row += 1
             return Refused(Reason.OTHER_REFERENCE, ' (another parameters file or reference.* '

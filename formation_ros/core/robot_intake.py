@@ -15,7 +15,10 @@ from dataclasses import dataclass
 from typing import Optional, Set
 
 from formation_ros.core.admission import Reason, refusal
+from formation_ros.core.frames import valid_quaternions
 from formation_ros.core.units import NS_PER_S
+import numpy as np
+from numpy.typing import ArrayLike
 
 
 @dataclass(frozen=True)
@@ -99,6 +102,21 @@ class StateIntake:
         if abs(gap) > self.timeout_ns:
             return Refused(Reason.CLOCK, gap_s=gap / NS_PER_S)
         return None
+
+    def poses_refusal(self, frame_id: str, stamp_ns: int, positions: ArrayLike,
+                      orientations: ArrayLike, needs_orientation: bool, clock_ns: int,
+                      stopped: bool, finite: Optional[bool] = None) -> Optional[Refused]:
+        """
+        Return why a state of poses is refused (:meth:`refusal`), or None.
+
+        positions: (..., dim) m; orientations: (..., 4) quaternions, looked at only when
+        ``needs_orientation``; finite: given (a pose's whole finiteness), else reckoned.
+        """
+        if finite is None:
+            finite = bool(np.all(np.isfinite(positions))
+                          and (not needs_orientation or np.all(np.isfinite(orientations))))
+        oriented = not needs_orientation or bool(np.all(valid_quaternions(orientations)))
+        return self.refusal(frame_id, stamp_ns, finite, oriented, clock_ns, stopped)
 
     def advance(self, stamp_ns: int, jump: bool) -> bool:
         """

@@ -4,34 +4,16 @@
 r"""
 Fleet process (executable ``fleet``): several robot nodes in one process.
 
-Each robot is the same :class:`formation_ros.nodes.robot.RobotNode` as ``ros2 run formation_ros
-robot`` starts, in its own namespace ``/robot_<i>``, with its own parameters, hearing only its
-own topics: the control stays decentralised, only the process (its memory, its one executor
-thread) is shared. A process per robot costs about 100 MB and its own DDS participant; a fleet
-of K robots costs one of each, which is what lets a hundred robots run on one small computer::
+Each robot is the same :class:`formation_ros.nodes.robot.RobotNode` as the ``robot``
+executable starts, in its own namespace ``/robot_<i>`` with its own parameters; only the
+process (its memory, its executor thread, its DDS participant) is shared. The first robot
+hears the reference and the changes for the others that share its values, publishes every
+robot's status on ``/diagnostics``, and with ``transport: team`` carries the process's
+:class:`formation_ros.nodes.robots_link.RobotsLink`. What a fleet shares and how to start one:
+docs/ros_interface.md ("Many robots: fleet processes")::
 
     ros2 run formation_ros fleet --robots 1-5 --ros-args \\
         --params-file config/paper_section5.yaml -p use_sim_time:=true
-
-Parameters given on the command line (``-p``) or in a parameters file apply to every robot of
-the fleet; a file's ``/robot_3/robot:`` section applies to robot 3 alone, as it would to a
-robot process. The namespace of each robot is set by the fleet: ``-r __ns:=...`` is refused,
-and a ``robot_id`` must match it. As in a robot process, each robot's simulated clock is set
-from its states' stamps (no ``/clock`` subscription), so its ``use_sim_time`` cannot be changed
-while it runs. The first robot alone hears ``/formation/reference``, ``/formation/shape`` and
-``/formation/status`` for all of them (it checks the reference's samples once, and each robot
-uses them as its own): a robot whose own parameters give other ``reference.*``,
-``formation.*`` or ``formations.*`` values hears them itself. With ``transport: team`` the
-robots share one ``/formation/states`` subscription and one ``/formation/commands``
-publisher, and their commands come from one call of the law per state. Either way the first
-robot publishes the fleet's ``/diagnostics``: one DiagnosticArray a second holding one status
-per robot, each named ``formation_ros/robot_<i>`` as a robot process names its own. With
-``fleet.parameter_services: false`` only the first robot's node offers the parameter services
-(``ros2 param``) and the type description service (``~/get_type_description``, which tools
-use to learn a message type they do not have), and publishes its log lines on ``/rosout``
-(the others' lines still reach the console, where the launcher collects them): each of the
-others then costs 15 DDS endpoints less, which is what discovery spends its time and memory
-on with hundreds of robots.
 """
 
 import re
@@ -39,7 +21,8 @@ import sys
 from typing import List, Optional, Sequence
 
 from formation_ros.core.declarations import ParamError
-from formation_ros.nodes.robot import RobotNode, TeamLink
+from formation_ros.nodes.robot import RobotNode
+from formation_ros.nodes.robots_link import RobotsLink
 from formation_ros.ros.runner import run
 from formation_ros.ros.topics import robot_namespace
 from rclpy.parameter import Parameter
@@ -107,8 +90,8 @@ def make_fleet(ids: Sequence[int]) -> List[RobotNode]:
     disagrees with every namespace but one and is refused there). The first robot publishes
     every robot's status on /diagnostics, one DiagnosticArray a period for the whole fleet.
     With ``transport: team`` the fleet's robots hear the team's states and send their commands
-    through one :class:`formation_ros.nodes.robot.TeamLink`: one message in and one out per
-    state.
+    through one :class:`formation_ros.nodes.robots_link.RobotsLink`: one message in and one out
+    per state.
     """
     if not ids:
         return []
@@ -137,7 +120,7 @@ def make_fleet(ids: Sequence[int]) -> List[RobotNode]:
                                 '(fleet.parameter_services false)')
     first.reported = nodes
     if team:
-        TeamLink(nodes)
+        RobotsLink(nodes)
     return nodes
 
 

@@ -4,25 +4,18 @@
 """
 Simulated time for robot nodes without a ``/clock`` subscription.
 
-With ``use_sim_time`` every rclpy node subscribes to ``/clock`` and runs a Python callback per
-tick (the plant publishes one per published state). A robot needs none: every state the plant
-sends it (its ``pose``, or ``/formation/states`` with the team transport) is stamped with the
-plant's simulated time, which is the time the robot needs. A robot node is made on the wall
-clock (:func:`wall_clock_overrides`), so rclpy's time source makes no ``/clock`` subscription
-(made and removed at once, it would still be announced to every participant), and then put on
-simulated time without one (:func:`sim_time_without_clock`); :class:`StateClock` sets the
-nodes' clocks to each accepted state's stamp: forward only while the states come, whichever
-way it jumps once they had stopped (the robot decides: a link cut for a while, a plant started
-again). ``use_sim_time`` still decides which clock a robot is on: with it false the robot stays
-on the wall clock and refuses the plant's states as stamped on another clock. It is fixed while
-the nodes run (:func:`keep_sim_time` refuses a change). Nodes on wall time are left as they
-are; on an rclpy without the node's time source attribute a robot follows ``/clock`` as any
-node does.
+A robot node is made on the wall clock (:func:`wall_clock_overrides`, so rclpy's time source
+makes no ``/clock`` subscription) and then put on the time asked for
+(:func:`sim_time_without_clock`); on simulated time :class:`StateClock` sets its clock to the
+time its states set (the rule: ``core.robot_intake.StateIntake``), and :func:`keep_sim_time`
+refuses a change of ``use_sim_time`` while it runs. Why: docs/ros_interface.md ("Time").
 """
 
-from typing import Any, List, Optional, Sequence
+import time
+from typing import Any, List, Mapping, Optional, Sequence
 
 from formation_ros.core.declarations import ParamError
+from formation_ros.ros.team import PublisherWatch
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import ROSClock
 from rclpy.node import Node
@@ -79,24 +72,50 @@ def keep_sim_time(parameters: List[Parameter]) -> SetParametersResult:
 
 
 class StateClock:
-    """The simulated clocks of ``nodes``, set from the states' stamps instead of ``/clock``."""
+    """The simulated clocks of robot nodes, set to the time their states set."""
 
-    def __init__(self, nodes: Sequence[Node]) -> None:
-        """Drive the clocks of those ``nodes`` that are on simulated time."""
+    def __init__(self, node: Node) -> None:
+        """Drive the clock of ``node`` if it is on simulated time (else none)."""
         self.clocks: List[ROSClock] = []
-        self.now_ns = 0
-        for node in nodes:
-            clock = node.get_clock()
-            if _active_source(node) is None or not isinstance(clock, ROSClock):
-                continue
+        clock = node.get_clock()
+        if _active_source(node) is not None and isinstance(clock, ROSClock):
             self.clocks.append(clock)
             node.add_on_set_parameters_callback(keep_sim_time)
 
-    def advance(self, stamp_ns: int, jump: bool = False) -> None:
-        """Set every clock to ``stamp_ns`` (ns) if it is later than their time, or ``jump``."""
-        if not self.clocks or stamp_ns == self.now_ns or (stamp_ns < self.now_ns and not jump):
+    @property
+    def follows_states(self) -> bool:
+        """Whether the clocks are set here from the states (simulated time without /clock)."""
+        return bool(self.clocks)
+
+    def join(self, other: 'StateClock') -> None:
+        """Drive the clocks of ``other`` too (the robots of one process's link)."""
+        self.clocks.extend(other.clocks)
+
+    def set_time(self, stamp_ns: int) -> None:
+        """Set every clock to ``stamp_ns`` (ns)."""
+        if not self.clocks:
             return
-        self.now_ns = stamp_ns
         moment = Time(nanoseconds=stamp_ns, clock_type=self.clocks[0].clock_type)
         for clock in self.clocks:
             clock.set_ros_time_override(moment)
+
+
+def clock_advice(graph: PublisherWatch, expected: Mapping[str, Optional[str]],
+                 nodes: str) -> Optional[str]:
+    """
+    Say what to do about stamps from another clock: the graph's answer, else use_sim_time.
+
+    expected: the topics (/clock, the reference) that must have one publisher; two of one are
+    two teams on one domain. ``nodes``: the nodes to start with ``use_sim_time:=true``. None
+    while the graph has not yet named every publisher (``PublisherWatch.named_publishers``).
+    """
+    now = time.monotonic()
+    found = {topic: graph.named_publishers(topic, now) for topic in expected}
+    if any(names is None for names in found.values()):
+        return None
+    doubled = {topic: names for topic, names in found.items() if names}
+    if doubled:
+        return ('; '.join(f"{topic} has {len(names)} publishers ({', '.join(names or [])})"
+                          for topic, names in doubled.items())
+                + ': two teams on one domain? each needs a ROS_DOMAIN_ID of its own')
+    return f'start {nodes} with use_sim_time:=true'

@@ -3,7 +3,7 @@
 
 """One path computes the commands of one robot and of K: each robot's as if it were alone."""
 
-from formation_ros.core.control import Control
+from formation_ros.core.control import Control, Sensed
 from formation_ros.core.frames import to_body_frame
 from formation_ros.core.law import make_law, robot_command
 from formation_ros.core.reference import Reference
@@ -34,14 +34,14 @@ def test_the_team_path_gives_each_robot_its_own_command(unicycle, body_frame):
     points, headings = team.points(POSITIONS, ORIENTATIONS)
     observer = np.repeat(np.arange(N), N - 1)
     neighbours = np.concatenate([sensed(points, k) for k in range(N)])
-    commands = team.commands(points, headings, ORIENTATIONS, VERTICES, observer, neighbours,
-                             FRAME)
+    commands = team.commands(Sensed(np.arange(N), points, headings, ORIENTATIONS, observer,
+                                    neighbours), VERTICES, FRAME)
     assert commands.published.shape == (N, team.width)
     for k in range(N):
         alone = Control(LAW, RADII[k:k + 1], 2, unicycle, 0.2, body_frame)
-        one = alone.commands(points[k:k + 1], headings[k:k + 1], ORIENTATIONS[k:k + 1],
-                             VERTICES[k:k + 1], np.zeros(N - 1, dtype=np.intp),
-                             sensed(points, k), FRAME)
+        one = alone.commands(Sensed(np.array([k]), points[k:k + 1], headings[k:k + 1],
+                                    ORIENTATIONS[k:k + 1], np.zeros(N - 1, dtype=np.intp),
+                                    sensed(points, k)), VERTICES[k:k + 1], FRAME)
         assert np.allclose(one.published[0], commands.published[k], rtol=0, atol=1e-12)
         law = robot_command(points[k], VERTICES[k], sensed(points, k), RADII[k], LAW, FRAME)
         assert np.allclose(law.u, commands.law.u[k], rtol=0, atol=1e-12)
@@ -71,6 +71,6 @@ def test_inputs_are_not_changed():
     before = POSITIONS.copy(), ORIENTATIONS.copy()
     team = Control(LAW, RADII, 2, True, 0.2, False)
     points, headings = team.points(POSITIONS, ORIENTATIONS)
-    team.commands(points, headings, ORIENTATIONS, VERTICES, np.zeros(0, dtype=np.intp),
-                  np.zeros((0, 2)), FRAME)
+    team.commands(Sensed(np.arange(N), points, headings, ORIENTATIONS,
+                         np.zeros(0, dtype=np.intp), np.zeros((0, 2))), VERTICES, FRAME)
     assert np.array_equal(before[0], POSITIONS) and np.array_equal(before[1], ORIENTATIONS)

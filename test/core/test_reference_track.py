@@ -103,8 +103,11 @@ def test_a_sample_far_from_the_states_is_another_clock_not_another_reference(tra
     assert frame is None and gap == pytest.approx(1.7e9 - 5.0)
 
 
-def test_before_any_state_a_sample_is_kept_unchecked(track):
-    assert track.refusal(sample_of(track.timeline, 3.0, 0.5), None, never) is None
+def test_before_any_state_a_sample_near_the_clock_is_checked_one_far_from_it_kept(track):
+    """A robot on simulated time before its first state: its clock is 0, the plant's start."""
+    near = track.refusal(sample_of(track.timeline, 0.0, 0.5), 0, never)
+    assert near.reason is Reason.OTHER_REFERENCE
+    assert track.refusal(sample_of(track.timeline, 1.7e9, 0.5), 0, never) is None
 
 
 def test_frame_finite_and_speed_are_checked_first(track):

@@ -16,9 +16,10 @@ import time
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from formation_ros.core.trajectory import Trajectory
-from formation_ros.nodes.robot import LISTENER_LOOKS, LISTENERS_PERIOD
+from formation_ros.nodes.robots_link import LISTENER_LOOKS
 from formation_ros.ros import qos
 from formation_ros.ros.diagnostics import PERIOD
+from formation_ros.ros.on_demand import LISTENERS_PERIOD
 from formation_ros.tools.supervise import ProcessSpec
 from geometry_msgs.msg import TwistStamped
 from helpers import (exe, launch, project_processes, SimClock, SQUARE, START_UP,

@@ -1,13 +1,19 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""A robot on simulated time checks reference samples against the frame it evaluates."""
+"""
+A robot node on simulated time wired to its reference track and answer policy.
+
+The track's rules (samples unlike the frame evaluated, samples from another clock) are tested
+in test/core/test_reference_track.py; here through the node's callbacks and timers.
+"""
 
 import os
 
+from formation_ros.core.admission import Reason
 from formation_ros.core.frames import FrameSample
 from formation_ros.core.units import NS_PER_S
-from formation_ros.nodes.robot import Reason, RobotNode
+from formation_ros.nodes.robot import RobotNode
 from geometry_msgs.msg import Point, Pose, PoseArray
 import pytest
 import rclpy
@@ -27,7 +33,7 @@ def robot(monkeypatch):
         '-p', 'reference.kind:=circle', '-p', 'reference.radius:=1.0',
         '-p', 'reference.speed:=0.5', '-p', 'wait_for_subscribers:=0'])
     steady = [10 ** 12]
-    monkeypatch.setattr(RobotNode, '_now_ns', staticmethod(lambda: steady[0]))
+    monkeypatch.setattr(RobotNode, 'now_ns', staticmethod(lambda: steady[0]))
     node = RobotNode(namespace='/robot_1', context=context)
     node.steady_ns = steady
     try:
@@ -46,23 +52,31 @@ def sample(node, stamp_s, shift=0.0):
     return serialize_message(wire.reference_odometry(moved, stamp_ns, 2))
 
 
-def refused(node):
-    return node.rejected.get(('reference', Reason.OTHER_REFERENCE), 0)
+def refused(node, reason):
+    return node.refusals.refusals.get(('reference', reason), 0)
 
 
-def test_one_sample_unlike_the_frame_is_refused_and_logged_only_if_the_next_is_too(robot):
+def test_a_sample_unlike_the_frame_is_refused_through_the_callback(robot):
     robot.on_reference(sample(robot, 5.0))
-    assert refused(robot) == 0 and len(robot.references) == 1
     robot.on_reference(sample(robot, 5.02, shift=0.5))
-    assert refused(robot) == 1 and len(robot.references) == 1
-    assert not robot.once.is_active(LOGGED)
-    robot.on_reference(sample(robot, 5.04))
-    robot.on_reference(sample(robot, 5.06, shift=0.5))
-    assert refused(robot) == 2 and not robot.once.is_active(LOGGED)
-    robot.on_reference(sample(robot, 5.08, shift=0.5))
-    assert refused(robot) == 3 and robot.once.is_active(LOGGED)
-    robot.on_reference(sample(robot, 5.10))
-    assert len(robot.references) == 3 and not robot.once.is_active(LOGGED)
+    robot.on_reference(sample(robot, 5.04, shift=0.5))
+    assert refused(robot, Reason.OTHER_REFERENCE) == 2 and len(robot.track.samples) == 1
+    assert robot.once.is_active(LOGGED)
+    robot.on_reference(sample(robot, 5.06))
+    assert len(robot.track.samples) == 2 and not robot.once.is_active(LOGGED)
+
+
+def test_a_sample_on_the_wall_clock_is_refused_as_another_clock_not_another_reference(robot):
+    """The reference started without use_sim_time beside a plant holding its clock at 0."""
+    robot.steady_ns[0] += robot.timeout_ns + 1
+    robot.on_pose(wire.pose_stamped_bytes(0, 'world', (-2.0, -2.0)))
+    assert robot.get_clock().now().nanoseconds == 0
+    robot.on_neighbours(neighbours(0.0))
+    robot.on_reference(sample(robot, 1.7e9, shift=0.5))
+    robot.on_reference(sample(robot, 1.7e9 + 0.02, shift=0.5))
+    assert refused(robot, Reason.OTHER_REFERENCE) == 0
+    robot.on_watchdog()
+    assert refused(robot, Reason.CLOCK) == 1
 
 
 def neighbours(stamp_s):
@@ -82,9 +96,9 @@ def test_a_silent_reference_is_stale_not_from_another_clock(robot):
     robot.steady_ns[0] += robot.timeout_ns + 1
     robot.on_pose(wire.pose_stamped_bytes(int(5.6 * NS_PER_S), 'world', (-2.0, -2.0)))
     robot.on_neighbours(neighbours(5.6))
-    robot._answer_newest()
-    assert robot.once.is_active('stale')
-    assert ('reference', Reason.CLOCK) not in robot.rejected
+    robot.on_watchdog()
+    assert robot.policy.stale == ['reference']
+    assert refused(robot, Reason.CLOCK) == 0
     robot.on_reference(sample(robot, 5.0))
-    robot._answer_newest()
-    assert robot.rejected[('reference', Reason.CLOCK)] == 1
+    robot.on_watchdog()
+    assert refused(robot, Reason.CLOCK) == 1

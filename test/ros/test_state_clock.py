@@ -2,10 +2,11 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-A robot on simulated time takes its clock from the poses it accepts, not from ``/clock``.
+A robot node on simulated time: no ``/clock`` subscription, its clock set from its states.
 
-Robot 1 of the square team (robot transport) is given serialized poses as its ``pose``
-callback would give them; its clock is then read as its timers and checks read it.
+The rule (forward only, a jump once the states stopped) is tested in
+test/core/test_robot_intake.py; here robot 1 of the square team is given serialized states as
+its callbacks would give them, and its rclpy clock is read as its timers read it.
 """
 
 import os
@@ -13,7 +14,8 @@ import time
 
 from formation_ros.core.declarations import ParamError
 from formation_ros.core.units import NS_PER_S
-from formation_ros.nodes.robot import RobotNode, TeamLink
+from formation_ros.nodes.robot import RobotNode
+from formation_ros.nodes.robots_link import RobotsLink
 from geometry_msgs.msg import Point, Pose, PoseArray
 import pytest
 import rclpy
@@ -51,7 +53,7 @@ class Steady:
 @pytest.fixture
 def steady(monkeypatch):
     clock = Steady()
-    monkeypatch.setattr(RobotNode, '_now_ns', staticmethod(clock))
+    monkeypatch.setattr(RobotNode, 'now_ns', staticmethod(clock))
     return clock
 
 
@@ -131,9 +133,9 @@ def test_a_use_sim_time_that_is_not_a_bool_is_refused():
 
 def test_its_clock_follows_the_poses_it_accepts_forward_only(sim_robot):
     sim_robot.on_pose(pose(5.0))
-    assert now_s(sim_robot) == 5.0 and sim_robot.pose_count == 1
+    assert now_s(sim_robot) == 5.0 and sim_robot.policy.states == 1
     sim_robot.on_pose(pose(4.9))
-    assert sim_robot.pose_count == 2 and now_s(sim_robot) == 5.0
+    assert sim_robot.policy.states == 2 and now_s(sim_robot) == 5.0
     sim_robot.on_pose(pose(5.25))
     assert now_s(sim_robot) == 5.25
 
@@ -142,8 +144,8 @@ def test_a_refused_pose_leaves_its_clock_alone(sim_robot):
     sim_robot.on_pose(pose(5.0))
     sim_robot.on_pose(pose(1000.0))
     sim_robot.on_pose(pose(5.5, frame='map'))
-    assert now_s(sim_robot) == 5.0 and sim_robot.pose_count == 1
-    rejected = {reason.name: count for (name, reason), count in sim_robot.rejected.items()
+    assert now_s(sim_robot) == 5.0 and sim_robot.policy.states == 1
+    rejected = {reason.name: count for (name, reason), count in sim_robot.refusals.refusals.items()
                 if name == 'pose'}
     assert rejected == {'CLOCK': 1, 'FRAME': 1}
 
@@ -152,29 +154,29 @@ def test_once_its_states_stopped_the_next_one_sets_its_clock_either_way(sim_robo
     sim_robot.on_pose(pose(5.0))
     steady.wait(sim_robot)
     sim_robot.on_pose(pose(20.0))
-    assert now_s(sim_robot) == 20.0 and sim_robot.pose_count == 2
+    assert now_s(sim_robot) == 20.0 and sim_robot.policy.states == 2
     sim_robot.on_pose(pose(40.0))
-    assert now_s(sim_robot) == 20.0 and sim_robot.pose_count == 2
+    assert now_s(sim_robot) == 20.0 and sim_robot.policy.states == 2
     steady.wait(sim_robot)
     sim_robot.on_pose(pose(0.5))
-    assert now_s(sim_robot) == 0.5 and sim_robot.pose_count == 3
+    assert now_s(sim_robot) == 0.5 and sim_robot.policy.states == 3
     assert {(name, reason.name): count for (name, reason), count
-            in sim_robot.rejected.items()} == {('pose', 'CLOCK'): 1}
+            in sim_robot.refusals.refusals.items()} == {('pose', 'CLOCK'): 1}
 
 
 def test_a_team_process_follows_its_states_the_same_way(steady):
     node, context = robot_node(True, 'team')
     try:
-        team = TeamLink([node])
+        link = RobotsLink([node])
         for stamp, later, taken in ((5.0, False, 5.0), (9.0, False, 5.0), (9.0, True, 9.0),
                                     (2.0, True, 2.0)):
             if later:
                 steady.wait(node)
-            team.on_states(team_state(stamp))
-            team.take()
+            link.on_states(team_state(stamp))
+            link.take_state()
             assert now_s(node) == taken, (stamp, later)
         assert {(name, reason.name): count for (name, reason), count
-                in node.rejected.items()} == {('states', 'CLOCK'): 1}
+                in node.refusals.refusals.items()} == {('states', 'CLOCK'): 1}
     finally:
         node.destroy_node()
         rclpy.shutdown(context=context)
@@ -191,7 +193,7 @@ def test_a_robot_on_the_wall_clock_refuses_simulated_stamps():
     try:
         before = time.time()
         node.on_pose(pose(5.0))
-        assert node.pose_count == 0 and now_s(node) >= before
+        assert node.policy.states == 0 and now_s(node) >= before
         assert '/clock' not in {subscription.topic_name for subscription in node.subscriptions}
     finally:
         node.destroy_node()

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-A fleet's team link reads a state once: a byte-for-byte copy is heard anew, not read again.
+A fleet's link to its robots reads a state once: a byte-for-byte copy is heard anew, not read.
 
 The plant sends the state again while it waits for answers (20 a second while a thousand
 robots start), and each read of a thousand poses and each sensing costs a fleet milliseconds.
@@ -12,8 +12,9 @@ them, are given states as the ``/formation/states`` callback would give them.
 
 import os
 
-from formation_ros.nodes import robot
-from formation_ros.nodes.robot import RobotNode, TeamLink
+from formation_ros.nodes import robots_link
+from formation_ros.nodes.robot import RobotNode
+from formation_ros.nodes.robots_link import RobotsLink
 from geometry_msgs.msg import Point, Pose, PoseArray
 import pytest
 import rclpy
@@ -35,15 +36,15 @@ def state(stamp_s, shift=0.0):
 
 @pytest.fixture
 def link(monkeypatch):
-    """Yield a team link of robots 1 and 2 and the list of states it read, then clean up."""
+    """Yield the link of robots 1 and 2 and the list of states it read, then clean up."""
     reads = []
-    real = robot.read_pose_array
+    real = robots_link.read_pose_array
 
     def counted(data, most):
         reads.append(data)
         return real(data, most)
 
-    monkeypatch.setattr(robot, 'read_pose_array', counted)
+    monkeypatch.setattr(robots_link, 'read_pose_array', counted)
     context = rclpy.Context()
     rclpy.init(context=context, args=['--ros-args', '--params-file', SQUARE,
                                       '-p', 'transport:=team', '-p', 'use_sim_time:=true'])
@@ -52,7 +53,7 @@ def link(monkeypatch):
         nodes.append(RobotNode(namespace='/robot_1', context=context))
         nodes.append(RobotNode(namespace='/robot_2', leader=nodes[0], reports=False,
                                context=context))
-        yield TeamLink(nodes), reads
+        yield RobotsLink(nodes), reads
     finally:
         for node in nodes:
             node.destroy_node()
@@ -63,35 +64,35 @@ def test_a_copy_of_the_state_taken_is_heard_but_not_read_again(link):
     team, reads = link
     leader = team.leader
     team.on_states(state(1.0))
-    team.take()
-    assert len(reads) == 1 and leader.pose_count == 1
+    team.take_state()
+    assert len(reads) == 1 and leader.policy.states == 1
     first = team.state
-    heard_ns = leader.received_ns['pose']
+    heard_ns = leader.policy.received_ns['pose']
     team.on_states(state(1.0))
-    team.take()
+    team.take_state()
     assert len(reads) == 1, 'a copy was read again'
-    assert leader.pose_count == 2 and team.state is first
-    assert leader.received_ns['pose'] >= heard_ns
-    assert leader.received_ns['neighbour'] == leader.received_ns['pose']
+    assert leader.policy.states == 2 and team.state is first
+    assert leader.policy.received_ns['pose'] >= heard_ns
+    assert leader.policy.received_ns['neighbour'] == leader.policy.received_ns['pose']
 
 
 def test_a_state_that_differs_in_any_byte_is_read(link):
     team, reads = link
     team.on_states(state(1.0))
-    team.take()
+    team.take_state()
     team.on_states(state(1.0, shift=1e-9))
-    team.take()
+    team.take_state()
     assert len(reads) == 2
     assert team.state.positions[0][0] == pytest.approx(-2.0 + 1e-9, abs=1e-15)
     team.on_states(state(1.1, shift=1e-9))
-    team.take()
+    team.take_state()
     assert len(reads) == 3 and team.state.stamp_ns == 1_100_000_000
 
 
 def test_a_refused_state_is_not_taken_for_its_copy(link):
     team, reads = link
     team.on_states(state(1.0, shift=float('nan')))
-    team.take()
+    team.take_state()
     team.on_states(state(1.0, shift=float('nan')))
-    team.take()
-    assert len(reads) == 2 and team.state is None and team.leader.pose_count == 0
+    team.take_state()
+    assert len(reads) == 2 and team.state is None and team.leader.policy.states == 0

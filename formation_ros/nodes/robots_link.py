@@ -1,0 +1,219 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+A robot process's link to its robots with ``transport: team``: states in, commands out.
+
+:class:`RobotsLink` reads ``/formation/states`` once for every robot of a process (or fleet),
+admits it through its first robot (the leader, ``RobotNode.admit_state``), senses each robot's
+neighbours with the plant's sensing rule (``core.sensing``) and is the leader's command output:
+every robot's command from one call of ``core.control.Control``, in one
+``/formation/commands`` message, and on a robot's own ``cmd_vel`` while someone subscribes to
+it (``ros.on_demand``). The message layouts and rules: docs/ros_interface.md ("Transports").
+"""
+
+from typing import List, Optional, Sequence, Tuple, TYPE_CHECKING
+
+from formation_ros.core.admission import Reason
+from formation_ros.core.bodies import make_bodies
+from formation_ros.core.control import Control, Sensed
+from formation_ros.core.declarations import ParamError
+from formation_ros.core.robot_intake import Refused
+from formation_ros.core.sensing import sensed_pairs, sensor_radii
+from formation_ros.core.transport import command_vectors, robot_name
+from formation_ros.ros import qos, topics
+from formation_ros.ros.cdr import (encode_names, encode_team_commands, PoseArrayData, PoseData,
+                                   read_pose_array)
+from formation_ros.ros.on_demand import LISTENERS_PERIOD, OnDemand
+from formation_ros.ros.wake import Wake
+from geometry_msgs.msg import PoseArray
+import numpy as np
+from numpy.typing import NDArray
+from rclpy.duration import Duration
+from trajectory_msgs.msg import MultiDOFJointTrajectory
+
+if TYPE_CHECKING:
+    from formation_ros.nodes.robot import RobotNode
+
+LISTENER_LOOKS = 10
+"""Robots without a cmd_vel publisher looked up in the graph per look, in turn."""
+TEAM_VALUES = ('num_robots', 'dim', 'world_frame', 'repulsion_radius', 'controller.gain',
+               'controller.kappa', 'controller.psi', 'jump.kind', 'jump.order', 'body.kind',
+               'body.hand_distance', 'command.type', 'command.frame', 'plant.lockstep',
+               'transport')
+"""Parameters the robots of one link share: one call of the law computes their commands (the
+watchdog and input timeout are the leader's)."""
+
+
+class RobotsLink:
+    """The team transport of one robot process or fleet, on its first robot node (the leader)."""
+
+    what = 'command (team topic and cmd_vel)'
+
+    def __init__(self, nodes: Sequence['RobotNode']) -> None:
+        """
+        Link ``nodes`` (team transport, sharing :data:`TEAM_VALUES`; ParamError if not).
+
+        The first is the leader; the link's rows are the robots in id order.
+        """
+        leader = self.leader = nodes[0]
+        self.nodes = sorted(nodes, key=lambda node: node.index)
+        config = leader.config
+        differing = [name for name in TEAM_VALUES for node in self.nodes[1:]
+                     if node.config.values.get(name) != config.values.get(name)]
+        if differing:
+            raise ParamError([(differing[0], 'must be the same for every robot of a process '
+                                             'with transport team (one call of the law '
+                                             'computes their commands)')])
+        self.n, self.dim = config.num_robots, config.dim
+        self.indices = np.array([node.index for node in self.nodes], dtype=np.intp)
+        radii = np.array([node.sensing_radius for node in self.nodes])
+        self.control = Control(leader.law, radii, self.dim, leader.control.unicycle,
+                               leader.control.hand_distance, leader.control.body_frame)
+        self.needs_orientation = leader.control.unicycle or leader.control.body_frame
+        self.reach = np.zeros(self.n)
+        self.reach[self.indices] = sensor_radii(radii, make_bodies(config.body).sensing_margin)
+        self.local = np.full(self.n, -1, dtype=np.intp)
+        self.local[self.indices] = np.arange(len(self.nodes))
+        self.names = encode_names([robot_name(int(i) + 1) for i in self.indices])
+        self.heard: Optional[bytes] = None
+        self.taken: Optional[bytes] = None
+        """The bytes of the state taken last: a copy of them is not read and sensed again."""
+        self.taken_ns = 0
+        self.state: Optional[PoseArrayData] = None
+        self.sensed_now: Optional[Sensed] = None
+        self.seen = np.zeros(0, dtype=np.intp)
+        self.bounds = np.zeros(len(self.nodes) + 1, dtype=np.intp)
+        self.last_sent: Optional[bytes] = None
+        self.sent: List[Tuple['RobotNode', bytes]] = []
+        """The cmd_vel messages that went with the latest team command, by robot."""
+        self.on_demand = OnDemand(
+            len(self.nodes), LISTENER_LOOKS, lambda k: self.nodes[k].cmd_vel.pub is not None,
+            lambda k: self.nodes[k].count_subscribers(topics.CMD_VEL) > 0,
+            lambda k: self.nodes[k].cmd_vel.make(),
+            lambda k: self.nodes[k].cmd_vel.listeners() > 0)
+        for node in self.nodes:
+            if node is not leader:
+                leader.state_clock.join(node.state_clock)
+            node.join(self, self if node is leader else None, self.control, self.sensed,
+                      leader)
+        self.pub = leader.create_publisher(MultiDOFJointTrajectory, topics.TEAM_COMMANDS,
+                                           qos.COMMAND)
+        self.wake = Wake(leader, self.on_wake, leader.steady)
+        leader.create_subscription(PoseArray, topics.STATES, self.on_states, qos.STATE_INPUT,
+                                   raw=True)
+        self.listeners_timer = leader.create_timer(LISTENERS_PERIOD, self.on_demand.look,
+                                                   clock=leader.steady)
+
+    def on_states(self, data: bytes) -> None:
+        """Store the latest team state's bytes and wake the link."""
+        self.heard = data
+        self.wake.arm()
+
+    def on_wake(self) -> None:
+        """Take the state heard, then let the leader answer it."""
+        self.take_state()
+        self.leader.on_state()
+
+    def take_state(self) -> None:
+        """
+        Read and admit the team state heard (if any), sense, and give the leader its part.
+
+        A copy of the state taken last (the plant sends one again while it waits for answers)
+        is not read again: it is heard anew and answered as a copy (``core.answers``).
+        """
+        data, self.heard = self.heard, None
+        if data is None or (data != self.taken and not self._sense(data)):
+            return
+        self.taken, self.taken_ns = data, self.leader.now_ns()
+        self._give(self.leader, new=True)
+
+    def _sense(self, data: bytes) -> bool:
+        """Read and admit a new state's bytes, sense; False if refused."""
+        leader = self.leader
+        state = leader.read('states', lambda raw: read_pose_array(raw, self.n), data)
+        if state is None:
+            return False
+        if len(state.positions) != self.n:
+            leader.refuse('states', Refused(Reason.MALFORMED, f' ({len(state.positions)} '
+                                                              f'poses for {self.n} robots)'))
+            return False
+        positions = state.positions[:, :self.dim]
+        checked = PoseArrayData(state.stamp_ns, state.frame_id, positions, state.orientations)
+        if not leader.admit_state('states', checked, self.needs_orientation):
+            return False
+        observer, self.seen = sensed_pairs(positions, self.reach, observers=self.indices)
+        points, headings = self.control.points(positions, state.orientations)
+        indices = self.indices
+        self.sensed_now = Sensed(indices, points[indices], headings[indices],
+                                 state.orientations[indices], self.local[observer],
+                                 points[self.seen])
+        self.bounds = np.searchsorted(self.sensed_now.observer, np.arange(len(self.nodes) + 1))
+        self.state = state
+        return True
+
+    def sensed(self) -> Sensed:
+        """Return what the robots know of the state taken last (``core.control.Sensed``)."""
+        assert self.sensed_now is not None
+        return self.sensed_now
+
+    def _give(self, node: 'RobotNode', new: bool) -> None:
+        """Give robot ``node`` its pose, neighbours and latest command as of the state taken."""
+        state = self.state
+        if state is None:
+            return
+        k = int(self.local[node.index])
+        seen = self.seen[self.bounds[k]:self.bounds[k + 1]]
+        node.see(PoseData(state.stamp_ns, state.frame_id,
+                          tuple(state.positions[node.index].tolist()),
+                          tuple(state.orientations[node.index].tolist())),
+                 PoseArrayData(state.stamp_ns, state.frame_id, state.positions[seen],
+                               state.orientations[seen]),
+                 self.taken_ns, new, self.leader.command_of(k))
+
+    def report_to(self, node: 'RobotNode') -> None:
+        """Give robot ``node`` what it would have heard and computed (its diagnostics)."""
+        self._give(node, new=False)
+
+    def publishes_cmd_vel(self, index: int) -> str:
+        """Return 'yes' while robot ``index``'s own cmd_vel is published (someone listens)."""
+        return 'yes' if self.on_demand.listening[self.local[index]] else 'no'
+
+    def listeners(self) -> int:
+        """Return the command subscribers every robot has: team topic plus its fewest cmd_vel."""
+        return self.pub.get_subscription_count() + min(node.cmd_vel.listeners()
+                                                       for node in self.nodes)
+
+    def started(self) -> None:
+        """Look at who subscribes to the robots' cmd_vel as the robots start answering."""
+        self.on_demand.look()
+
+    def publish(self, u: Optional[NDArray[np.float64]], stamp_ns: int) -> None:
+        """
+        Publish one team command answering the state ``stamp_ns``: u (K, width), None for zero.
+
+        Robot i's own cmd_vel carries its row too while someone subscribes to it.
+        """
+        linear, angular = command_vectors(self.control.zero() if u is None else u,
+                                          self.control.unicycle)
+        message = encode_team_commands(stamp_ns, self.leader.config.world_frame, self.names,
+                                       linear, angular)
+        self.pub.publish(message)
+        self.sent = [(self.nodes[k], self.nodes[k].cmd_vel.encode(stamp_ns, linear[k],
+                                                                  angular[k]))
+                     for k in np.flatnonzero(self.on_demand.listening).tolist()]
+        for node, own in self.sent:
+            node.cmd_vel.publish(own)
+        self.last_sent = message
+
+    def resend(self) -> None:
+        """Publish the latest team command again, and each listened robot's cmd_vel with it."""
+        if self.last_sent is None:
+            return
+        self.pub.publish(self.last_sent)
+        for node, own in self.sent:
+            node.cmd_vel.publish(own)
+
+    def flush(self, seconds: float) -> None:
+        """Wait up to ``seconds`` for the team topic's subscribers to have the last command."""
+        self.pub.wait_for_all_acked(Duration(seconds=seconds))
