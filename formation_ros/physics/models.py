@@ -34,30 +34,46 @@ from formation_ros.physics.parts import GRAVITY
 from formation_ros.physics.points import Flyer, Holonomic
 
 DEFAULT_FOOTPRINT = 0.1
-"""The footprint radius of a point body without ``body.radius``, m."""
+"""The footprint radius of a point body without ``body.radius``, m (at most
+:data:`START_GAP_SHARE` of the closest start distance)."""
+START_GAP_SHARE = 0.4
+"""Points without ``body.radius`` get footprints this share of the closest two starts apart, so
+that none overlap at the start."""
 Model = Union[DiffDrive, Holonomic, Flyer]
 
 
-def footprint_radius(body: BodySettings, minimum: float = 0.0) -> float:
-    """Return the footprint radius, m: ``body.radius``, or a default, at least ``minimum``."""
-    return max(body.radius if body.radius > 0.0 else DEFAULT_FOOTPRINT, minimum)
+def footprint_radius(body: BodySettings, closest_start: float = math.inf) -> float:
+    """
+    Return the footprint radius, m: ``body.radius``; without one a point's default.
+
+    closest_start: the distance of the two closest starts, m (the default is at most
+    :data:`START_GAP_SHARE` of it).
+    """
+    if body.radius > 0.0:
+        return body.radius
+    return min(DEFAULT_FOOTPRINT, START_GAP_SHARE * closest_start)
 
 
 def make_model(body: BodySettings, dim: int, world: WorldSettings,
-               command_frame: Optional[CommandFrame] = None) -> Model:
-    """Return the model of ``body.kind`` and ``dim`` with the world's settings."""
+               command_frame: Optional[CommandFrame] = None,
+               closest_start: float = math.inf) -> Model:
+    """
+    Return the model of ``body.kind`` and ``dim`` with the world's settings.
+
+    A unicycle's footprint holds its wheels; closest_start: see :func:`footprint_radius`.
+    """
     body_frame = command_frame is CommandFrame.BODY
     if body.kind is BodyKind.UNICYCLE:
         return DiffDrive(
             wheel_radius=world.wheel_radius, track=world.wheel_track,
-            footprint=footprint_radius(body, 0.5 * world.wheel_track + WHEEL_HALF_WIDTH),
+            footprint=max(body.radius, 0.5 * world.wheel_track + WHEEL_HALF_WIDTH),
             mass=world.mass, wheel_torque=world.wheel_torque, friction=world.floor_friction,
             max_linear=math.inf if body.max_linear is None else body.max_linear,
             max_angular=math.inf if body.max_angular is None else body.max_angular)
     if dim == 2:
         traction = world.floor_friction * world.mass * GRAVITY
-        return Holonomic(footprint=footprint_radius(body), mass=world.mass,
+        return Holonomic(footprint=footprint_radius(body, closest_start), mass=world.mass,
                          force=min(world.force_limit, traction), torque=world.torque_limit,
                          body_frame=body_frame)
-    return Flyer(footprint=footprint_radius(body), mass=world.mass, force=world.force_limit,
-                 torque=world.torque_limit, body_frame=body_frame)
+    return Flyer(footprint=footprint_radius(body, closest_start), mass=world.mass,
+                 force=world.force_limit, torque=world.torque_limit, body_frame=body_frame)

@@ -20,6 +20,7 @@ from typing import Optional, Tuple
 from xml.etree import ElementTree
 
 from formation_ros.core.params import FormationConfig, WorldSettings
+from formation_ros.physics.contacts import closest_distance
 from formation_ros.physics.models import make_model, Model
 from formation_ros.physics.parts import FLOOR_GROUP, GRAVITY, number, numbers
 import numpy as np
@@ -83,8 +84,9 @@ def build_scene(config: FormationConfig, world: Optional[WorldSettings] = None) 
         raise ValueError('the scene needs the start positions (a configuration validated for '
                          'formation_sim or the plant)')
     world = world or config.world or WorldSettings()
-    model = make_model(config.body, config.dim, world, config.command.frame)
     start = np.asarray(config.start, dtype=float)
+    model = make_model(config.body, config.dim, world, config.command.frame,
+                       closest_distance(start)[0])
     headings = (np.zeros(len(start)) if config.start_headings is None
                 else np.asarray(config.start_headings, dtype=float))
     root = ElementTree.Element('mujoco', model='formation')

@@ -18,6 +18,11 @@ Non-ideal bodies (``plant.actuator_lag``, ``plant.max_acceleration``, ``plant.po
 only ``--dt`` runs have them: without ``--dt`` a file that sets any of them is refused. In a
 ``--dt`` run the law acts on what the robots sense (noisy, late), the bodies move with their
 lagged velocity, and trajectory.npz holds the true states.
+
+``--engine mujoco`` runs the law every ``--dt`` (default 0.02 s) on the physics engine
+(``formation_ros.physics``, ``tools.physics_run``: bodies with mass, motors and contacts) and
+also writes world.xml and world_stats.json; ``--engine ideal`` (the default) is all of the
+above.
 """
 
 import argparse
@@ -48,6 +53,9 @@ from formation_ros.core.timeline import Mode, scheduled_shapes, Shape, TeamState
 from formation_ros.core.trajectory import Trajectory, TRAJECTORY_FILE
 from formation_ros.core.unicycle import hand_points, unicycle_commands, unicycle_rates
 from formation_ros.core.units import NS_PER_S
+from formation_ros.tools.physics_run import (DEFAULT_CONTROL_DT, engine_metrics, engine_problem,
+                                             engine_summary, run_on_engine, world_stats,
+                                             WORLD_STATS_FILE)
 import numpy as np
 
 RTOL = 1e-8
@@ -61,6 +69,8 @@ the samples stay well under a gigabyte; smaller runs are sampled as before."""
 MAX_STEPS = 10_000_000
 METRICS_FILE = 'metrics.json'
 PARAMS_COPY = 'params.yaml'
+ENGINES = ('ideal', 'mujoco')
+"""formation_sim's bodies: the paper's (RK45 or the plant model) or the physics engine's."""
 
 
 class Progress:
@@ -536,6 +546,12 @@ def build_parser() -> argparse.ArgumentParser:
                              f'{MAX_ROBOT_SAMPLES:,} robots x samples the smallest multiple '
                              f'of {DEFAULT_SAMPLE_DT:g} s that keeps within it; metrics.json '
                              'says which under sample_dt and sampling)')
+    parser.add_argument('--engine', choices=ENGINES, default='ideal',
+                        help="the bodies: 'ideal' (default: q' = u by RK45, or the plant "
+                             "model with --dt) or 'mujoco' (the physics engine, world.*: the "
+                             'law every --dt s, default '
+                             f'{DEFAULT_CONTROL_DT:g}, held while the engine steps; also '
+                             f'writes world.xml and {WORLD_STATS_FILE})')
     parser.add_argument('--no-plots', action='store_true', help='skip the figures')
     parser.add_argument('--quiet', action='store_true', help='print no progress')
     return parser
@@ -595,9 +611,12 @@ def prepare_out(path: str, overwrite: bool, names: Sequence[str]) -> Optional[st
     return None
 
 
-def output_names(plots_wanted: bool) -> Tuple[str, ...]:
+def output_names(plots_wanted: bool, engine: str = 'ideal') -> Tuple[str, ...]:
     """Return the names of the files a run writes into its output directory."""
     names: Tuple[str, ...] = (TRAJECTORY_FILE, METRICS_FILE, PARAMS_COPY)
+    if engine == 'mujoco':
+        from formation_ros.physics.scene import WORLD_FILE
+        names += (WORLD_FILE, WORLD_STATS_FILE)
     if plots_wanted:
         from formation_ros.tools.plots import FIGURES
         names += tuple(FIGURES)
@@ -638,6 +657,8 @@ def main(argv: Optional[list] = None) -> int:
               'formation_sim, plant, reference and robot')
         return 0
     duration = config.duration if args.duration is None else args.duration
+    if args.engine == 'mujoco':
+        return run_engine_command(args, config, duration)
     problem = ((continuous_time_problem(config) if args.dt is None else None)
                or run_length_problem(duration, args.dt, args.sample_dt)
                or prepare_out(args.out, args.overwrite, output_names(not args.no_plots)))
@@ -669,6 +690,50 @@ def main(argv: Optional[list] = None) -> int:
         plots.write_figures(trajectory, config.law(), metrics, args.out)
     print(f'formation_sim: {integrator}, {duration:g} s simulated in {progress.elapsed:.1f} s')
     print(format_summary(metrics, args.out))
+    return 0
+
+
+def run_engine_command(args: argparse.Namespace, config: FormationConfig,
+                       duration: float) -> int:
+    """Run ``formation_sim --engine mujoco`` (``tools.physics_run``); return the exit code."""
+    dt = DEFAULT_CONTROL_DT if args.dt is None else args.dt
+    problem = (engine_problem(config, dt) or run_length_problem(duration, dt, args.sample_dt)
+               or prepare_out(args.out, args.overwrite,
+                              output_names(not args.no_plots, args.engine)))
+    if problem:
+        print(f'formation_sim: {problem}', file=sys.stderr)
+        return 2
+    try:
+        from formation_ros.physics.scene import build_scene
+    except ImportError as exc:
+        print(f'formation_sim: --engine mujoco needs MuJoCo 3 (pip install mujoco): {exc}',
+              file=sys.stderr)
+        return 2
+    sampling = sampling_metadata(config.num_robots, duration, dt, args.sample_dt)
+    progress = Progress(duration, quiet=args.quiet)
+    run = run_on_engine(config, duration, dt, sampling['sample_dt'], shapes_of(config),
+                        progress)
+    world = config.world
+    assert world is not None
+    integrator = (f'MuJoCo {run.version}, timestep {world.timestep:g} s, the law every '
+                  f'{dt:g} s held (zero-order hold)')
+    metrics = run_metrics(run.trajectory, config, integrator, schedule_events(config))
+    metrics.update(engine_metrics(run))
+    metrics.update(sampling)
+    metrics['wall_time'] = progress.elapsed
+    run.trajectory.save(os.path.join(args.out, TRAJECTORY_FILE))
+    _copy_params(args.params, args.out)
+    build_scene(config).write(args.out)
+    for name, content in ((METRICS_FILE, metrics), (WORLD_STATS_FILE, world_stats(run))):
+        with open(os.path.join(args.out, name), 'w', encoding='utf-8') as stream:
+            json.dump(content, stream, indent=2)
+            stream.write('\n')
+    if not args.no_plots:
+        from formation_ros.tools import plots
+        plots.write_figures(run.trajectory, config.law(), metrics, args.out)
+    print(f'formation_sim: {integrator}, {duration:g} s simulated in {progress.elapsed:.1f} s')
+    print(format_summary(metrics, args.out))
+    print(engine_summary(metrics))
     return 0
 
 
