@@ -26,7 +26,8 @@ ROSDEP_KEYS = {
     'yaml': 'python3-yaml',
 }
 # Imports without an apt package: package.xml must say, in a comment, how to install them.
-PIP_ONLY = {'rosbags': 'pip install rosbags', 'mcap': 'pip install mcap'}
+PIP_ONLY = {'rosbags': 'pip install rosbags', 'mcap': 'pip install mcap',
+            'mujoco': 'pip install mujoco'}
 TEST_DEPENDS = ('ament_flake8', 'ament_pep257', 'python3-pytest', 'python3-mypy',
                 'python3-hypothesis')
 

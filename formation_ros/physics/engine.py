@@ -133,6 +133,11 @@ class Engine:
         return result
 
     @property
+    def version(self) -> str:
+        """Return MuJoCo's version."""
+        return str(mujoco.__version__)
+
+    @property
     def time_ns(self) -> int:
         """Simulated time since the start, ns."""
         return self.steps * self.step_ns

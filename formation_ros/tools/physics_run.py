@@ -77,7 +77,6 @@ def run_on_engine(config: FormationConfig, duration: float, control_dt: float,
     shapes: the shape in force at each time (``tools.sim.shapes_of``); progress: a
     ``tools.sim.Progress``. The engine's ``world.output_dir`` is not used.
     """
-    import mujoco
     from formation_ros.physics.engine import Engine
     engine = Engine(config)
     law, reference = config.law(), config.reference()
@@ -123,7 +122,7 @@ def run_on_engine(config: FormationConfig, duration: float, control_dt: float,
     stats = asdict(engine.stats())
     events = [{'i': event.i, 'j': event.j, 't': event.t_ns / NS_PER_S}
               for event in engine.contacts.events]
-    return EngineRun(trajectory, stats, events, mujoco.__version__)
+    return EngineRun(trajectory, stats, events, engine.version)
 
 
 def _finite(stats: Dict[str, Any]) -> Dict[str, Any]:
