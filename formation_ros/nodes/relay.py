@@ -4,66 +4,23 @@
 r"""
 Relay node (executable ``relay``): the range sensor of the plant, without the bodies.
 
-In a lab the bodies are real and a motion-capture system (or any localisation) measures them.
-The relay reads those measured poses and publishes what the plant node would: every robot's
-``/robot_<i>/pose`` (PoseStamped) and ``/robot_<i>/neighbors`` (PoseArray: what its range
-sensor sees), same types, same QoS (``qos.STATE``), in ``world_frame``, with the one sensing
-rule of ``core.sensing`` (strictly within R_i; R_i + 2 l for unicycles, whose law acts on hand
-points l ahead of the bodies). The robot nodes run unchanged, on wall-clock time::
+In a lab the bodies are real and a motion-capture system measures them: :class:`RelayNode`
+reads each robot's measured pose (``relay.source_topic``, a PoseStamped or an Odometry) and
+publishes what the plant would, every robot's ``pose`` and ``neighbors`` with the one sensing
+rule of ``core.sensing``, all with one wall-clock stamp per cycle at ``relay.rate``. A
+measurement is admitted by ``core.admission`` (frame, finite values, a unit quaternion, whole
+bytes; every refusal counted and logged once through ``ros.once.RefusalLog``) and by its stamp
+(:meth:`RelayNode._advances`: later than the last one taken). The rules and the stale robots:
+docs/lab.md and docs/faults.md ("the motion capture repeats a lost body's last pose")::
 
     ros2 run formation_ros relay --ros-args --params-file config/lab_turtlebot3.yaml
-
-(from the repository; ``$(ros2 pkg prefix --share formation_ros)/config/...`` elsewhere). The
-relay runs on wall-clock time: leave ``use_sim_time`` out (a lab has no ``/clock``; it is
-refused).
-
-Inputs: robot i's measured pose on ``relay.source_topic`` with ``{i}`` its id and ``{name}`` its
-entry of ``relay.source_names`` (e.g. ``/vrpn_mocap/{name}/pose``), a PoseStamped or, with
-``relay.source_type: odometry``, a nav_msgs/Odometry; QoS ``qos.MEASUREMENT`` (best effort, no
-liveliness), so best-effort and reliable publishers are both heard. Callbacks read the bytes
-(``ros.cdr``), check them and store the latest measurement of each robot with the time it
-arrived; a timer at ``relay.rate`` (steady clock) runs each cycle.
-
-Stamps and ages: every pose and neighbour list of a cycle carries ONE stamp, the relay's
-wall-clock time at the cycle (``get_clock().now()``), so that a robot, which answers a state
-when its pose and neighbours carry the same stamp, answers every cycle. The age of a
-measurement is measured from its arrival on this host's monotonic clock, never from its header
-stamp: a mocap computer's clock may be off by any amount. A measurement's own stamp is not
-forwarded; it is only compared with the same robot's previous one, which needs no common clock:
-a measurement stamped no later than the last one taken (a driver that repeats a frozen pose
-after it lost the body, or a reordered sample) is refused and does not keep the robot fresh,
-so a frozen source goes stale after ``relay.max_age`` like a silent one. Stamps that go back by
-more than ``relay.max_age`` are a restarted source: taken, and logged once. A source that
-stamps nothing (stamp 0, e.g. ``ros2 topic pub``) is taken by arrival alone, logged once:
-repeats cannot be told from fresh measurements there.
-
-What is forwarded: the positions (x, y and in 3D z; in 2D the height z is dropped) and the
-orientations. A unicycle's orientation is its heading (yaw of the measured quaternion) as a
-rotation about +z, as the plant writes it; a point's is the measured quaternion, normalised (a
-holonomic base that takes body-frame commands, ``command.frame: body``, is turned by it). An
-orientation that is not a unit quaternion (``core.frames.valid_quaternions``, as the robots
-check it) is refused for every body kind: the relay does not know whether the robots turn their
-commands by it.
-
-Stale robots: a robot whose latest measurement is older than ``relay.max_age`` gets no pose and
-no neighbour list (its own watchdog, ``input_timeout``, then stops it), but stays in the other
-robots' neighbour lists at its last measured position: a neighbour that vanishes from a list is
-how collisions happen. A robot never measured is listed nowhere. Until at least one robot is
-measured nothing is published. ``/diagnostics`` names the stale robots (WARN) and counts the
-measurements refused per robot and reason.
-
-Untrusted input: a measurement in a frame other than ``world_frame``, with non-finite values,
-with an orientation that is not a unit quaternion, or whose bytes are not a whole message of the
-source type is refused (counted, logged once naming the topic, not stored). A source topic that
-also has publishers of another type (which DDS does not connect to this subscription) is logged
-once from the diagnostics timer.
 """
 
-import enum
 import time
 from typing import Callable, Dict, List, Optional, Tuple
 
 from diagnostic_msgs.msg import DiagnosticArray
+from formation_ros.core.admission import Reason, refusal
 from formation_ros.core.bodies import make_bodies
 from formation_ros.core.declarations import Exe, ParamError, SourceType
 from formation_ros.core.frames import valid_quaternions
@@ -75,7 +32,7 @@ from formation_ros.ros import qos, topics
 from formation_ros.ros.cdr import (CdrError, PoseData, read_odometry, read_pose_stamped,
                                    StateEncoder)
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
-from formation_ros.ros.once import OnceLog
+from formation_ros.ros.once import OnceLog, RefusalLog
 from formation_ros.ros.parameters import declare_parameters
 from formation_ros.ros.runner import run
 from formation_ros.ros.team import announced
@@ -89,16 +46,6 @@ from scipy.spatial import cKDTree
 NEVER = -1
 UNSTAMPED = 0
 MESSAGE_TYPES = {SourceType.POSE: PoseStamped, SourceType.ODOMETRY: Odometry}
-
-
-class Reason(enum.Enum):
-    """Why the relay refuses a measurement."""
-
-    MALFORMED = 'bytes that are not a whole message of relay.source_type'
-    FRAME = 'a frame other than world_frame'
-    NON_FINITE = 'non-finite values'
-    ROTATION = 'an orientation that is not a unit quaternion'
-    NOT_NEWER = 'a stamp no later than the last one taken (a repeated or reordered measurement)'
 
 
 class RelayNode(Node):
@@ -144,7 +91,8 @@ class RelayNode(Node):
         self.received_ns = np.full(self.n, NEVER, dtype=np.int64)
         self.stamps_ns: List[Optional[int]] = [None] * self.n
         self.measurements = np.zeros(self.n, dtype=np.int64)
-        self.refused: Dict[Tuple[int, Reason], int] = {}
+        self.refusals: RefusalLog[int] = RefusalLog(self.once, self._refusal_line)
+        """Refused measurements by robot id (1-based) and reason."""
         self.foreign_types: Dict[str, List[str]] = {}
         self.cycles = 0
         self.published_cycles = 0
@@ -177,14 +125,10 @@ class RelayNode(Node):
             f'({self.source_type_name}), publishing pose and neighbors in '
             f"'{self.world_frame}' at {settings.rate:g} Hz, stale after {settings.max_age:g} s")
 
-    def _refuse(self, index: int, reason: Reason, detail: str) -> None:
-        """Count a refused measurement of robot ``index``; log it once per robot and reason."""
-        key = (index + 1, reason)
-        self.refused[key] = self.refused.get(key, 0) + 1
-        self.once.start(f'refused-{index}-{reason.name}',
-                        f'robot {index + 1}: ignoring measurements on {self.sources[index]} '
-                        f'with {reason.value}: {detail} (logged once; counted in diagnostics)',
-                        'error')
+    def _refusal_line(self, robot: int, reason: Reason, detail: str) -> str:
+        """Return the log line of robot ``robot``'s measurements refused for ``reason``."""
+        return (f'robot {robot}: ignoring measurements on {self.sources[robot - 1]} with '
+                f'{reason.value}: {detail} (logged once; counted in diagnostics)')
 
     def on_pose(self, index: int, data: bytes) -> None:
         """Store robot ``index``'s measured pose, read from a serialized PoseStamped."""
@@ -199,20 +143,23 @@ class RelayNode(Node):
         try:
             pose = reader(data)
         except CdrError as exc:
-            self._refuse(index, Reason.MALFORMED, f'{exc}, expected a {self.source_type_name}')
+            self.refusals.refuse(index + 1, Reason.MALFORMED,
+                                 f'{exc}, expected a {self.source_type_name}')
             return
         self._store(index, pose)
 
     def _store(self, index: int, pose: PoseData) -> None:
         """Keep a measurement that is in world_frame, finite and rotated by a unit quaternion."""
-        if pose.frame_id != self.world_frame:
-            self._refuse(index, Reason.FRAME, f"got frame '{pose.frame_id}', expected "
-                                              f"world_frame '{self.world_frame}'")
-        elif not pose.finite:
-            self._refuse(index, Reason.NON_FINITE, f'position {pose.position}, orientation '
-                                                   f'{pose.orientation}')
-        elif not valid_quaternions(pose.orientation):
-            self._refuse(index, Reason.ROTATION, f'orientation {pose.orientation}')
+        reason = refusal(pose.frame_id, self.world_frame, pose.finite,
+                         bool(valid_quaternions(pose.orientation)))
+        if reason is Reason.FRAME:
+            self.refusals.refuse(index + 1, reason, f"got frame '{pose.frame_id}', expected "
+                                                    f"world_frame '{self.world_frame}'")
+        elif reason is Reason.NON_FINITE:
+            self.refusals.refuse(index + 1, reason, f'position {pose.position}, orientation '
+                                                    f'{pose.orientation}')
+        elif reason is Reason.ORIENTATION:
+            self.refusals.refuse(index + 1, reason, f'orientation {pose.orientation}')
         elif self._advances(index, pose.stamp_ns):
             self.positions[index] = pose.position
             self.orientations[index] = pose.orientation
@@ -230,8 +177,9 @@ class RelayNode(Node):
         elif last is not None and last != UNSTAMPED and stamp_ns <= last:
             if last - stamp_ns <= self.max_age_ns:
                 self.stamps_ns[index] = last
-                self._refuse(index, Reason.NOT_NEWER, f'stamp {stamp_ns / NS_PER_S:.9f} s '
-                                                      f'after {last / NS_PER_S:.9f} s')
+                self.refusals.refuse(index + 1, Reason.NOT_NEWER,
+                                     f'stamp {stamp_ns / NS_PER_S:.9f} s after '
+                                     f'{last / NS_PER_S:.9f} s')
                 return False
             self.once.start(f'restarted-{index}',
                             f'robot {index + 1}: stamps on {source} went back by '
@@ -328,7 +276,7 @@ class RelayNode(Node):
                   'robots not measured yet': ', '.join(map(str, never)) or 'none',
                   'oldest fresh measurement [s]': float(np.max(ages)) if len(ages) else 'none',
                   'measurements': int(np.sum(self.measurements))}
-        for (robot, reason), count in sorted(self.refused.items(),
+        for (robot, reason), count in sorted(self.refusals.refusals.items(),
                                              key=lambda item: (item[0][0], item[0][1].name)):
             values[f'robot {robot}: refused measurements ({reason.value})'] = count
         for topic, names in self.foreign_types.items():

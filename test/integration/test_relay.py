@@ -191,8 +191,8 @@ STATUS_KEY = 'robot {robot}: refused measurements ({reason})'
 REFUSALS = {
     2: ('a frame other than world_frame', "got frame 'world', expected world_frame 'map'"),
     3: ('non-finite values', 'non-finite values: position'),
-    4: ('bytes that are not a whole message of relay.source_type', 'left over after a '
-                                                                   'PoseStamped'),
+    4: ('bytes that are not a whole message of its type', 'expected a '
+                                                          'geometry_msgs/msg/PoseStamped'),
     5: ('an orientation that is not a unit quaternion', 'orientation (0.0, 0.0, 0.0, 0.0)'),
 }
 
