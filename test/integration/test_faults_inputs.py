@@ -5,6 +5,7 @@
 
 import json
 import math
+import os
 import signal
 import subprocess
 
@@ -12,8 +13,10 @@ from formation_ros.core.law import robot_command
 from formation_ros.core.params import load_config
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.ros import messages, qos
+from formation_ros.tools.supervise import ProcessSpec
 from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
-from helpers import exe, node, SimClock, SQUARE, wait_exit, watch_commands, write_params
+from helpers import (CONFIG, exe, logged, node, SimClock, SQUARE, wait_exit, watch_commands,
+                     write_params)
 from nav_msgs.msg import Odometry
 import numpy as np
 import pytest
@@ -22,6 +25,7 @@ import wire
 pytestmark = pytest.mark.faults
 START_UP = 90.0
 BOUND = load_config(SQUARE).law().u_bound
+CIRCLE = os.path.join(CONFIG, 'circle_2d.yaml')
 
 
 def start_robots(processes, install, robots, sim_time=True):
@@ -49,6 +53,23 @@ def test_a_reference_on_wall_time_is_refused_and_the_team_waits(processes, insta
     assert probe.spin_until(lambda: any(any(u) for _, u in heard[moving:]), START_UP), \
         processes.log('robot_1')
     assert max(max(abs(c) for c in u) for _, u in heard) <= BOUND
+
+
+def test_a_moving_reference_on_wall_time_is_on_another_clock_not_another_reference(
+        processes, install, probe):
+    """A circle started without use_sim_time: the robots say it runs on another clock."""
+    heard, _ = watch_commands(probe, 6)
+    processes.start(node(install, 'plant', CIRCLE))
+    processes.start(ProcessSpec('fleet', [exe(install, 'fleet'), '--robots', '1-6', '--ros-args',
+                                          '--params-file', CIRCLE, '-p', 'use_sim_time:=true']))
+    processes.start(node(install, 'reference', CIRCLE, process='wall_reference'))
+    assert probe.spin_until(lambda: len(heard) >= 100 and 'robots refuse its samples'
+                            in processes.log('wall_reference'), START_UP), processes.log('fleet')
+    assert all(not any(u) for _, u in heard), heard[:5]
+    log = logged(probe, processes, 'fleet', 'ignoring reference messages with stamps from '
+                                            'another clock', 'start the reference with '
+                                                             'use_sim_time:=true')
+    assert 'a frame other than the one its reference' not in log, log
 
 
 def test_forged_commands_are_refused_or_saturated(processes, install, probe, tmp_path):
