@@ -36,6 +36,7 @@ setup(
             'record = formation_ros.nodes.entry:record',
             'fleet = formation_ros.nodes.entry:fleet',
             'relay = formation_ros.nodes.entry:relay',
+            'world = formation_ros.nodes.entry:world',
         ],
     },
 )

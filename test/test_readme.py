@@ -19,7 +19,7 @@ MAX_README_LINES = 250
 SHARE = 'install/formation_ros/share/formation_ros/'
 PKG_PREFIX = '$(ros2 pkg prefix --share formation_ros)/'
 NODES = {'plant': Exe.PLANT, 'robot': Exe.ROBOT, 'fleet': Exe.ROBOT, 'reference': Exe.REFERENCE,
-         'record': Exe.RECORD, 'relay': Exe.RELAY}
+         'record': Exe.RECORD, 'relay': Exe.RELAY, 'world': Exe.WORLD}
 ON_SIM_TIME = ('robot', 'fleet', 'reference')
 
 

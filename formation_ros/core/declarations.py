@@ -54,6 +54,7 @@ class Exe(enum.Enum):
     REFERENCE = 'reference'
     RECORD = 'record'
     RELAY = 'relay'
+    WORLD = 'world'
 
 
 class BodyKind(Choice):
@@ -137,13 +138,16 @@ class Required:
 REQUIRED = Required()
 ALL = frozenset(Exe)
 START = frozenset({Exe.SIM, Exe.PLANT, Exe.RECORD})
+PLACED = START | {Exe.WORLD}
+"""The readers of the start and the bodies' size and limits: START and the physics world."""
 PLANT = frozenset({Exe.PLANT, Exe.RECORD})
 ROBOT = frozenset({Exe.ROBOT, Exe.RECORD})
-COMMAND = frozenset({Exe.SIM, Exe.ROBOT, Exe.PLANT, Exe.RECORD})
+COMMAND = frozenset({Exe.SIM, Exe.ROBOT, Exe.PLANT, Exe.RECORD, Exe.WORLD})
 RELAY = frozenset({Exe.RELAY})
 SCHEDULE = frozenset({Exe.SIM, Exe.REFERENCE, Exe.RECORD})
-PHYSICS = frozenset({Exe.SIM})
-"""The readers of ``world.*``: ``formation_sim --engine mujoco`` (formation_ros/physics)."""
+PHYSICS = frozenset({Exe.SIM, Exe.WORLD})
+"""The readers of ``world.*``: ``formation_sim --engine mujoco`` and the ``world`` node
+(formation_ros/physics)."""
 SHAPE_VERTICES = 'formations.<name>.vertices'
 """The declaration of every named shape's vertices: ``formations.line.vertices`` and so on."""
 SHAPE_NAME = re.compile(r'[A-Za-z][A-Za-z0-9_]*')
@@ -243,31 +247,31 @@ DECLARATIONS = (
     Param('body.radius', Kind.DOUBLE, 0.0,
           'Radius of a body about its position (the axle centre of a unicycle), m: two bodies '
           'closer than twice this are logged as a collision.', low=at_least(0.0),
-          high=at_least(LENGTH_LIMIT), users=START),
+          high=at_least(LENGTH_LIMIT), users=PLACED),
     Param('body.max_linear', Kind.DOUBLE, None,
           'Unicycles: actuator limit on |v|, m/s; a file whose bound sqrt(2) c M1 '
           'exceeds it is refused, and the plant clips |v| to it; the reference refuses a '
           'speed whose vertices it cannot carry.', low=above(0.0),
-          high=at_least(SPEED_LIMIT), users=START | {Exe.REFERENCE}),
+          high=at_least(SPEED_LIMIT), users=PLACED | {Exe.REFERENCE}),
     Param('body.max_angular', Kind.DOUBLE, None,
           'Unicycles: actuator limit on |w|, rad/s; a file whose bound '
           'sqrt(2) c M1 / l exceeds it is refused, and the plant clips |w| to it.',
-          low=above(0.0), high=at_least(SPEED_LIMIT), users=START),
+          low=above(0.0), high=at_least(SPEED_LIMIT), users=PLACED),
     Param('start.positions', Kind.DOUBLE_ARRAY, None,
           'Flat list of num_robots x dim start positions, m (or use start.random_*).',
-          low=at_least(-LENGTH_LIMIT), high=at_least(LENGTH_LIMIT), users=START),
+          low=at_least(-LENGTH_LIMIT), high=at_least(LENGTH_LIMIT), users=PLACED),
     Param('start.random_radius', Kind.DOUBLE, None,
           'Random start: radius of the disc (ball in 3D) about the origin, m.', low=above(0.0),
-          high=at_least(LENGTH_LIMIT), users=START),
+          high=at_least(LENGTH_LIMIT), users=PLACED),
     Param('start.min_separation', Kind.DOUBLE, None,
           'Random start: smallest distance between two robots, m.', low=above(0.0),
-          high=at_least(LENGTH_LIMIT), users=START),
+          high=at_least(LENGTH_LIMIT), users=PLACED),
     Param('start.headings', Kind.DOUBLE_ARRAY, None,
           'Unicycles: num_robots start headings, rad, counter-clockwise from +x (default: random '
           'with a random start, else 0).', low=at_least(-LENGTH_LIMIT),
-          high=at_least(LENGTH_LIMIT), users=START),
+          high=at_least(LENGTH_LIMIT), users=PLACED),
     Param('start.seed', Kind.INT, 0, 'Random start: seed of the random generator.',
-          low=at_least(0), high=at_least(2 ** 31 - 1), users=START),
+          low=at_least(0), high=at_least(2 ** 31 - 1), users=PLACED),
     Param('reference.kind', Kind.STRING, ReferenceKind.FIXED.value,
           'Desired formation trajectory q_od(t).', choices=_choices(ReferenceKind)),
     Param('reference.origin', Kind.DOUBLE_ARRAY, None,

@@ -245,9 +245,10 @@ class FormationConfig:
     Validated parameters of one formation run, for one executable.
 
     Arrays: sensing_radii (N,), vertices (N, dim), start (N, dim) (for ``formation_sim``, the
-    plant and the recorder; None for the others), reference_origin (dim,), reference_velocity
-    (dim,). plant / robot / reference_node / recorder: the executable's own settings (None for
-    the others). values: the flat checked values with defaults (to write back as a file).
+    plant, the recorder and the world; None for the others), reference_origin (dim,),
+    reference_velocity (dim,). plant / robot / reference_node / recorder: the executable's own
+    settings (None for the others). values: the flat checked values with defaults (to write
+    back as a file).
     body: the robots' bodies (``body.*``); start_headings: (N,) start headings in rad of
     unicycles and of points with body-frame commands (for the executables that get a start;
     None otherwise). world_frame: the
@@ -611,7 +612,7 @@ def _own_settings(values: Mapping[str, Any], exe: Exe, n: int,
         return {'recorder': RecorderSettings(path=values['record.path'],
                                              overwrite=values['record.overwrite'],
                                              markers=values['record.markers'])}
-    if exe is Exe.SIM:
+    if exe in (Exe.SIM, Exe.WORLD):
         return {'world': world_settings(values, problems)}
     return {}
 
@@ -795,8 +796,8 @@ def validate(raw: Mapping[str, Any], executable: Union[Exe, str] = Exe.SIM) -> F
     if values.get('formation.name') and vertices is not None:
         vertices = shapes.get(values['formation.name'], vertices)
     schedule = _schedule(values, shapes, problems)
-    start = _start(values, n, dim, problems) if exe in (Exe.SIM, Exe.PLANT, Exe.RECORD) \
-        else None
+    start = (_start(values, n, dim, problems)
+             if exe in (Exe.SIM, Exe.PLANT, Exe.RECORD, Exe.WORLD) else None)
     _geometry(values, radii, vertices, start, problems)
     _reference_problems(values, dim, problems)
     origin = _vector(values, 'reference.origin', dim, problems)

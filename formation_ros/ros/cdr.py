@@ -296,6 +296,13 @@ def encode_twist(linear: ArrayLike, angular: ArrayLike = (0.0, 0.0, 0.0)) -> byt
     return _with_doubles(LITTLE, _xyz(linear) + _xyz(angular))
 
 
+def encode_pose_stamped(stamp_ns: int, frame_id: str, position: ArrayLike,
+                        orientation: Sequence[float]) -> bytes:
+    """Return a serialized PoseStamped: ``position`` ((dim,) m), ``orientation`` (x, y, z, w)."""
+    return _with_doubles(encode_header(stamp_ns, frame_id),
+                         _xyz(position) + [float(v) for v in orientation])
+
+
 def encode_odometry(stamp_ns: int, frame_id: str, child_frame_id: str, position: ArrayLike,
                     orientation: Sequence[float], linear: ArrayLike,
                     angular: ArrayLike) -> bytes:

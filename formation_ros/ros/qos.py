@@ -43,7 +43,8 @@ STATE = _profile(1, ReliabilityPolicy.BEST_EFFORT, DurabilityPolicy.VOLATILE, LI
 STATE_INPUT = _profile(1, ReliabilityPolicy.BEST_EFFORT, DurabilityPolicy.VOLATILE)
 """States heard by a robot: no lease asked, so any publisher of poses is heard."""
 MEASUREMENT = _profile(1, ReliabilityPolicy.BEST_EFFORT, DurabilityPolicy.VOLATILE)
-"""The relay's sources (motion capture): best effort, keep last 1, no lease."""
+"""The relay's sources (motion capture) and the world's measured poses and odometry: best
+effort, keep last 1, no lease."""
 CLOCK = _profile(1, ReliabilityPolicy.RELIABLE, DurabilityPolicy.VOLATILE)
 """``/clock``: reliable, keep last 1 (matches rclpy's best-effort time source too)."""
 DIAGNOSTICS = _profile(10, ReliabilityPolicy.RELIABLE, DurabilityPolicy.VOLATILE)
@@ -56,7 +57,7 @@ CHANGES = _profile(CHANGES_KEPT, ReliabilityPolicy.RELIABLE, DurabilityPolicy.TR
 """The changes: reliable, transient local, CHANGES_KEPT deep."""
 BY_KIND = {QosKind.COMMAND: COMMAND, QosKind.REFERENCE: REFERENCE, QosKind.STATE: STATE,
            QosKind.CLOCK: CLOCK, QosKind.DIAGNOSTICS: DIAGNOSTICS, QosKind.MARKERS: MARKERS,
-           QosKind.CHANGES: CHANGES}
+           QosKind.CHANGES: CHANGES, QosKind.MEASUREMENT: MEASUREMENT}
 
 
 def team_commands_input(robots: int) -> QoSProfile:

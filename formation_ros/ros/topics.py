@@ -31,6 +31,11 @@ STATES = '/formation/states'
 """Team transport: every robot's pose in one PoseArray per state (``core.transport``)."""
 TEAM_COMMANDS = '/formation/commands'
 """Team transport: one MultiDOFJointTrajectory per robot process or fleet per state."""
+MEASURED_POSE = 'measured_pose'
+"""The world's ground truth of robot i, ``/robot_<i>/measured_pose`` (the relay's default
+source, ``relay.source_topic``): what a motion-capture driver gives a lab."""
+ODOM = 'odom'
+"""The world's wheel odometry of a differential-drive robot i, ``/robot_<i>/odom``."""
 MEASUREMENT_TYPES: Dict[str, str] = {
     'pose': 'geometry_msgs/msg/PoseStamped',
     'odometry': 'nav_msgs/msg/Odometry',
@@ -49,6 +54,7 @@ class QosKind(enum.Enum):
     DIAGNOSTICS = 'diagnostics'
     MARKERS = 'markers'
     CHANGES = 'changes'
+    MEASUREMENT = 'measurement'
 
 
 @dataclass(frozen=True)
@@ -94,6 +100,20 @@ def team_topics() -> List[Topic]:
     """Return the two topics of the team transport: the team's states and its commands."""
     return [Topic(STATES, 'geometry_msgs/msg/PoseArray', QosKind.STATE),
             Topic(TEAM_COMMANDS, 'trajectory_msgs/msg/MultiDOFJointTrajectory', QosKind.COMMAND)]
+
+
+def world_topics(robot_id: int, wheeled: bool) -> List[Topic]:
+    """
+    Return what the ``world`` node publishes for robot ``robot_id``: measured pose, odometry.
+
+    wheeled: differential-drive bases (``body.kind: unicycle``), which have wheel odometry.
+    """
+    found = [Topic(robot_topic(robot_id, MEASURED_POSE), MEASUREMENT_TYPES['pose'],
+                   QosKind.MEASUREMENT)]
+    if wheeled:
+        found.append(Topic(robot_topic(robot_id, ODOM), MEASUREMENT_TYPES['odometry'],
+                           QosKind.MEASUREMENT))
+    return found
 
 
 def recorded_topics(num_robots: int, markers: bool,

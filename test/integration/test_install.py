@@ -9,7 +9,8 @@ import subprocess
 
 from helpers import exe
 
-EXECUTABLES = ('robot', 'plant', 'reference', 'record', 'formation_sim', 'formation_report')
+EXECUTABLES = ('robot', 'plant', 'reference', 'record', 'world', 'formation_sim',
+               'formation_report')
 
 
 def test_install_layout(install):

@@ -1,0 +1,399 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+World node (executable ``world``): the physics engine behind the topics a simulated lab has.
+
+It steps :class:`formation_ros.physics.engine.Engine` (MuJoCo) on the steady clock at
+``world.realtime_factor`` (``physics.pacing``) and gives the robots what a simulator and its
+ROS bridge give a lab (Gazebo with ros_gz_bridge): ``/clock``, each robot's ground truth on
+``/robot_<i>/measured_pose`` (the relay's default source) and, for wheeled bases, wheel
+odometry on ``/robot_<i>/odom``; it drives the bodies from ``/robot_<i>/cmd_vel``, whose
+callbacks only store (``physics.intake``). It counts contacts between robots and, with
+``world.output_dir``, writes ``world.xml``, ``trajectory.npz`` and ``world_stats.json``.
+How to start it, what it refuses and writes: docs/physics.md ("The world node"); its topics:
+docs/ros_interface.md.
+"""
+
+from dataclasses import asdict, replace
+import json
+import os
+import shutil
+import time
+from typing import Any, Dict, List, Optional, Set
+
+from diagnostic_msgs.msg import DiagnosticArray
+from formation_ros.core.admission import Reason
+from formation_ros.core.declarations import CommandFrame, Exe
+from formation_ros.core.trajectory import (CHUNKS_DIR, ChunkWriter, read_body_chunks,
+                                           read_chunks, save_atomically, Trajectory,
+                                           TRAJECTORY_FILE)
+from formation_ros.core.unicycle import hand_points, hand_velocity, quaternions_from_headings
+from formation_ros.core.units import NS_PER_S
+from formation_ros.physics.engine import Engine
+from formation_ros.physics.intake import CommandInbox
+from formation_ros.physics.pacing import Pacer
+from formation_ros.physics.parts import rotated
+from formation_ros.physics.scene import WORLD_FILE
+from formation_ros.ros import messages, qos, topics
+from formation_ros.ros.cdr import (CdrError, encode_clock, encode_odometry, encode_pose_stamped,
+                                   read_twist, read_twist_stamped, TwistData)
+from formation_ros.ros.diagnostics import diagnostics, PERIOD
+from formation_ros.ros.once import OnceLog, RefusalLog
+from formation_ros.ros.parameters import declare_parameters
+from formation_ros.ros.runner import run
+from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
+from nav_msgs.msg import Odometry
+import numpy as np
+from numpy.typing import NDArray
+from rclpy.clock import Clock, ClockType
+from rclpy.node import Node
+from rosgraph_msgs.msg import Clock as ClockMsg
+
+WORLD_STATUS = 'formation_ros/world'
+WORLD_STATS_FILE = 'world_stats.json'
+MIN_TICK = 0.005
+"""The shortest period of the step timer, s (wall clock): a fast world publishes several poses
+per tick rather than waking more often."""
+CATCH_UP = 0.2
+"""The most wall-clock time a tick catches up when the world is behind, s (times the factor:
+simulated); the rest is let go and counted (``physics.pacing``)."""
+KEPT_UP = 0.9
+"""A world whose real-time factor over the last second is below this share of the one asked
+for is behind: WARN in /diagnostics, said once in the log."""
+CONTACT_LINES = 50
+"""Contacts logged one line each; further ones are counted only (in /diagnostics and the
+stats)."""
+CHUNK_PERIOD = 1.0
+ODOMETRY_HEIGHT = 0.0
+"""The height of an odometry pose, m: wheel odometry is planar."""
+REFUSAL_WORDS = {Reason.MALFORMED: 'bytes that are not a whole {kind}',
+                 Reason.FRAME: 'a frame other than its command frame',
+                 Reason.NON_FINITE: 'non-finite values',
+                 Reason.CLOCK: "a stamp after the world's time (another clock?)"}
+"""How the world's log and /diagnostics name each reason a cmd_vel is refused for."""
+
+
+class WorldNode(Node):
+    """Steps the physics engine; publishes /clock, measured poses and odometry; takes cmd_vel."""
+
+    def __init__(self) -> None:
+        """Declare and check parameters, build the engine, set up topics and timers."""
+        super().__init__('world')
+        config = declare_parameters(self, Exe.WORLD)
+        assert config.world is not None and config.start is not None
+        self.config, self.world = config, config.world
+        self.engine = Engine(config, config.world)
+        self.n, self.dim = config.num_robots, config.dim
+        self.unicycles = config.body.is_unicycle
+        self.body_frame = config.command.frame is CommandFrame.BODY
+        self.stamped = config.command.stamped
+        self.once = OnceLog(self.get_logger())
+        self.refusals: RefusalLog[int] = RefusalLog(self.once, self._refusal_line)
+        self.refused_robots: Set[int] = set()
+        self.command_frames = [messages.body_frame(i) if self.body_frame
+                               else config.world_frame for i in range(1, self.n + 1)]
+        self.inbox = CommandInbox(self.command_frames, self.dim, self.unicycles, self.stamped,
+                                  self.world.cmd_timeout_ns)
+        self.steps_per_pose = self.world.steps_per_pose
+        self.pacer = Pacer(self.world.timestep_ns, self.world.realtime_factor,
+                           int(CATCH_UP * self.world.realtime_factor * NS_PER_S))
+        self.steady = Clock(clock_type=ClockType.STEADY_TIME)
+        self.contacts_logged = 0
+        self.rate_window = (time.monotonic_ns(), 0)
+        self.output_dir = self.world.output_dir
+        self.output_failure: Optional[str] = None
+        self.chunks: Optional[ChunkWriter] = None
+        self._start_output()
+
+        self.clock_pub = self.create_publisher(ClockMsg, topics.CLOCK, qos.CLOCK)
+        self.pose_pubs = [self.create_publisher(
+            PoseStamped, topics.robot_topic(i, topics.MEASURED_POSE), qos.MEASUREMENT)
+            for i in range(1, self.n + 1)]
+        self.odometry_pubs = ([self.create_publisher(
+            Odometry, topics.robot_topic(i, topics.ODOM), qos.MEASUREMENT)
+            for i in range(1, self.n + 1)] if self.engine.odometer is not None else [])
+        self.command_subs = [self.create_subscription(
+            TwistStamped if self.stamped else Twist, topics.robot_topic(i, topics.CMD_VEL),
+            lambda data, index=i - 1: self.on_command(index, data), qos.COMMAND_INPUT,
+            raw=True) for i in range(1, self.n + 1)]
+        self.diagnostics_pub = self.create_publisher(DiagnosticArray, topics.DIAGNOSTICS,
+                                                     qos.DIAGNOSTICS)
+        tick = max(MIN_TICK, 1.0 / (self.world.pose_rate * self.world.realtime_factor))
+        self.timer = self.create_timer(tick, self.on_timer, clock=self.steady)
+        self.diagnostics_timer = self.create_timer(PERIOD, self.on_diagnostics,
+                                                   clock=self.steady)
+        if self.chunks is not None:
+            self.chunk_timer = self.create_timer(CHUNK_PERIOD, self.write_chunk,
+                                                 clock=self.steady)
+        self.get_logger().info(
+            f'world: {self.n} {self.engine.model.kind.value} robots in {self.dim}D, timestep '
+            f'{self.world.timestep:g} s, realtime factor {self.world.realtime_factor:g}, '
+            f'poses at {self.world.pose_rate:g} Hz'
+            + (f', writing to {self.output_dir}' if self.chunks is not None else ''))
+
+    def _start_output(self) -> None:
+        """With ``world.output_dir``: write world.xml now and start the trajectory's chunks."""
+        if not self.output_dir:
+            return
+        where = self.output_dir
+        try:
+            where = self.engine.scene.write(self.output_dir)
+            where = os.path.join(self.output_dir, CHUNKS_DIR)
+            self.chunks = ChunkWriter(where)
+        except OSError as exc:
+            self._output_failed(exc, where)
+
+    def _refusal_line(self, index: int, reason: Reason, detail: str) -> str:
+        kind = 'TwistStamped' if self.stamped else 'Twist'
+        what = REFUSAL_WORDS.get(reason, reason.value).format(kind=kind)
+        return (f'robot {index + 1}: ignoring cmd_vel with {what} ({detail}; logged once, '
+                'counted in /diagnostics)')
+
+    def on_command(self, index: int, data: bytes) -> None:
+        """Keep robot ``index``'s command for the next step, or count and log its refusal."""
+        try:
+            message = read_twist_stamped(data) if self.stamped else read_twist(data)
+        except CdrError as exc:
+            self.refused_robots.add(index)
+            self.refusals.refuse(index, Reason.MALFORMED, str(exc))
+            return
+        reason = self.inbox.take(index, message.frame_id, message.linear, message.angular,
+                                 message.stamp_ns, self.engine.time_ns)
+        if reason is not None:
+            self.refused_robots.add(index)
+            self.refusals.refuse(index, reason, self._refusal_detail(index, reason, message))
+        elif index in self.refused_robots:
+            self.refused_robots.discard(index)
+            for each in REFUSAL_WORDS:
+                self.refusals.admitted(index, each)
+
+    def _refusal_detail(self, index: int, reason: Reason, message: TwistData) -> str:
+        """Say what was wrong with a refused command: its frame, its stamp or its values."""
+        if reason is Reason.FRAME:
+            return f'frame {message.frame_id!r}, expected {self.command_frames[index]!r}'
+        if reason is Reason.CLOCK:
+            return (f'stamp {message.stamp_ns / NS_PER_S:.9g} s, world at '
+                    f'{self.engine.time_s:.9g} s')
+        return f'linear {message.linear}, angular {message.angular}'
+
+    def on_timer(self) -> None:
+        """Apply the commands kept, run the steps due, publishing at every pose period."""
+        now = time.monotonic_ns()
+        if self.pacer.started_ns is None:
+            self.pacer.start(now, self.engine.steps)
+            self.rate_window = (now, self.engine.steps)
+            self._publish()
+            return
+        rows, commands, stamps = self.inbox.drain()
+        if len(rows):
+            self.engine.apply(commands, stamps, robots=rows)
+        due = self.pacer.due(now, self.engine.steps)
+        while due > 0:
+            steps = min(due, self.steps_per_pose - self.engine.steps % self.steps_per_pose)
+            self.engine.step(steps)
+            due -= steps
+            if self.engine.steps % self.steps_per_pose == 0:
+                self._publish()
+        self._log_contacts()
+
+    def _publish(self) -> None:
+        """Publish /clock, then every robot's measured pose and odometry, all at one stamp."""
+        t_ns = self.engine.time_ns
+        self.clock_pub.publish(encode_clock(t_ns))
+        measured = self.engine.measured_poses()
+        frame = self.config.world_frame
+        for pub, position, orientation in zip(self.pose_pubs, measured.positions,
+                                              measured.orientations):
+            pub.publish(encode_pose_stamped(t_ns, frame, position, orientation))
+        if self.odometry_pubs:
+            self._publish_odometry(t_ns)
+        if self.chunks is not None:
+            self._sample(t_ns)
+
+    def _publish_odometry(self, t_ns: int) -> None:
+        """Publish each base's wheel odometry: pose in world_frame, (v, w) in its base_link."""
+        assert self.engine.odometer is not None
+        positions, headings = self.engine.odometry()
+        quaternions = quaternions_from_headings(headings)
+        rates = self.engine.odometer.rates
+        frame = self.config.world_frame
+        for i, pub in enumerate(self.odometry_pubs):
+            pub.publish(encode_odometry(
+                t_ns, frame, self.command_frames[i],
+                (positions[i, 0], positions[i, 1], ODOMETRY_HEIGHT), quaternions[i],
+                (rates[i, 0], 0.0, 0.0), (0.0, 0.0, rates[i, 1])))
+
+    def _held(self) -> NDArray[np.float64]:
+        """Return the commands driving the motors now (N, width); zero for stale or none."""
+        return np.where(self.engine.live()[:, None], self.engine.command, 0.0)
+
+    def _sample(self, t_ns: int) -> None:
+        """Keep one trajectory sample as the plant writes it (hand points for unicycles)."""
+        assert self.chunks is not None
+        positions, headings = self.engine.planar_state()
+        held = self._held()
+        t = t_ns / NS_PER_S
+        if self.unicycles:
+            distance = self.config.body.hand_distance
+            self.chunks.append(t, hand_points(positions, headings, distance),
+                               hand_velocity(held, headings, distance), heading=headings,
+                               q_body=positions, body_command=held)
+            return
+        velocity = held.copy()
+        if self.body_frame:
+            velocity[:, :2] = rotated(held[:, :2], headings)
+        self.chunks.append(t, positions, velocity)
+
+    def _log_contacts(self) -> None:
+        """Log each new contact between two robots once: the pair and the simulated time."""
+        events = self.engine.contacts.events
+        for number in range(self.contacts_logged + 1, min(len(events), CONTACT_LINES) + 1):
+            event = events[number - 1]
+            last = ('; further contacts are counted in /diagnostics only'
+                    if number == CONTACT_LINES else '')
+            self.get_logger().error(f'contact {number}: robots {event.i} and {event.j} '
+                                    f'touched at t = {event.t:.3f} s{last}')
+        self.contacts_logged = len(events)
+
+    def on_diagnostics(self) -> None:
+        """Publish the world's status: time, step rate, real-time factor, contacts, refusals."""
+        now = time.monotonic_ns()
+        since, steps = self.rate_window
+        self.rate_window = (now, self.engine.steps)
+        wall = (now - since) / NS_PER_S
+        rate = (self.engine.steps - steps) / wall if wall > 0.0 else 0.0
+        factor = rate * self.world.timestep
+        target = self.world.realtime_factor
+        running = self.pacer.started_ns is not None
+        behind = running and factor < KEPT_UP * target
+        if behind:
+            self.once.start('behind', f'world: stepping at {factor:.2f} x real time of '
+                                      f'{target:g} asked (too many robots for this machine, '
+                                      'or a busy one); counted in /diagnostics')
+        else:
+            self.once.end('behind', 'world: keeping up with real time again')
+        live = np.flatnonzero(self.engine.live()) + 1
+        values: Dict[str, Any] = {
+            'simulated time [s]': self.engine.time_s,
+            'step rate achieved [Hz]': rate,
+            'step rate target [Hz]': target / self.world.timestep,
+            'realtime factor achieved': factor,
+            'realtime factor target': target,
+            'realtime factor since start': self.pacer.achieved(now, self.engine.steps),
+            'ticks behind': self.pacer.falls,
+            'simulated time let go [s]': self.pacer.dropped_s,
+            'steps': self.engine.steps,
+            'contacts': self.engine.contacts.count,
+            'min body distance [m]': self.engine.closest.distance,
+            'robots with live commands': ', '.join(map(str, live.tolist())) or 'none',
+            'refused cmd_vel messages': self.refusals.refusals.count()}
+        values.update({f'robot {index + 1}: refused cmd_vel messages ({reason.name.lower()})':
+                       count for (index, reason), count in self.refusals.refusals.items()})
+        contacts = self.engine.contacts.count
+        if contacts or behind or self.refusals.refusals.count():
+            level, message = 'warn', (f'{contacts} contacts, '
+                                      f'{self.refusals.refusals.count()} refused commands, '
+                                      f'{factor:.2f} x real time of {target:g}')
+        else:
+            level, message = 'ok', 'running' if running else 'starting'
+        self.diagnostics_pub.publish(diagnostics(WORLD_STATUS, level, message, values))
+
+    def write_chunk(self) -> None:
+        """Write the samples since the last chunk into ``world.output_dir`` (a failure: once)."""
+        if self.chunks is None or self.output_failure is not None:
+            return
+        try:
+            self.chunks.flush()
+        except OSError as exc:
+            self._output_failed(exc, self.chunks.folder)
+
+    def _output_failed(self, exc: OSError, where: str) -> None:
+        """Say in one line that the output stopped, where and why; write nothing more there."""
+        reason = exc.strerror or ' '.join(str(exc).split()) or type(exc).__name__
+        self.output_failure = f'cannot write to {where} ({reason})'
+        self.chunks = None
+        self.get_logger().error(f'world: output stopped at t = {self.engine.time_s:.2f} s: '
+                                f'{self.output_failure}; the world goes on and writes nothing '
+                                'more there')
+
+    def stats(self, wall: float) -> Dict[str, Any]:
+        """Return ``world_stats.json``: the engine's figures, the node's pace, the refusals."""
+        engine = self.engine.stats()
+        steps = engine.steps
+        achieved = engine.simulated / wall if wall > 0.0 else 0.0
+        stats: Dict[str, Any] = asdict(engine)
+        stats['engine_realtime_factor'] = stats.pop('achieved_realtime_factor')
+        stats.update({
+            'achieved_realtime_factor': achieved,
+            'realtime_factor': self.world.realtime_factor,
+            'wall_time': wall,
+            'simulated_time': engine.simulated,
+            'steps_per_second': steps / wall if wall > 0.0 else 0.0,
+            'ticks_behind': self.pacer.falls,
+            'simulated_time_let_go': self.pacer.dropped_s,
+            'contact_events': [{'i': e.i, 'j': e.j, 't': e.t}
+                               for e in self.engine.contacts.events],
+            'model': self.engine.model.kind.value,
+            'timestep': self.world.timestep,
+            'refused_command_messages': {
+                reason.name.lower(): {str(index + 1): count for (index, why), count
+                                      in self.refusals.refusals.items() if why is reason}
+                for reason in REFUSAL_WORDS}})
+        stats['engine_wall_time'] = stats.pop('wall')
+        stats.pop('simulated')
+        return stats
+
+    def trajectory(self) -> Optional[Trajectory]:
+        """Return the run written so far: a sample per published pose, as the plant's."""
+        if self.chunks is None:
+            return None
+        self.write_chunk()
+        if self.chunks is None:
+            return None
+        try:
+            t, q, u = read_chunks(self.chunks.folder)
+        except ValueError:
+            return None
+        reference = self.config.reference()
+        trajectory = Trajectory.from_frames(t, q, u, [reference.sample(s) for s in t],
+                                            self.config.vertices)
+        body = read_body_chunks(self.chunks.folder) if self.unicycles else None
+        return trajectory if body is None else replace(trajectory, **body)
+
+    def finish(self) -> None:
+        """Log a summary; with ``world.output_dir`` write world_stats.json and trajectory.npz."""
+        if self.pacer.started_ns is None:
+            self.get_logger().info('world: stopped before the first step')
+            return
+        wall = (time.monotonic_ns() - self.pacer.started_ns) / NS_PER_S
+        stats = self.stats(wall)
+        self.get_logger().info(
+            f"world: {stats['steps']} steps ({stats['simulated_time']:.2f} s simulated in "
+            f"{wall:.1f} s, {stats['achieved_realtime_factor']:.3g} x real time of "
+            f'{self.world.realtime_factor:g}), {stats["contacts"]} contacts between robots, '
+            f"min body distance {stats['min_body_distance']:.4g} m, "
+            f'{self.refusals.refusals.count()} cmd_vel messages refused'
+            + (f'; output stopped early: {self.output_failure}' if self.output_failure else ''))
+        if not self.output_dir or self.output_failure is not None:
+            return
+        text = (json.dumps(stats, indent=2) + '\n').encode()
+        where = os.path.join(self.output_dir, WORLD_STATS_FILE)
+        try:
+            save_atomically(where, lambda stream: stream.write(text))
+            trajectory = self.trajectory()
+            where = os.path.join(self.output_dir, TRAJECTORY_FILE)
+            if trajectory is not None:
+                trajectory.save(where)
+        except OSError as exc:
+            self._output_failed(exc, where)
+            return
+        if trajectory is not None and self.chunks is not None:
+            shutil.rmtree(self.chunks.folder, ignore_errors=True)
+        written = [WORLD_FILE, WORLD_STATS_FILE] + ([TRAJECTORY_FILE] if trajectory else [])
+        self.get_logger().info(f"world: wrote {', '.join(written)} to {self.output_dir}")
+
+
+def main(args: Optional[List[str]] = None) -> int:
+    """Entry point of ``ros2 run formation_ros world``."""
+    return run(WorldNode, args, name='world')
