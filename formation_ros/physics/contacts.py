@@ -37,7 +37,7 @@ class ContactEvent:
 
     @property
     def t(self) -> float:
-        """The time of the contact, s."""
+        """Return the time of the contact, s."""
         return self.t_ns / NS_PER_S
 
 

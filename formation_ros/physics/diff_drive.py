@@ -73,13 +73,13 @@ class DiffDrive:
 
     @property
     def caster_position(self) -> Float:
-        """The caster's centre in the base frame, m: at the rear edge, touching the floor."""
+        """Return the caster's centre in the base frame, m: at the rear edge, on the floor."""
         return np.array([-(self.footprint - self.caster_radius), 0.0,
                          self.caster_radius - self.wheel_radius])
 
     @property
     def centre_of_mass(self) -> Float:
-        """The chassis' centre of mass in the base frame, m: halfway to the caster."""
+        """Return the chassis' centre of mass in the base frame, m: halfway to the caster."""
         return np.array([0.5 * self.caster_position[0], 0.0, 0.0])
 
     @property

@@ -139,12 +139,12 @@ class Engine:
 
     @property
     def time_ns(self) -> int:
-        """Simulated time since the start, ns."""
+        """Return the simulated time since the start, ns."""
         return self.steps * self.step_ns
 
     @property
     def time_s(self) -> float:
-        """Simulated time since the start, s."""
+        """Return the simulated time since the start, s."""
         return self.time_ns / 1e9
 
     def apply(self, commands: ArrayLike, stamps_ns: Optional[ArrayLike] = None,

@@ -59,6 +59,7 @@ def numbers(values: Sequence[float]) -> str:
 
 
 def add(parent: ElementTree.Element, tag: str, **attributes: str) -> ElementTree.Element:
+    """Add an MJCF element ``tag`` with ``attributes`` (text) under ``parent``; return it."""
     return ElementTree.SubElement(parent, tag, attributes)
 
 
@@ -72,17 +73,19 @@ def footprint_geom(body: ElementTree.Element, name: str, shape: str, size: Seque
 
 def inertial(body: ElementTree.Element, mass: float, inertia: Sequence[float],
              pos: Sequence[float] = (0.0, 0.0, 0.0)) -> None:
+    """Give ``body`` its mass (kg), principal moments (kg m^2) and centre of mass (m)."""
     add(body, 'inertial', pos=numbers(pos), mass=number(mass), diaginertia=numbers(inertia))
 
 
 def velocity_servo(actuators: ElementTree.Element, name: str, joint: str, gain: float,
                    limit: float) -> None:
+    """Add a velocity servo on ``joint``: gain (N s/m or N m s/rad), force or torque limit."""
     add(actuators, 'velocity', name=name, joint=joint, kv=number(gain),
         forcerange=numbers((-limit, limit)))
 
 
 def cylinder_inertia(mass: float, radius: float, half_height: float) -> Sequence[float]:
-    """Principal moments (x, y, z) of a solid cylinder about its centre, kg m^2."""
+    """Return the principal moments (x, y, z) of a solid cylinder about its centre, kg m^2."""
     across = mass * (3.0 * radius * radius + 4.0 * half_height * half_height) / 12.0
     return (across, across, 0.5 * mass * radius * radius)
 

@@ -114,7 +114,7 @@ class Flyer:
 
     @property
     def weight(self) -> float:
-        """The thrust that holds the body up, N."""
+        """Return the thrust that holds the body up, N."""
         return self.mass * GRAVITY
 
     def controls(self, command: Float, yaw: Float) -> Float:
