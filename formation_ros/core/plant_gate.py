@@ -26,6 +26,11 @@ CLOCK_MATCH_WAIT = 5.0
 graph shows to be matched to its publisher, s (one that never matches cannot hold the team)."""
 
 
+CLOCK_MATCH_LINE = 'every robot is up: waiting for /clock to reach its subscribers'
+GAVE_UP_LINE = (f'a /clock subscriber is still not matched after {CLOCK_MATCH_WAIT:g} s (a QoS '
+                '/clock does not offer?): starting the clock all the same')
+
+
 class Verdict(enum.Enum):
     """What the other /clock publishers of a domain are."""
 

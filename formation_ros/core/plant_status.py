@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 from formation_ros.core.admission import Reason, Refusals
+from formation_ros.core.params import FormationConfig
 from formation_ros.core.plant import CommandStatus, PlantModel, StepReport
 from formation_ros.core.plant_gate import Phase
 from formation_ros.core.plant_intake import refused_by_robot, Source, TEAM
@@ -42,6 +43,20 @@ def robots_named(indices: Sequence[int], shown: int = 5) -> str:
 def _counts(counts: Dict[int, int]) -> str:
     """Return '1: 3, 4: 1' of {robot: count}."""
     return ', '.join(f'{robot}: {count}' for robot, count in counts.items())
+
+
+def start_line(config: FormationConfig, dt: float) -> str:
+    """Return the plant's first line: the team, the step, the reference, how it runs (dt: s)."""
+    imperfections = config.imperfections
+    plant = config.plant
+    assert plant is not None
+    return (f'plant: {config.num_robots} robots in {config.dim}D, dt = {dt:g} s, reference '
+            f'{config.reference_kind.value}, '
+            + ('lockstep' if config.lockstep else f'realtime factor {plant.realtime_factor:g}')
+            + (', team transport' if config.team_transport else '')
+            + ('' if imperfections.is_ideal else ', bodies beyond the paper: ' + ', '.join(
+                f'{name} = {value:g}' for name, value in imperfections.as_dict().items()
+                if value)))
 
 
 @dataclass

@@ -25,34 +25,33 @@ from formation_ros.core.events import event_records, timeline_events
 from formation_ros.core.exits import REFUSED
 from formation_ros.core.frames import desired_positions
 from formation_ros.core.plant import PlantModel, StepReport
-from formation_ros.core.plant_gate import (CLOCK_MATCH_WAIT, ClockMatch, leftover_line, Phase,
-                                           refusal_line, StartGate, Verdict, waiting_line)
-from formation_ros.core.plant_intake import CommandIntake, TEAM
+from formation_ros.core.plant_gate import (CLOCK_MATCH_LINE, ClockMatch, GAVE_UP_LINE,
+                                           leftover_line, Phase, refusal_line, StartGate,
+                                           Verdict, waiting_line)
+from formation_ros.core.plant_intake import CommandIntake, Source, TEAM
 from formation_ros.core.plant_stats import RunOutput, RunStats
 from formation_ros.core.plant_status import (collision_lines, CommandWatch, Heard, Note,
-                                             PlantStatus, violation_lines)
+                                             PlantStatus, start_line, violation_lines)
 from formation_ros.core.team import team_values
 from formation_ros.core.timeline import Mode
 from formation_ros.core.units import NS_PER_S
 from formation_ros.ros import messages, qos, topics
-from formation_ros.ros.cdr import (CdrError, encode_clock, read_twist, read_twist_stamped,
-                                   StateEncoder, TeamCommandReader)
+from formation_ros.ros.cdr import CdrError, read_twist, read_twist_stamped, TeamCommandReader
 from formation_ros.ros.changes import Changes
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.liveliness import PeerLiveliness
 from formation_ros.ros.markers import formation_markers, Paths
-from formation_ros.ros.on_demand import LISTENERS_PERIOD, OnDemand
 from formation_ros.ros.once import OnceLog, RefusalLog
 from formation_ros.ros.parameters import declare_parameters
+from formation_ros.ros.plant_topics import PlantTopics
 from formation_ros.ros.runner import run
 from formation_ros.ros.team import announced, DomainWatch, team_problems, TeamCheck
 from formation_ros.ros.wake import Wake
-from geometry_msgs.msg import PoseArray, PoseStamped, Twist, TwistStamped
+from geometry_msgs.msg import Twist, TwistStamped
 import numpy as np
 from rclpy.clock import Clock, ClockType
 from rclpy.duration import Duration
 from rclpy.node import Node
-from rclpy.publisher import Publisher
 from rosgraph_msgs.msg import Clock as ClockMsg
 from trajectory_msgs.msg import MultiDOFJointTrajectory
 from visualization_msgs.msg import MarkerArray
@@ -64,9 +63,6 @@ PATH_LENGTH = 100
 CHUNK_PERIOD = 1.0
 REFUSAL_HEARD = 2.0
 """How long a refusing plant waits for its last status to be acknowledged, s."""
-LISTENER_LOOKS = 50
-"""Team transport: robots whose pose and neighbors subscribers are looked up in the graph per
-LISTENERS_PERIOD while the plant has no publishers of theirs (two lookups each)."""
 
 
 class PlantNode(Node):
@@ -85,7 +81,6 @@ class PlantNode(Node):
         self.n, self.dim = config.num_robots, config.dim
         self.unicycles = config.body.is_unicycle
         body_frame = config.command.frame is CommandFrame.BODY
-        self.headed = self.unicycles or body_frame
         self.intake = CommandIntake(
             [messages.body_frame(i) if body_frame else config.world_frame
              for i in range(1, self.n + 1)], config.world_frame, self.dim, self.unicycles,
@@ -120,30 +115,25 @@ class PlantNode(Node):
                        if settings.output_dir else None)
         self.paths = Paths(self.n, PATH_LENGTH)
         self.last_publish_wall = 0.0
-        self.state_encoder = StateEncoder(self.n, self.dim, config.world_frame)
-        self.pose_topics = [topics.robot_topic(i, topics.POSE) for i in range(1, self.n + 1)]
-        self.neighbour_topics = [topics.robot_topic(i, topics.NEIGHBOURS)
-                                 for i in range(1, self.n + 1)]
-        self.pose_pubs: List[Optional[Publisher]] = [None] * self.n
-        self.neighbour_pubs: List[Optional[Publisher]] = [None] * self.n
-        self.listened = np.ones(self.n, dtype=bool)
-        if not self.team_transport or settings.wait_for_subscribers > 1:
-            for i in range(self.n):
-                self._make_robot_publishers(i)
+        self.states = PlantTopics(self, self.n, self.dim, config.world_frame, self.team_transport,
+                                  self.team_transport and settings.wait_for_subscribers <= 1,
+                                  self.unicycles or body_frame, self.steady)
         self.command_liveliness: Dict[str, PeerLiveliness] = {}
         if self.team_transport:
-            self._team_topics()
+            self.team_reader = TeamCommandReader(self.n)
+            self.team_liveliness = PeerLiveliness()
+            self.team_sub = self.create_subscription(
+                MultiDOFJointTrajectory, topics.TEAM_COMMANDS, self.on_team_command,
+                qos.team_commands_input(self.n), raw=True,
+                event_callbacks=self.team_liveliness.callbacks())
         else:
             self._command_topics()
-        self.clock_pub = self.create_publisher(ClockMsg, topics.CLOCK, qos.CLOCK)
         self.clock_sub = self.create_subscription(ClockMsg, topics.CLOCK, self.on_clock,
                                                   qos.CLOCK, raw=True)
-        expected = dict.fromkeys([topics.CLOCK] + [topic for pair in zip(
-            self.pose_topics, self.neighbour_topics) for topic in pair]
-            + ([topics.STATES] if self.team_transport else []), self.own_name)
         self.domain = DomainWatch(
             self, self.team_check, self.once,
-            {**expected, **dict.fromkeys(self.command_liveliness)}, self.command_liveliness,
+            {**dict.fromkeys(self.states.published_topics(), self.own_name),
+             **dict.fromkeys(self.command_liveliness)}, self.command_liveliness,
             [topics.robot_node_name(i) for i in range(1, self.n + 1)]
             if self.team_transport else [])
         self.diagnostics_pub = self.create_publisher(
@@ -160,15 +150,7 @@ class PlantNode(Node):
             self.marker_pub = self.create_publisher(MarkerArray, topics.MARKERS, qos.MARKERS)
             self.marker_timer = self.create_timer(1.0 / settings.marker_rate, self.on_markers,
                                                   clock=self.steady)
-        self.get_logger().info(
-            f'plant: {self.n} robots in {self.dim}D, dt = {self.model.dt:g} s, '
-            f'reference {self.reference.kind}, '
-            + ('lockstep' if self.lockstep
-               else f'realtime factor {settings.realtime_factor:g}')
-            + (', team transport' if self.team_transport else '')
-            + ('' if config.imperfections.is_ideal else ', bodies beyond the paper: ' + ', '.join(
-                f'{name} = {value:g}' for name, value in config.imperfections.as_dict().items()
-                if value)))
+        self.get_logger().info(start_line(config, self.model.dt))
 
     def _command_topics(self) -> None:
         """Robot transport: hear each robot's cmd_vel, with its DDS liveliness."""
@@ -181,37 +163,6 @@ class PlantNode(Node):
                 raw=True, event_callbacks=liveliness.callbacks())
             self.command_liveliness[sub.topic_name] = liveliness
 
-    def _team_topics(self) -> None:
-        """Team transport: publish /formation/states, hear /formation/commands."""
-        self.states_pub = self.create_publisher(PoseArray, topics.STATES, qos.STATE)
-        self.team_reader = TeamCommandReader(self.n)
-        self.team_liveliness = PeerLiveliness()
-        self.team_sub = self.create_subscription(
-            MultiDOFJointTrajectory, topics.TEAM_COMMANDS, self.on_team_command,
-            qos.team_commands_input(self.n), raw=True,
-            event_callbacks=self.team_liveliness.callbacks())
-        self.robot_topics = OnDemand(
-            self.n, LISTENER_LOOKS, lambda i: self.pose_pubs[i] is not None,
-            lambda i: (self.count_subscribers(self.pose_topics[i]) > 0
-                       or self.count_subscribers(self.neighbour_topics[i]) > 0),
-            self._make_robot_publishers,
-            lambda i: (self.pose_pubs[i].get_subscription_count() > 0
-                       or self.neighbour_pubs[i].get_subscription_count() > 0))
-        self.listeners_timer = self.create_timer(LISTENERS_PERIOD, self._look_at_listeners,
-                                                 clock=self.steady)
-        self._look_at_listeners()
-
-    def _make_robot_publishers(self, index: int) -> None:
-        """Create the ``pose`` and ``neighbors`` publishers of robot ``index`` (0-based)."""
-        self.pose_pubs[index] = self.create_publisher(PoseStamped, self.pose_topics[index],
-                                                      qos.STATE)
-        self.neighbour_pubs[index] = self.create_publisher(
-            PoseArray, self.neighbour_topics[index], qos.STATE)
-
-    def _look_at_listeners(self) -> None:
-        """Team transport: publish a robot's pose and neighbors only while someone listens."""
-        self.listened = self.robot_topics.look()
-
     def on_command(self, index: int, data: bytes) -> None:
         """Store robot ``index``'s command (``core.plant_intake``); lockstep: wake the step."""
         try:
@@ -219,12 +170,9 @@ class PlantNode(Node):
         except CdrError as exc:
             self.refusals.refuse(index, Reason.MALFORMED, str(exc))
             return
-        reason = self.intake.take(index, command.frame_id, command.linear, command.angular,
-                                  command.stamp_ns, time.monotonic_ns())
-        if reason is not None:
-            self.refusals.refuse(index, reason, command.frame_id)
-        elif self.lockstep:
-            self.step_wake.arm()
+        self._took(index, self.intake.take(index, command.frame_id, command.linear,
+                                           command.angular, command.stamp_ns,
+                                           time.monotonic_ns()), command.frame_id)
 
     def on_team_command(self, data: bytes) -> None:
         """Team transport: store the commands of one team message, as :meth:`on_command`."""
@@ -233,10 +181,15 @@ class PlantNode(Node):
         except CdrError as exc:
             self.refusals.refuse(TEAM, Reason.MALFORMED, str(exc))
             return
-        reason = self.intake.take_team(message.indices, message.frame_id, message.linear,
-                                       message.angular, message.stamp_ns, time.monotonic_ns())
+        self._took(TEAM, self.intake.take_team(message.indices, message.frame_id,
+                                               message.linear, message.angular,
+                                               message.stamp_ns, time.monotonic_ns()),
+                   message.frame_id)
+
+    def _took(self, source: Source, reason: Optional[Reason], frame_id: str) -> None:
+        """Count a refusal (logged once while it lasts), or in lockstep wake the step."""
         if reason is not None:
-            self.refusals.refuse(TEAM, reason, message.frame_id)
+            self.refusals.refuse(source, reason, frame_id)
         elif self.lockstep:
             self.step_wake.arm()
 
@@ -281,7 +234,7 @@ class PlantNode(Node):
         if not self.gate.look_due(now, at_once):
             return self.gate.looked
         looking = self.gate.phase is Phase.LOOKING
-        others = self.domain.graph.named_publishers(self.clock_pub.topic_name, now)
+        others = self.domain.graph.named_publishers(topics.CLOCK, now)
         if others is not None and self.own_name in others:
             others.remove(self.own_name)
         running = [name for name in others or [] if self.team_check.running(name, now)]
@@ -303,29 +256,21 @@ class PlantNode(Node):
         """While the clock waits: start it once every robot is up and /clock reaches them."""
         missing = self.intake.missing()
         wanted = self.settings.wait_for_subscribers - (1 if self.team_transport else 0)
-        unheard = wanted > 0 and any(pub is None or pub.get_subscription_count() < wanted
-                                     for pub in self.pose_pubs)
-        if self.team_transport and self.states_pub.get_subscription_count() < 1:
-            unheard = True
-        if missing or unheard:
+        if missing or self.states.unheard(wanted):
             self.once.start('waiting', waiting_line(
                 missing, self.n, wanted, topics.STATES if self.team_transport else None), 'info')
             self._resend_if_due()
             return False
-        match = self.gate.clock_match(self.clock_pub.get_subscription_count()
-                                      < self.count_subscribers(topics.CLOCK), now)
+        match = self.gate.clock_match(self.states.clock_unmatched(), now)
         if match is ClockMatch.WAIT:
-            self.once.start('clock-match', 'every robot is up: waiting for /clock to reach its '
-                                           'subscribers', 'info')
+            self.once.start('clock-match', CLOCK_MATCH_LINE, 'info')
             self._resend_if_due()
             return False
         if match is ClockMatch.GAVE_UP:
-            self.get_logger().warning(
-                f'a /clock subscriber is still not matched after {CLOCK_MATCH_WAIT:g} s '
-                '(a QoS /clock does not offer?): starting the clock all the same')
+            self.get_logger().warning(GAVE_UP_LINE)
         self.gate.start()
         if self.team_transport:
-            self._look_at_listeners()
+            self.states.look_at_listeners()
         self.stats.started = now
         self.status_report.restart(now, self.model.counts.steps)
         self.once.end('clock-match')
@@ -379,27 +324,10 @@ class PlantNode(Node):
                 self.once.end(key)
 
     def _publish(self) -> None:
-        """
-        Publish /clock, then the model's sensed state (``PlantModel.sensed``).
-
-        Every pose and each range sensor's bodies; team transport: /formation/states, and
-        robot i's pose and neighbors only while someone subscribes to them.
-        """
-        self.clock_pub.publish(encode_clock(self.model.t_ns))
-        state = self.model.sensed()
-        self.intake.state_stamp_ns = state.stamp_ns
-        self.stats.answers.published(state.stamp_ns, time.monotonic_ns())
-        headings = state.heading if self.headed else None
-        if self.team_transport:
-            self.state_encoder.set_rows(state.q, headings)
-            self.states_pub.publish(self.state_encoder.team(state.stamp_ns))
-        if not self.team_transport or np.any(self.listened):
-            observer, seen = self.model.sensed_pairs()
-            poses, arrays = self.state_encoder.encode(state.q, observer, seen, state.stamp_ns,
-                                                      headings)
-            for i in np.flatnonzero(self.listened).tolist():
-                self.pose_pubs[i].publish(poses[i])
-                self.neighbour_pubs[i].publish(arrays[i])
+        """Publish /clock and the state (``ros.plant_topics``); note when, for the latency."""
+        stamp_ns = self.states.publish(self.model)
+        self.intake.state_stamp_ns = stamp_ns
+        self.stats.answers.published(stamp_ns, time.monotonic_ns())
         self.last_publish_wall = time.monotonic()
 
     def _resend_if_due(self) -> None:
@@ -417,16 +345,17 @@ class PlantNode(Node):
             self._look_at_domain(time.monotonic(), at_once=True)
         now = time.monotonic()
         shape = self._vertices_at(self.model.t_ns)
-        running = self.gate.phase is Phase.RUNNING
         heard = Heard(self._command_states(),
                       announced=announced(team_values(self.config, shape), self),
-                      disagreeing=team_problems(self.team_check, self.config, shape, self.once),
-                      shared=self.domain.shared_topics(now, topics.CLOCK, running)
-                      if self.gate.looked else {},
-                      doubled=self.domain.doubled_robots(now) if self.gate.looked else {},
-                      plants=self.domain.other_plants(now) if self.gate.looked else '')
+                      disagreeing=team_problems(self.team_check, self.config, shape, self.once))
+        if self.gate.looked:
+            heard.shared = self.domain.shared_topics(now, topics.CLOCK,
+                                                     self.gate.phase is Phase.RUNNING)
+            heard.doubled, heard.plants = (self.domain.doubled_robots(now),
+                                           self.domain.other_plants(now))
         if self.team_transport:
-            heard.team_publishers, heard.listened = self.team_liveliness.alive, self.listened
+            heard.team_publishers = self.team_liveliness.alive
+            heard.listened = self.states.listened
         level, message, values = self.status_report.report(
             now, self.model, self.gate.phase, self.changes.states.at(self.model.t_ns).mode.value,
             self.stats.held_steps, self.refusals.refusals, heard)
@@ -491,11 +420,7 @@ class PlantNode(Node):
             self.get_logger().error(line)
 
     def _announce_refusal(self) -> None:
-        """
-        Publish the refusal as this plant's last status; wait for it to be acknowledged.
-
-        The other plant names this one from its status (at most REFUSAL_HEARD s).
-        """
+        """Publish the refusal as the last status (the other plant names this one from it)."""
         shape = self._vertices_at(self.model.t_ns)
         self.diagnostics_pub.publish(diagnostics(
             PLANT_STATUS, 'error', self.refusal,
