@@ -9,11 +9,11 @@ inertias in kg m^2, forces in N.
 """
 
 import enum
-from typing import Sequence
+from typing import Tuple
 from xml.etree import ElementTree
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 Float = NDArray[np.float64]
 GRAVITY = 9.81
@@ -53,9 +53,9 @@ def number(value: float) -> str:
     return repr(float(value))
 
 
-def numbers(values: Sequence[float]) -> str:
+def numbers(values: ArrayLike) -> str:
     """Return floats as an MJCF list: '0 0.1 0'."""
-    return ' '.join(number(float(v)) for v in values)
+    return ' '.join(number(float(v)) for v in np.asarray(values, dtype=float).ravel())
 
 
 def add(parent: ElementTree.Element, tag: str, **attributes: str) -> ElementTree.Element:
@@ -63,16 +63,16 @@ def add(parent: ElementTree.Element, tag: str, **attributes: str) -> ElementTree
     return ElementTree.SubElement(parent, tag, attributes)
 
 
-def footprint_geom(body: ElementTree.Element, name: str, shape: str, size: Sequence[float],
-                   pos: Sequence[float] = (0.0, 0.0, 0.0)) -> None:
+def footprint_geom(body: ElementTree.Element, name: str, shape: str, size: ArrayLike,
+                   pos: ArrayLike = (0.0, 0.0, 0.0)) -> None:
     """Add the geom other robots collide with: massless, in :data:`FOOTPRINT_GROUP` alone."""
     add(body, 'geom', name=name, type=shape, size=numbers(size), pos=numbers(pos),
         mass='0', contype=str(FOOTPRINT_GROUP), conaffinity=str(FOOTPRINT_GROUP),
         rgba='0.2 0.45 0.8 1')
 
 
-def inertial(body: ElementTree.Element, mass: float, inertia: Sequence[float],
-             pos: Sequence[float] = (0.0, 0.0, 0.0)) -> None:
+def inertial(body: ElementTree.Element, mass: float, inertia: ArrayLike,
+             pos: ArrayLike = (0.0, 0.0, 0.0)) -> None:
     """Give ``body`` its mass (kg), principal moments (kg m^2) and centre of mass (m)."""
     add(body, 'inertial', pos=numbers(pos), mass=number(mass), diaginertia=numbers(inertia))
 
@@ -84,13 +84,13 @@ def velocity_servo(actuators: ElementTree.Element, name: str, joint: str, gain: 
         forcerange=numbers((-limit, limit)))
 
 
-def cylinder_inertia(mass: float, radius: float, half_height: float) -> Sequence[float]:
+def cylinder_inertia(mass: float, radius: float, half_height: float) -> Tuple[float, float, float]:
     """Return the principal moments (x, y, z) of a solid cylinder about its centre, kg m^2."""
     across = mass * (3.0 * radius * radius + 4.0 * half_height * half_height) / 12.0
     return (across, across, 0.5 * mass * radius * radius)
 
 
-def carriage(worldbody: ElementTree.Element, name: str, position: Sequence[float],
+def carriage(worldbody: ElementTree.Element, name: str, position: ArrayLike,
              mass: float, dim: int) -> ElementTree.Element:
     """Add the body of robot ``name`` that slides along the first ``dim`` world axes."""
     carriage = add(worldbody, 'body', name=f'{name}_carriage', pos=numbers(position))
