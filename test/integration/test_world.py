@@ -14,7 +14,7 @@ from formation_ros.core.params_file import load_params_file, write_params_file
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.ros import qos
 from formation_ros.tools.report import load_run
-from geometry_msgs.msg import PoseStamped, TwistStamped
+from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
 from helpers import CONFIG, logged, node, SimClock, Statuses, wait_exit
 from nav_msgs.msg import Odometry
 import numpy as np
@@ -29,9 +29,13 @@ BRAKING = 0.2
 STATUS = 'formation_ros/world'
 
 
-def world_params(folder, **changes):
-    """Write two TurtleBot3-like bases, 0.6 m apart along x, both heading +x; return the path."""
-    values = load_params_file(os.path.join(CONFIG, 'lab_turtlebot3.yaml'))
+def world_params(folder, source='lab_turtlebot3.yaml', **changes):
+    """
+    Write two robots of a lab's config (no relay, no random start); return the path.
+
+    By default TurtleBot3-like bases, 0.6 m apart along x, both heading +x.
+    """
+    values = load_params_file(os.path.join(CONFIG, source))
     values = {name: value for name, value in values.items()
               if not name.startswith(('relay.', 'start.'))}
     values.update({'num_robots': 2, 'formation.vertices': [0.6, 0.0, -0.6, 0.0],
@@ -160,18 +164,35 @@ def test_commands_drive_the_bodies_stale_ones_stop_them_bad_ones_are_counted(
     assert config.num_robots == 2 and loaded.t[-1] > last
 
 
-def test_the_clock_advances_at_real_time_and_an_unwritable_output_is_one_line(
+def test_a_holonomic_base_takes_twists_in_its_body_frame_and_the_clock_keeps_pace(
         processes, install, probe, tmp_path):
+    """Twists (no stamp) in the body frame; the clock at 2 x real time; output refused once."""
     blocked = tmp_path / 'file'
     blocked.write_text('not a directory')
-    params = world_params(tmp_path, **{'world.output_dir': str(blocked / 'out'),
-                                       'world.realtime_factor': 2.0})
+    params = world_params(tmp_path, 'lab_holonomic.yaml', **{
+        'start.positions': [0.0, 0.0, 1.5, 0.0], 'start.headings': [math.pi / 2, 0.0],
+        'formation.vertices': [0.75, 0.0, -0.75, 0.0], 'world.realtime_factor': 2.0,
+        'world.output_dir': str(blocked / 'out')})
     processes.start(node(install, 'world', params))
-    clock = SimClock(probe)
-    assert probe.spin_until(lambda: clock.seconds > 0.5, START_UP), processes.log('world')
+    clock, poses = SimClock(probe), Poses(probe)
+    drive = probe.create_publisher(Twist, '/robot_1/cmd_vel', qos.COMMAND)
+    assert probe.spin_until(lambda: poses.heard[1] and drive.get_subscription_count(),
+                            START_UP), processes.log('world')
+    start = poses.latest(1)
+    twist = Twist()
+    twist.linear.x = 0.2
+
+    def sideways():
+        drive.publish(twist)
+        return poses.latest(1)[2] > start[2] + 0.1
+
+    assert probe.spin_until(sideways, 30), processes.log('world')
+    assert abs(poses.latest(1)[1] - start[1]) < 0.01, poses.latest(1)
     first, begun = clock.seconds, time.monotonic()
     assert probe.spin_until(lambda: clock.seconds > first + 2.0, 30)
     assert (clock.seconds - first) / (time.monotonic() - begun) > 1.0
+    stopped = poses.at(1, first + TIMEOUT + BRAKING)
+    assert abs(poses.latest(1)[2] - stopped[2]) < 0.002, (stopped, poses.latest(1))
     processes.send_signal('world', signal.SIGINT)
     info = wait_exit(probe, processes, 'world', 30)
     assert info is not None and info.returncode == 0, processes.log('world')
