@@ -5,14 +5,16 @@
 When the plant may publish its first state and start its clock: its start gate, without ROS.
 
 The plant node reads the graph (the other ``/clock`` publishers, who announced them, the
-subscribers) and feeds it here; the gate decides. The rule for another team on the domain is
-:func:`domain_verdict`; the start-up order is docs/ros_interface.md ("Behaviour of the nodes",
-Start-up) and docs/faults.md (another team's plant already on the domain). Times are steady
-clock seconds.
+subscribers) and feeds it here; the gate decides. Another team on the domain is
+``core.occupants``'s rule, which the launcher applies too (:func:`domain_verdict`); the
+start-up order is docs/ros_interface.md ("Behaviour of the nodes", Start-up) and docs/faults.md
+(another team's plant already on the domain). Times are steady clock seconds.
 """
 
 import enum
 from typing import List, Optional, Sequence
+
+from formation_ros.core.occupants import occupants
 
 LOOK_TIME = 2.0
 """How long the plant looks for another /clock publisher before its first state, s."""
@@ -24,8 +26,6 @@ LOOK_PERIOD = 0.5
 CLOCK_MATCH_WAIT = 5.0
 """Once every robot is up, how long the clock waits at most for each /clock subscriber the
 graph shows to be matched to its publisher, s (one that never matches cannot hold the team)."""
-
-
 CLOCK_MATCH_LINE = 'every robot is up: waiting for /clock to reach its subscribers'
 GAVE_UP_LINE = (f'a /clock subscriber is still not matched after {CLOCK_MATCH_WAIT:g} s (a QoS '
                 '/clock does not offer?): starting the clock all the same')
@@ -42,18 +42,15 @@ class Verdict(enum.Enum):
 def domain_verdict(others: Sequence[str], announced: Sequence[str], sent_clock: bool,
                    own_name: str) -> Verdict:
     """
-    Return what the /clock publishers ``others`` (fully qualified names, this node left out) are.
+    Return what the /clock publishers ``others`` (fully qualified, its own writer left out) are.
 
-    announced: those of them a process other than this one announces on /diagnostics (they
-    run); sent_clock: whether /clock messages came from another node. Another team when one has
-    another name than ``own_name``, is announced or sends /clock; a silent one with this node's
-    name is a killed plant's leftover, which DDS forgets within about 20 s.
+    announced: those of them another process announces on /diagnostics; sent_clock: whether
+    /clock messages came from another node. The rule is ``core.occupants.occupants``, the
+    launcher's too: a leftover is a silent one of this node's name.
     """
-    if not others:
-        return Verdict.FREE
-    if announced or sent_clock or any(name != own_name for name in others):
+    if occupants(others, (), own_name, announced, sent_clock):
         return Verdict.OTHER_TEAM
-    return Verdict.LEFTOVER
+    return Verdict.LEFTOVER if others else Verdict.FREE
 
 
 class Phase(enum.Enum):
