@@ -24,7 +24,7 @@ FORBIDDEN = {
     'nodes': ('formation_ros.tools', 'matplotlib'),
     'tools': ('formation_ros.nodes',),
 }
-NODES = ('robot', 'fleet', 'plant', 'reference', 'recorder', 'relay')
+NODES = ('robot', 'fleet', 'plant', 'reference', 'recorder', 'relay', 'world')
 NEVER_IN_A_NODE = ('matplotlib', 'scipy.integrate', 'formation_ros.tools')
 NOT_IN_A_ROBOT = ('scipy',)
 """A robot process (one per robot) needs no k-d tree, quadrature or rotation library: scipy
