@@ -17,7 +17,8 @@ crazyswarm2's simulator backends share one. It builds the scene of a validated c
 * :meth:`Engine.step` advances ``world.timestep`` at a time (integer ns: :attr:`time_ns`);
 * :meth:`Engine.poses` is the ground truth (positions (N, 3) m, orientations (N, 4)
   quaternions x, y, z, w), :meth:`Engine.measured_poses` the same with ``world.pose_noise``,
-  :meth:`Engine.odometry` the wheel-encoder odometry of differential-drive bases;
+  :meth:`Engine.odometry` the wheel-encoder odometry of differential-drive bases (updated
+  every ``odometry.ODOMETRY_PERIOD``);
 * :attr:`Engine.contacts` counts contact events between robots from MuJoCo's contact list and
   :attr:`Engine.closest` keeps the closest approach of two robots' positions.
 """
@@ -31,7 +32,7 @@ from formation_ros.core.params import FormationConfig, WorldSettings
 from formation_ros.core.unicycle import headings_from_quaternions
 from formation_ros.physics.contacts import ClosestApproach, ContactLog, RELEASE_GAP
 from formation_ros.physics.diff_drive import DiffDrive
-from formation_ros.physics.odometry import WheelOdometry
+from formation_ros.physics.odometry import ODOMETRY_PERIOD, WheelOdometry
 from formation_ros.physics.scene import build_scene, Scene
 import mujoco
 import numpy as np
@@ -108,11 +109,13 @@ class Engine:
         self._live = np.zeros(n, dtype=bool)
         self._changed = True
         self.odometer: Optional[WheelOdometry] = None
+        self._odometry_steps = max(1, int(round(ODOMETRY_PERIOD / self.world.timestep)))
         if isinstance(self.model, DiffDrive):
-            self._wheel_dofs = np.array([[self._dof(f'{name}_{side}_wheel')
-                                          for side in ('left', 'right')]
-                                         for name in self.scene.names])
-            self.odometer = WheelOdometry(self.model, start.positions[:, :2], start.headings)
+            self._wheel_angles = np.array([[self._angle(f'{name}_{side}_wheel')
+                                            for side in ('left', 'right')]
+                                           for name in self.scene.names])
+            self.odometer = WheelOdometry(self.model, start.positions[:, :2], start.headings,
+                                          self.data.qpos[self._wheel_angles])
 
     def _id(self, kind: 'mujoco.mjtObj', name: str) -> int:
         index = int(mujoco.mj_name2id(self.mj_model, kind, name))
@@ -120,8 +123,9 @@ class Engine:
             raise KeyError(f'no {kind.name} {name!r} in the scene')
         return index
 
-    def _dof(self, joint: str) -> int:
-        return int(self.mj_model.jnt_dofadr[self._id(mujoco.mjtObj.mjOBJ_JOINT, joint)])
+    def _angle(self, joint: str) -> int:
+        """Return where hinge ``joint``'s angle is in qpos."""
+        return int(self.mj_model.jnt_qposadr[self._id(mujoco.mjtObj.mjOBJ_JOINT, joint)])
 
     def _robots_of_geoms(self) -> NDArray[np.intp]:
         """Return the robot (0-based) each geom belongs to, -1 for the world's: (ngeom,)."""
@@ -198,11 +202,13 @@ class Engine:
 
     def _observe(self) -> None:
         """After a step: odometry, contacts between robots, the closest approach."""
-        if self.odometer is not None:
-            self.odometer.advance(self.data.qvel[self._wheel_dofs], self.world.timestep)
-        robots = self._geom_robot[self.data.contact.geom]
+        if self.odometer is not None and self.steps % self._odometry_steps == 0:
+            self.odometer.advance(self.data.qpos[self._wheel_angles],
+                                  self._odometry_steps * self.world.timestep)
+        contact = self.data.contact
+        robots = self._geom_robot[contact.geom]
         between = ((robots[:, 0] >= 0) & (robots[:, 1] >= 0) & (robots[:, 0] != robots[:, 1])
-                   & (self.data.contact.dist <= 0.0))
+                   & (contact.dist <= 0.0))
         positions = self.data.xpos[self._pose_bodies, :self.dim]
         if np.any(between) or len(self.contacts.touching):
             self.contacts.update(robots[between, 0], robots[between, 1], positions,

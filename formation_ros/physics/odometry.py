@@ -4,11 +4,13 @@
 """
 Wheel-encoder odometry of differential-drive bases, as a base's controller integrates it.
 
-Each engine step the wheels' measured speeds (left, right, rad/s) become (v, w) by the model's
-own rolling-without-slip relation (:meth:`DiffDrive.body_rates`), held over the step and
-integrated exactly along the arc (:func:`formation_ros.core.unicycle.zoh_step`). The estimate
-starts at the true start pose and drifts from the truth wherever a wheel slips or the base is
-pushed: what real odometry does.
+Every odometry period (:data:`ODOMETRY_PERIOD`, a whole number of engine steps) the wheels'
+encoder angles (left, right, rad) are read; their increments since the last reading, over the
+time between, are the wheels' mean speeds, which the model's rolling-without-slip relation
+(:meth:`DiffDrive.body_rates`) turns into (v, w), integrated exactly along the arc
+(:func:`formation_ros.core.unicycle.zoh_step`), as ``diff_drive_controller`` does from its
+wheels' positions. The estimate starts at the true start pose and drifts from the truth
+wherever a wheel slips or the base is pushed: what real odometry does.
 """
 
 from typing import Tuple
@@ -19,21 +21,25 @@ import numpy as np
 from numpy.typing import NDArray
 
 Float = NDArray[np.float64]
+ODOMETRY_PERIOD = 0.01
+"""Time between two odometry updates, s (a base controller's 100 Hz)."""
 
 
 class WheelOdometry:
     """The odometry of N bases: positions (N, 2) in m, headings (N,) in rad, (v, w) (N, 2)."""
 
-    def __init__(self, model: DiffDrive, positions: Float, headings: Float):
-        """Start at the given poses, at rest."""
+    def __init__(self, model: DiffDrive, positions: Float, headings: Float, angles: Float):
+        """Start at the given poses, at rest, with the wheels' angles (N, 2), rad."""
         self.model = model
         self.positions = np.array(positions, dtype=float)
         self.headings = np.array(headings, dtype=float)
+        self.angles = np.array(angles, dtype=float)
         self.rates = np.zeros((len(self.positions), 2))
 
-    def advance(self, wheel_speeds: Float, dt: float) -> None:
-        """Integrate wheel speeds (N, 2) (left, right; rad/s) held over dt s."""
-        self.rates = self.model.body_rates(wheel_speeds)
+    def advance(self, angles: Float, dt: float) -> None:
+        """Take the wheels' angles (N, 2) (left, right; rad) dt s after the last reading."""
+        self.rates = self.model.body_rates((angles - self.angles) / dt)
+        self.angles = np.array(angles, dtype=float)
         self.positions, self.headings = zoh_step(self.positions, self.headings, self.rates, dt)
 
     def pose(self) -> Tuple[Float, Float]:
