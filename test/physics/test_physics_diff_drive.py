@@ -147,3 +147,14 @@ def test_wheel_odometry_follows_the_truth_while_the_wheels_roll():
     assert np.linalg.norm(positions[0] - truth.positions[0, :2]) < 0.01
     assert abs(yaw_difference(headings[0], truth.headings[0])) < 0.02
     assert np.linalg.norm(truth.positions[0, :2]) > 0.15
+
+
+def test_wheel_odometry_drifts_when_the_wheels_slip():
+    """Two bases pushing against each other: their wheels turn, they hardly move."""
+    engine = Engine(bases([[0.0, 0.0], [0.4, 0.0]], [0.0, math.pi], {'world.cmd_timeout': 10.0}))
+    engine.apply([[0.2, 0.0], [0.2, 0.0]])
+    run(engine, 2.0)
+    truth = engine.poses().positions[:, 0]
+    odometry = engine.odometry()[0][:, 0]
+    assert truth[1] - truth[0] > 2.0 * engine.model.footprint - 0.01
+    assert odometry[0] - truth[0] > 0.1 and truth[1] - odometry[1] > 0.1
