@@ -4,49 +4,16 @@
 """
 The robots' bodies and sensors, without ROS: one model for ``formation_sim --dt`` and the plant.
 
-Bodies are single integrators, q_i' = u_i (eq. 1), stepped with zero-order hold: the command
-admitted for a robot is held over the step, ``q(t + dt) = q(t) + dt u``; or differential-drive
-unicycles commanded with (v, w) through their hand points, stepped exactly over the step
-(``core.bodies``, ``core.unicycle``: everything that depends on the kind of body is there, and
-the law acts on the bodies' control points: q itself, or the hand points). Time is kept in integer
-nanoseconds, as message stamps are, so the simulator and the plant node step through exactly the
-same instants.
+:class:`PlantModel` steps the bodies with zero-order hold (q_i' = u_i, eq. 1, or the unicycles
+of ``core.bodies`` and ``core.unicycle``), in integer nanoseconds as message stamps are, so the
+simulator and the plant node step through the same instants. Each step it admits the commands
+(:meth:`PlantModel.admit`), audits the bound c M1 and checks collisions
+(:meth:`PlantModel.advance`); it senses what each robot's range sensor sees
+(:meth:`PlantModel.sensed`, the rule of ``core.sensing``). Bodies beyond the paper (lag, an
+acceleration limit, noisy or late sensing): ``core.dynamics`` and docs/equations.md (D1-D4).
 
-Each step the model
-
-* admits commands (:meth:`PlantModel.admit`): for each robot the latest command counts if there
-  is one (else ``MISSING``), it is finite (else ``NON_FINITE``) and its state stamp is at most
-  ``input_timeout`` old (else ``STALE``) and not newer than the present state (else
-  ``FUTURE``); a command that does not count is replaced by zero. One that counts but asks for
-  more than the law can produce is clipped (``SATURATED``): its bounded part u_hat of eq. (14)
-  (recovered through eq. (25) for a moving reference; for a unicycle from the velocity its
-  (v, w) gives its hand point at the heading of the state it answers) to c M1, then to the
-  actuator caps: every world component to ``max_speed`` when that is set (points), |v| and |w| to
-  ``body.max_linear`` and ``body.max_angular`` (unicycles);
-* audits the bound (:meth:`PlantModel.advance`): a new command above c M1 is counted once and
-  reported;
-* integrates and checks collisions: a pair of bodies closer than ``collision_distance`` (or
-  twice the body radius) is counted once when it comes closer;
-* senses (:meth:`PlantModel.sensed`, :meth:`PlantModel.neighbours`): what each robot's range
-  sensor sees, the other bodies strictly within its R_i (R_i + 2 l for unicycles, so that it
-  sees every hand point within R_i of its own), from one k-d tree per step.
-
-Non-ideal bodies (``core.dynamics``, beyond the paper; all ideal by default, and then none of
-this state exists and the model steps exactly as above): with ``actuator_lag`` or
-``max_acceleration`` the model keeps every body's velocity (:attr:`PlantModel.velocity`, from
-rest) and steps it with the dynamics of ``core.dynamics``; with ``pose_noise`` every state's
-positions are sensed with noise (one draw per body per state: a motion-capture system measures
-each body once, and every robot that sees body j gets the same measured position); with
-``state_delay`` the robots get, at time t, the state measured at t - d (d rounded to whole
-steps; before d has passed, the start state), stamped with t - d. Commands then answer that
-stamp, and the admission looks it up among the states it keeps (what the robots were sent:
-the sensed control points and headings). Collisions, distances and the recorded trajectory are
-the true bodies'; the range sensor's pairs are those of the sensed positions (the rule of
-``core.sensing`` applied to what the robots are sent, as the relay applies it to a
-motion-capture system's measurements).
-
-Positions are rows: ``q`` has shape (N, dim), in m; headings (N,) in rad; commands (N, dim) in m/s
-for points, (N, 2) holding (v, w) in m/s and rad/s for unicycles.
+Positions are rows: ``q`` (N, dim) in m; headings (N,) in rad; commands (N, dim) in m/s for
+points, (N, 2) holding (v, w) in m/s and rad/s for unicycles.
 """
 
 from collections import OrderedDict
@@ -77,12 +44,12 @@ GRID_FROM = 64
 many, with the points of the neighbouring grid cells after."""
 PLANT_STATS_FILE = 'plant_stats.json'
 AGE_BINS = 64
+"""Command ages counted step by step in :attr:`PlantCounts.age_steps` (one more bin: none)."""
 PAIR_SKIN = 0.25
 """With ``pair_radius`` the model searches the pairs within (1 + PAIR_SKIN) times it and keeps
 them as candidates until some control point has moved half the difference since (a Verlet
 list): each step's pairs are the candidates within ``pair_radius``, the very pairs a search of
 its own would find, in the same order (``law.neighbour_pairs``), with fewer searches."""
-"""Command ages counted step by step in :attr:`PlantCounts.age_steps` (one more bin: none)."""
 
 
 class CommandStatus(enum.IntEnum):
@@ -353,7 +320,11 @@ class PlantModel:
     keeps every pair of control points within it of each new state (:attr:`pairs`, for the law)
     and, for points when it is at least the collision distance, checks collisions among them
     instead of searching the tree a second time. imperfections: how the bodies and their
-    sensing differ from the ideal (``core.dynamics``; default ideal).
+    sensing differ from the ideal (``core.dynamics``; default ideal): with ``pose_noise`` each
+    state is measured once (one draw per body), and every robot that sees body j gets the same
+    measured position; with ``state_delay`` the robots get the state measured d ago (whole
+    steps), stamped then, and the commands answering it are admitted against it. Collisions,
+    distances and the recorded trajectory are always the true bodies'.
 
     Public state: ``q`` (N, dim) body positions, ``heading`` (N,), ``points`` (N, dim) the
     control points the law acts on, ``tree`` a k-d tree of ``points`` and ``body_tree`` one of

@@ -4,16 +4,11 @@
 """
 Whether a subscription's publishers are alive, from DDS liveliness (the lease of ``qos.py``).
 
-The robots' ``cmd_vel`` publishers offer a liveliness lease of
-:data:`formation_ros.ros.qos.LIVELINESS_LEASE`, kept by their commands (a running robot sends
-one at least every control period), and the plant's subscribers ask for it, so DDS
-tells the plant within that lease when a robot stopped showing signs of life (its process was
-killed, its host lost power or its link was cut), and again when it is back. (The plant offers
-the lease on ``pose`` and ``neighbors`` too, but robots ask for none there: they hear any
-publisher, and notice a silent plant by their watchdog.) A
-:class:`PeerLiveliness` stores what the subscription's liveliness events say; the node's
-diagnostics timer reports it. Without liveliness the dead process's publisher stays listed
-until DDS drops its participant, about 20 s later.
+The robots' ``cmd_vel`` publishers offer the lease :data:`formation_ros.ros.qos.LIVELINESS_LEASE`
+and the plant's subscribers ask for it, so DDS tells the plant within the lease when a robot
+stops showing signs of life, and when it is back (docs/faults.md: a peer dies or its link is
+cut). A :class:`PeerLiveliness` keeps what the subscription's liveliness events say; the node's
+diagnostics timer reports it.
 """
 
 import time

@@ -7,9 +7,8 @@ RViz markers of the formation (``/formation/markers``, visualization_msgs/Marker
 Namespaces: ``robots`` (spheres), ``sensing`` (discs in 2D, balls in 3D, radius R_i: a sphere
 list per distinct radius), ``repulsion`` (radius b, one sphere list), ``desired`` (the desired
 formation polygon), ``paths`` (recent paths, one line list). Every marker is in the world frame;
-the arrays come from the plant. The number of markers does not grow with the team: a marker is
-a Python message of some forty fields, and building one per robot cost the plant most of its
-time at 50 robots.
+the arrays come from the plant. The number of markers does not grow with the team (a list
+marker per kind, not a marker per robot).
 """
 
 from collections import deque

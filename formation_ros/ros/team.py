@@ -47,7 +47,8 @@ GRAPH_LOOKS = 100
 """Topics looked up in the graph per look for a second publisher (of 3N + 2, in turn)."""
 DOUBLED_WITHIN = 1.5
 """Team transport: two processes that announced one robot node within this many seconds (their
-statuses come once a second) both run it."""
+statuses come once a second) both run it; a restarted process announces its first status more
+than that after the one it replaces announced its last."""
 UNKNOWN_NAME = '_NODE_NAME_UNKNOWN_'
 """What rmw calls a node whose ROS name has not reached this participant yet."""
 UNNAMED = 'a node not yet named in the ROS graph'
