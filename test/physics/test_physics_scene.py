@@ -72,3 +72,18 @@ def test_the_scene_needs_a_start():
     config = load_config('config/square_4.yaml', 'reference')
     with pytest.raises(ValueError, match='start positions'):
         build_scene(config)
+
+
+def test_measured_poses_carry_seeded_gaussian_noise_on_the_positions_only():
+    starts = [[0.3 * (i % 10), 0.3 * (i // 10)] for i in range(100)]
+    draws = []
+    for _ in range(2):
+        engine = Engine(team(starts, 2, None, {'world.pose_noise': 0.01, 'start.seed': 3}))
+        truth, measured = engine.poses(), engine.measured_poses()
+        draws.append(measured.positions - truth.positions)
+        assert np.array_equal(measured.orientations, truth.orientations)
+    assert np.array_equal(draws[0], draws[1])
+    assert np.all(draws[0][:, 2] == 0.0)
+    assert 0.008 < np.std(draws[0][:, :2]) < 0.012
+    quiet = Engine(team(starts, 2))
+    assert np.array_equal(quiet.measured_poses().positions, quiet.poses().positions)

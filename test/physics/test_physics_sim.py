@@ -14,6 +14,7 @@ mujoco = pytest.importorskip('mujoco')
 from formation_ros.core.metrics import formation_errors  # noqa: E402, I100
 from formation_ros.core.params_file import load_params_file, write_params_file  # noqa: E402
 from formation_ros.core.trajectory import Trajectory  # noqa: E402
+from formation_ros.tools.report import main as report_main  # noqa: E402
 from formation_ros.tools.sim import main as sim_main  # noqa: E402
 
 UNICYCLES = 'config/unicycle_2d.yaml'
@@ -42,6 +43,8 @@ def test_unicycles_on_the_engine_write_what_every_run_writes_and_close_in(tmp_pa
     model = mujoco.MjModel.from_xml_path(str(out / 'world.xml'))
     assert model.nu == 12
     assert 'physics (MuJoCo' in capsys.readouterr().out
+    assert report_main([str(out), '--out', str(tmp_path / 'report'), '--no-plots']) == 0
+    assert 'closest body approach: 0.6' in capsys.readouterr().out
 
 
 def test_points_on_the_engine_close_in_without_touching(tmp_path):
