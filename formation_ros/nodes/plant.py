@@ -115,9 +115,10 @@ class PlantNode(Node):
                        if settings.output_dir else None)
         self.paths = Paths(self.n, PATH_LENGTH)
         self.last_publish_wall = 0.0
-        self.states = PlantTopics(self, self.n, self.dim, config.world_frame, self.team_transport,
-                                  self.team_transport and settings.wait_for_subscribers <= 1,
-                                  self.unicycles or body_frame, self.steady)
+        self.state_topics = PlantTopics(
+            self, self.n, self.dim, config.world_frame, self.team_transport,
+            self.team_transport and settings.wait_for_subscribers <= 1,
+            self.unicycles or body_frame, self.steady)
         self.command_liveliness: Dict[str, PeerLiveliness] = {}
         if self.team_transport:
             self.team_reader = TeamCommandReader(self.n)
@@ -132,14 +133,14 @@ class PlantNode(Node):
                                                   qos.CLOCK, raw=True)
         self.domain = DomainWatch(
             self, self.team_check, self.once,
-            {**dict.fromkeys(self.states.published_topics(), self.own_name),
+            {**dict.fromkeys(self.state_topics.published_topics(), self.own_name),
              **dict.fromkeys(self.command_liveliness)}, self.command_liveliness,
             [topics.robot_node_name(i) for i in range(1, self.n + 1)]
             if self.team_transport else [])
         self.diagnostics_pub = self.create_publisher(
             DiagnosticArray, topics.DIAGNOSTICS, qos.DIAGNOSTICS)
         period = RESEND_AFTER if self.lockstep else self.model.dt / settings.realtime_factor
-        self.timer = self.create_timer(period, self.advance_run, clock=self.steady)
+        self.step_timer = self.create_timer(period, self.advance_run, clock=self.steady)
         self.step_wake = Wake(self, self.advance_run, self.steady)
         self.diagnostics_timer = self.create_timer(PERIOD, self.on_diagnostics,
                                                    clock=self.steady)
@@ -256,12 +257,12 @@ class PlantNode(Node):
         """While the clock waits: start it once every robot is up and /clock reaches them."""
         missing = self.intake.missing()
         wanted = self.settings.wait_for_subscribers - (1 if self.team_transport else 0)
-        if missing or self.states.unheard(wanted):
+        if missing or self.state_topics.unheard(wanted):
             self.once.start('waiting', waiting_line(
                 missing, self.n, wanted, topics.STATES if self.team_transport else None), 'info')
             self._resend_if_due()
             return False
-        match = self.gate.clock_match(self.states.clock_unmatched(), now)
+        match = self.gate.clock_match(self.state_topics.clock_unmatched(), now)
         if match is ClockMatch.WAIT:
             self.once.start('clock-match', CLOCK_MATCH_LINE, 'info')
             self._resend_if_due()
@@ -270,7 +271,7 @@ class PlantNode(Node):
             self.get_logger().warning(GAVE_UP_LINE)
         self.gate.start()
         if self.team_transport:
-            self.states.look_at_listeners()
+            self.state_topics.look_at_listeners()
         self.stats.started = now
         self.status_report.restart(now, self.model.counts.steps)
         self.once.end('clock-match')
@@ -325,7 +326,7 @@ class PlantNode(Node):
 
     def _publish(self) -> None:
         """Publish /clock and the state (``ros.plant_topics``); note when, for the latency."""
-        stamp_ns = self.states.publish(self.model)
+        stamp_ns = self.state_topics.publish(self.model)
         self.intake.state_stamp_ns = stamp_ns
         self.stats.answers.published(stamp_ns, time.monotonic_ns())
         self.last_publish_wall = time.monotonic()
@@ -355,7 +356,7 @@ class PlantNode(Node):
                                            self.domain.other_plants(now))
         if self.team_transport:
             heard.team_publishers = self.team_liveliness.alive
-            heard.listened = self.states.listened
+            heard.listened = self.state_topics.listened
         level, message, values = self.status_report.report(
             now, self.model, self.gate.phase, self.changes.states.at(self.model.t_ns).mode.value,
             self.stats.held_steps, self.refusals.refusals, heard)
