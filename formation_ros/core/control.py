@@ -59,6 +59,12 @@ class Commands:
         """Return the commands as published: (K, width), in their command frames."""
         return self.law.u if self.body is None else self.body
 
+    def row(self, k: int) -> Tuple[Command, Optional[Float]]:
+        """Return robot k's command ((dim,) arrays) and its published form, if not u."""
+        law = self.law
+        return (Command(u=law.u[k], u_hat=law.u_hat[k], omega=law.omega[k]),
+                None if self.body is None else self.body[k])
+
 
 class Control:
     """
@@ -93,6 +99,21 @@ class Control:
             return q, np.zeros(len(q))
         headings = np.asarray(headings_from_quaternions(orientations), dtype=float)
         return hand_points(q, headings, self.hand_distance), headings
+
+    def alone(self, index: int, position: ArrayLike, orientation: ArrayLike,
+              positions: ArrayLike, orientations: ArrayLike) -> Sensed:
+        """
+        Return what one robot (0-based id ``index``) knows, as the law takes it (K = 1).
+
+        position: (>= dim,) m and orientation (4,) of its pose; positions: (P, >= dim) m and
+        orientations: (P, 4) of the neighbours it sensed.
+        """
+        own = np.asarray(orientation, dtype=float)[None, :]
+        points, headings = self.points(np.vstack([np.asarray(position, dtype=float)[None, :],
+                                                  positions]),
+                                       np.vstack([own, orientations]))
+        return Sensed(np.array([index], dtype=np.intp), points[:1], headings[:1], own,
+                      np.zeros(len(points) - 1, dtype=np.intp), points[1:])
 
     def zero(self) -> Float:
         """Return the K robots' zero commands: (K, width)."""

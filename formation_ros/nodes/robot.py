@@ -19,11 +19,11 @@ docs/faults.md. One per robot::
 """
 
 import time
-from typing import Any, Callable, Dict, List, Optional, Tuple, TypeVar
+from typing import Any, Callable, Dict, List, Optional, Tuple
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.admission import Reason
-from formation_ros.core.answers import Act, AnswerPolicy, INPUTS
+from formation_ros.core.answers import Act, AnswerPolicy
 from formation_ros.core.control import Commands, Control, Sensed
 from formation_ros.core.declarations import CommandFrame, Exe, PoseType
 from formation_ros.core.frames import FrameSample
@@ -31,22 +31,23 @@ from formation_ros.core.law import Command
 from formation_ros.core.params import FormationConfig
 from formation_ros.core.reference_track import ReferenceTrack
 from formation_ros.core.robot_intake import Refused, StateIntake
+from formation_ros.core.robot_status import status_level, status_values
 from formation_ros.core.team import team_values
 from formation_ros.core.timeline import Mode, Shape, TeamState
 from formation_ros.core.units import NS_PER_S
 from formation_ros.nodes.robots_link import RobotsLink
 from formation_ros.ros import messages, qos, topics
-from formation_ros.ros.cdr import (CdrError, PoseArrayData, PoseData, read_odometry,
-                                   read_pose_array, read_pose_stamped, StatusData, TooManyPoses)
+from formation_ros.ros.cdr import (PoseArrayData, PoseData, read_odometry, read_pose_array,
+                                   read_pose_stamped, StatusData)
 from formation_ros.ros.changes import Changes
 from formation_ros.ros.command_output import CmdVel, CmdVelOutput, Output
 from formation_ros.ros.diagnostics import encode_statuses, make_status, PERIOD
-from formation_ros.ros.once import OnceLog, RefusalLog
+from formation_ros.ros.once import OnceLog
 from formation_ros.ros.parameters import declare_parameters
+from formation_ros.ros.robot_inputs import InputGate
 from formation_ros.ros.runner import run
-from formation_ros.ros.sim_clock import (clock_advice, sim_time_without_clock, StateClock,
-                                         wall_clock_overrides)
-from formation_ros.ros.team import announced, PublisherWatch
+from formation_ros.ros.sim_clock import sim_time_without_clock, StateClock, wall_clock_overrides
+from formation_ros.ros.team import announced
 from formation_ros.ros.wake import Wake
 from geometry_msgs.msg import PoseArray, PoseStamped
 from nav_msgs.msg import Odometry
@@ -57,7 +58,6 @@ from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.publisher import Publisher
 
-Read = TypeVar('Read')
 LAST_WORD = 0.5
 """How long a stopping robot waits for its last (zero) command to be received, s."""
 REFERENCE_VALUES = ('num_robots', 'dim', 'world_frame', 'repulsion_radius')
@@ -71,12 +71,6 @@ def reference_values(config: FormationConfig) -> Dict[str, Any]:
     """Return the values of ``config`` that decide how the reference and changes are checked."""
     return {name: value for name, value in config.values.items()
             if name in REFERENCE_VALUES or name.startswith(REFERENCE_PREFIXES)}
-
-
-def refusal_line(name: str, reason: Reason, detail: str) -> str:
-    """Return the log line of a message of input ``name`` refused for ``reason``."""
-    return (f'ignoring {name} messages with {reason.value}{detail} (logged once; diagnostics '
-            'count them)')
 
 
 class RobotNode(Node):
@@ -115,12 +109,14 @@ class RobotNode(Node):
         self.evaluates = config.team_transport or self.sim_time
         """Whether this robot evaluates the reference at each state's stamp itself."""
         self.once = OnceLog(self.get_logger())
-        self.refusals: RefusalLog[str] = RefusalLog(self.once, refusal_line)
         self.steady = Clock(clock_type=ClockType.STEADY_TIME)
         self.state_clock = StateClock(self)
-        self.intake = StateIntake(config.world_frame, self.timeout_ns, self.sim_time,
-                                  self.state_clock.follows_states,
-                                  'a unicycle' if self.unicycle else 'command.frame body')
+        shares = leader is not None and (config.team_transport or reference_values(config)
+                                         == reference_values(leader.config))
+        self.inputs = InputGate(self, StateIntake(
+            config.world_frame, self.timeout_ns, self.sim_time, self.state_clock.follows_states,
+            'a unicycle' if self.unicycle else 'command.frame body'), self.state_clock,
+            self.once, leader.inputs.expected if shares and leader is not None else {})
         period = settings.plant_period if self.sim_time else settings.relay_period
         self.watch_ns = max(1, int(round(NS_PER_S / settings.control_rate)))
         self.policy = AnswerPolicy(max(1, int(round(period * NS_PER_S))), self.timeout_ns,
@@ -133,9 +129,6 @@ class RobotNode(Node):
         self.last: Optional[Tuple[Command, Optional[NDArray[np.float64]]]] = None
         """This robot's latest command and its published form (diagnostics)."""
         self.flooded_reported = 0
-        self.graph = PublisherWatch(self)
-        self.shared: Dict[str, str] = {}
-        self.expected_publishers: Dict[str, Optional[str]] = {}
         self.first: RobotNode = self
         """The robot that hears the reference and the changes for this one (or itself)."""
         self.followers: List[RobotNode] = []
@@ -145,18 +138,16 @@ class RobotNode(Node):
         """The robot that answers for this one (its link's leader, or itself)."""
         if not config.team_transport:
             self._subscribe_to_states(settings.pose_type)
-        if leader is not None and (config.team_transport or reference_values(config)
-                                   == reference_values(leader.config)):
+        if shares and leader is not None:
             self.first = leader
             leader.followers.append(self)
             self.changes, self.track = leader.changes, leader.track
-            self.expected_publishers = leader.expected_publishers
         else:
             reference = self.create_subscription(Odometry, topics.REFERENCE, self.on_reference,
                                                  qos.REFERENCE, raw=True)
-            self.expected_publishers[reference.topic_name] = None
+            self.inputs.expected[reference.topic_name] = None
             if self.sim_time:
-                self.expected_publishers[topics.CLOCK] = None
+                self.inputs.expected[topics.CLOCK] = None
             self.changes = Changes(self, config, self.steady, self._refuse_change,
                                    self._new_state)
             self.track = ReferenceTrack(self.changes.reference, self.dim, config.world_frame,
@@ -216,61 +207,21 @@ class RobotNode(Node):
         """Steady time, ns: the clock of the timers (CLOCK_MONOTONIC), read without rclpy."""
         return time.monotonic_ns()
 
-    def read(self, name: str, reader: Callable[[bytes], Read], data: bytes) -> Optional[Read]:
-        """Return ``reader(data)``; None, the refusal counted, if the bytes do not fit it."""
-        try:
-            return reader(data)
-        except TooManyPoses as exc:
-            self.refuse(name, Refused(Reason.TOO_MANY, f' ({exc})'))
-        except CdrError as exc:
-            self.refuse(name, Refused(Reason.MALFORMED, f' ({exc})'))
-        return None
-
-    def refuse(self, name: str, refused: Refused) -> None:
-        """Count a message of input ``name`` refused; log it once (CLOCK: with advice)."""
-        if refused.reason is not Reason.CLOCK:
-            self.refusals.refuse(name, refused.reason, refused.detail, log=refused.log)
-            return
-        advice = ('' if name in self.intake.advised else clock_advice(
-            self.graph, self.expected_publishers, 'the reference' if name == 'reference'
-            else 'the robots and the reference'))
-        if advice is not None:
-            self.intake.advised.add(name)
-        where = ('the state' if name == 'reference' else
-                 f"the {'simulated' if self.sim_time else 'wall-clock'} time of this node")
-        self.refusals.refuse(name, Reason.CLOCK, f' ({refused.gap_s:+.3g} s from {where}: '
-                                                 f'{advice})', log=advice is not None)
-
-    def _on_clock(self, name: str, message: str) -> None:
-        if name in self.intake.advised:
-            self.intake.advised.discard(name)
-            self.refusals.admitted(name, Reason.CLOCK, message)
-
     def admit_state(self, name: str, state: PoseArrayData, needs_orientation: bool,
                     finite: Optional[bool] = None) -> bool:
-        """Admit a state of input ``name`` (``StateIntake``) and let it set the clock."""
-        stopped = self.intake.stopped(self.policy.received_ns['pose'], self.now_ns())
-        refused = self.intake.poses_refusal(state.frame_id, state.stamp_ns, state.positions,
-                                            state.orientations, needs_orientation,
-                                            self.get_clock().now().nanoseconds, stopped,
-                                            finite)
-        if refused is not None:
-            self.refuse(name, refused)
-            return False
-        self._on_clock(name, f'{name} messages on this clock again')
-        if self.intake.advance(state.stamp_ns, stopped):
-            self.state_clock.set_time(state.stamp_ns)
-        return True
+        """Admit a state of input ``name`` (``InputGate.admit_state``) as of now."""
+        return self.inputs.admit_state(name, state, needs_orientation,
+                                       self.policy.received_ns['pose'], self.now_ns(), finite)
 
     def on_pose(self, data: bytes) -> None:
         """Store the latest own pose, read from the serialized PoseStamped."""
-        pose = self.read('pose', read_pose_stamped, data)
+        pose = self.inputs.read('pose', read_pose_stamped, data)
         if pose is not None:
             self._store_pose(pose)
 
     def on_odometry(self, data: bytes) -> None:
         """Store the latest own pose, read from a serialized nav_msgs/Odometry."""
-        odometry = self.read('pose', read_odometry, data)
+        odometry = self.inputs.read('pose', read_odometry, data)
         if odometry is not None:
             self._store_pose(odometry.pose)
 
@@ -289,8 +240,8 @@ class RobotNode(Node):
 
     def on_neighbours(self, data: bytes) -> None:
         """Store the latest sensed neighbour positions, read from the serialized PoseArray."""
-        heard = self.read('neighbour', lambda raw: read_pose_array(raw, self.config.num_robots
-                                                                   - 1), data)
+        most = self.config.num_robots - 1
+        heard = self.inputs.read('neighbour', lambda raw: read_pose_array(raw, most), data)
         if heard is not None and self.admit_state('neighbour', heard, self.unicycle):
             self.neighbours = heard
             self.policy.heard(['neighbour'], self.now_ns())
@@ -318,17 +269,17 @@ class RobotNode(Node):
 
     def on_reference(self, data: bytes) -> None:
         """Keep a reference sample the track admits; wake the robots in lockstep."""
-        sample = self.read('reference', read_odometry, data)
+        sample = self.inputs.read('reference', read_odometry, data)
         if sample is None:
             return
         time_ns = (self.get_clock().now().nanoseconds if self.pose is None
                    else self.pose.stamp_ns)
         refused = self.track.refusal(sample, time_ns, lambda: bool(self.changes.take()))
         if refused is not None:
-            self.refuse('reference', refused)
+            self.inputs.refuse('reference', refused)
             return
-        self.refusals.admitted('reference', Reason.OTHER_REFERENCE,
-                               'the reference is the one this robot evaluates again')
+        self.inputs.refusals.admitted('reference', Reason.OTHER_REFERENCE,
+                                      'the reference is the one this robot evaluates again')
         now = self.now_ns()
         for node in [self] + self.followers:
             node.reference_heard(now)
@@ -341,7 +292,7 @@ class RobotNode(Node):
 
     def _refuse_change(self, what: str, why: str) -> None:
         """Count and log once a shape or status refused (``ros.changes``)."""
-        self.refusals.refusals.add(what, Reason.CHANGE)
+        self.inputs.refused.add(what, Reason.CHANGE)
         self.once.start(f'{what}-refused', f'ignoring a {what} with {why} (logged once; '
                                            'diagnostics count them)', 'error')
 
@@ -353,20 +304,16 @@ class RobotNode(Node):
         """Return the reference frame at ``stamp_ns`` (``ReferenceTrack.frame_at``), or None."""
         frame, gap = self.track.frame_at(stamp_ns, exact, self.evaluates, self.timeout_ns)
         if gap is not None:
-            self.refuse('reference', Refused(Reason.CLOCK, gap_s=gap))
+            self.inputs.refuse('reference', Refused(Reason.CLOCK, gap_s=gap))
         elif frame is not None:
-            self._on_clock('reference', 'reference on the clock of the states')
+            self.inputs.on_clock('reference', 'reference on the clock of the states')
         return frame
 
     def _sensed_alone(self) -> Sensed:
-        """Return what this robot knows of the stored state, as the law takes it."""
+        """Return what this robot knows of the state stored (``Control.alone``)."""
         assert self.pose is not None and self.neighbours is not None
-        points, headings = self.control.points(
-            np.vstack([self.pose.position, self.neighbours.positions]),
-            np.vstack([self.pose.orientation, self.neighbours.orientations]))
-        return Sensed(np.array([self.index]), points[:1], headings[:1],
-                      np.array([self.pose.orientation]),
-                      np.zeros(len(points) - 1, dtype=np.intp), points[1:])
+        return self.control.alone(self.index, self.pose.position, self.pose.orientation,
+                                  self.neighbours.positions, self.neighbours.orientations)
 
     def _commands(self, stamp_ns: int, exact: bool) -> Optional[NDArray[np.float64]]:
         """Return the commands (K, width) answering the state ``stamp_ns``; None: zero."""
@@ -483,78 +430,40 @@ class RobotNode(Node):
             self.announcing = (shape, announced(team_values(self.config, shape.vertices), self))
         return self.announcing[1]
 
-    def command_of(self, row: int) -> Optional[Tuple[Command, Optional[NDArray[np.float64]]]]:
-        """Return row ``row`` of the commands computed last and its published form."""
-        if self.latest is None:
-            return None
-        law, body = self.latest.law, self.latest.body
-        return (Command(u=law.u[row], u_hat=law.u_hat[row], omega=law.omega[row]),
-                None if body is None else body[row])
+    def command_of(self, k: int) -> Optional[Tuple[Command, Optional[NDArray[np.float64]]]]:
+        """Return row ``k`` of the commands computed last (``Commands.row``), None before."""
+        return None if self.latest is None else self.latest.row(k)
 
     def diagnostic_status(self) -> StatusData:
-        """Return this robot's status: input ages, neighbours, command, refusals, its state."""
+        """Return this robot's status (``core.robot_status``) with its team values."""
         if self.link is not None:
             self.link.report_to(self)
         else:
             self.last = self.command_of(0)
-        leader, policy = self.answering, self.answering.policy
-        now = self.now_ns()
-        values: Dict[str, Any] = {
-            f'{name} message age [s]': ('never' if self.policy.received_ns[name] is None
-                                        else (now - self.policy.received_ns[name]) / NS_PER_S)
-            for name in INPUTS}
+        policy, now = self.answering.policy, self.now_ns()
+        points = None
         if self.neighbours is not None and self.pose is not None:
-            points, _ = self.control.points(
-                np.vstack([self.pose.position, self.neighbours.positions]),
-                np.vstack([self.pose.orientation, self.neighbours.orientations]))
-            gaps = np.linalg.norm(points[1:] - points[0], axis=1)
-            values['neighbours heard'] = len(gaps)
-            values['neighbours within R_i'] = int(np.count_nonzero(gaps < self.sensing_radius))
-            values['neighbours within b'] = int(np.count_nonzero(gaps < self.law.repulsion_radius))
-        if self.last is not None:
-            values['max |u| component [m/s]'] = float(np.max(np.abs(self.last[0].u)))
-            values['max |u_hat| component [m/s]'] = float(np.max(np.abs(self.last[0].u_hat)))
+            sensed = self._sensed_alone()
+            points = np.vstack([sensed.points, sensed.neighbours])
+        values = status_values({name: None if heard is None else (now - heard) / NS_PER_S
+                                for name, heard in self.policy.received_ns.items()}, points,
+                               self.sensing_radius, self.law.repulsion_radius, self.last,
+                               self.unicycle)
         values['bound c*M1 [m/s]'] = self.law.u_bound
         values.update(self._announcement(self.pose.stamp_ns if self.pose is not None else 0))
-        body = None if self.last is None else self.last[1]
-        if body is not None and self.unicycle:
-            values['|v| [m/s]'] = abs(float(body[0]))
-            values['|w| [rad/s]'] = abs(float(body[1]))
-        elif body is not None:
-            values['max |u| component in the body frame [m/s]'] = float(np.max(np.abs(body)))
         values.update({f'rejected {name} messages ({reason.value})': count
-                       for (name, reason), count in self.refusals.refusals.items()})
+                       for (name, reason), count in self.inputs.refused.items()})
         values['states not answered (flooding)'] = policy.flooded
         if self.link is not None:
             values['cmd_vel published'] = self.link.publishes_cmd_vel(self.index)
-        flooding = policy.flooded > self.flooded_reported
-        self.flooded_reported = policy.flooded
-        shared = self._shared_topics() if self.first is self else self.first.shared
+        flooding, self.flooded_reported = policy.flooded > self.flooded_reported, policy.flooded
+        shared = self.inputs.shared_topics() if self.first is self else self.first.inputs.shared
         if shared:
             values['topics with more than one publisher'] = ' | '.join(
                 f'{topic}: {names}' for topic, names in sorted(shared.items()))
-            level, message = 'error', (f"{', '.join(sorted(shared))}: more than one publisher "
-                                       '(two teams on one domain?)')
-        elif policy.waiting:
-            level, message = 'warn', 'waiting for its first inputs'
-        elif policy.stale:
-            level, message = 'warn', 'publishing zero: inputs stale'
-        elif flooding:
-            level, message = 'warn', 'flooding: states beyond the state rate dropped'
-        else:
-            level, message = 'ok', 'lockstep' if leader.lockstep else 'controlling'
+        level, message = status_level(shared, policy.waiting, bool(policy.stale), flooding,
+                                      self.lockstep)
         return make_status(f'formation_ros/robot_{self.index + 1}', level, message, values)
-
-    def _shared_topics(self) -> Dict[str, str]:
-        """Return {topic: its publishers} of /clock and the reference with several; log once."""
-        shared = self.graph.check(self.expected_publishers, time.monotonic())
-        self.once.follow('publishers', {topic: f'{topic} has more than one publisher: {names} '
-                                               '(two teams on one domain? each needs a '
-                                               'ROS_DOMAIN_ID of its own)'
-                                        for topic, names in shared.items()},
-                         self.shared, lambda topic: f'{topic} has one publisher again')
-        self.shared = shared
-        return shared
 
 
 def make_robot() -> RobotNode:

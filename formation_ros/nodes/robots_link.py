@@ -131,12 +131,12 @@ class RobotsLink:
     def _sense(self, data: bytes) -> bool:
         """Read and admit a new state's bytes, sense; False if refused."""
         leader = self.leader
-        state = leader.read('states', lambda raw: read_pose_array(raw, self.n), data)
+        state = leader.inputs.read('states', lambda raw: read_pose_array(raw, self.n), data)
         if state is None:
             return False
         if len(state.positions) != self.n:
-            leader.refuse('states', Refused(Reason.MALFORMED, f' ({len(state.positions)} '
-                                                              f'poses for {self.n} robots)'))
+            leader.inputs.refuse('states', Refused(
+                Reason.MALFORMED, f' ({len(state.positions)} poses for {self.n} robots)'))
             return False
         positions = state.positions[:, :self.dim]
         checked = PoseArrayData(state.stamp_ns, state.frame_id, positions, state.orientations)

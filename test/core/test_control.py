@@ -74,3 +74,16 @@ def test_inputs_are_not_changed():
     team.commands(Sensed(np.arange(N), points, headings, ORIENTATIONS,
                          np.zeros(0, dtype=np.intp), np.zeros((0, 2))), VERTICES, FRAME)
     assert np.array_equal(before[0], POSITIONS) and np.array_equal(before[1], ORIENTATIONS)
+
+
+def test_one_robot_alone_is_the_team_path_with_k_1():
+    control = Control(LAW, RADII[:1], 2, True, 0.2, False)
+    positions = np.hstack([POSITIONS, np.zeros((N, 1))])
+    alone = control.alone(3, positions[0], ORIENTATIONS[0], positions[1:], ORIENTATIONS[1:])
+    points, headings = control.points(POSITIONS, ORIENTATIONS)
+    assert alone.indices.tolist() == [3] and np.array_equal(alone.points, points[:1])
+    assert np.array_equal(alone.neighbours, points[1:]) and not alone.observer.any()
+    commands = control.commands(alone, VERTICES[:1], FRAME)
+    command, body = commands.row(0)
+    assert np.array_equal(command.u, commands.law.u[0]) and np.array_equal(body, commands.body[0])
+    assert body.shape == (2,) and headings.shape == (N,)

@@ -53,7 +53,7 @@ def sample(node, stamp_s, shift=0.0):
 
 
 def refused(node, reason):
-    return node.refusals.refusals.get(('reference', reason), 0)
+    return node.inputs.refused.get(('reference', reason), 0)
 
 
 def test_a_sample_unlike_the_frame_is_refused_through_the_callback(robot):

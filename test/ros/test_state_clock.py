@@ -145,7 +145,7 @@ def test_a_refused_pose_leaves_its_clock_alone(sim_robot):
     sim_robot.on_pose(pose(1000.0))
     sim_robot.on_pose(pose(5.5, frame='map'))
     assert now_s(sim_robot) == 5.0 and sim_robot.policy.states == 1
-    rejected = {reason.name: count for (name, reason), count in sim_robot.refusals.refusals.items()
+    rejected = {reason.name: count for (name, reason), count in sim_robot.inputs.refused.items()
                 if name == 'pose'}
     assert rejected == {'CLOCK': 1, 'FRAME': 1}
 
@@ -161,7 +161,7 @@ def test_once_its_states_stopped_the_next_one_sets_its_clock_either_way(sim_robo
     sim_robot.on_pose(pose(0.5))
     assert now_s(sim_robot) == 0.5 and sim_robot.policy.states == 3
     assert {(name, reason.name): count for (name, reason), count
-            in sim_robot.refusals.refusals.items()} == {('pose', 'CLOCK'): 1}
+            in sim_robot.inputs.refused.items()} == {('pose', 'CLOCK'): 1}
 
 
 def test_a_team_process_follows_its_states_the_same_way(steady):
@@ -176,7 +176,7 @@ def test_a_team_process_follows_its_states_the_same_way(steady):
             link.take_state()
             assert now_s(node) == taken, (stamp, later)
         assert {(name, reason.name): count for (name, reason), count
-                in node.refusals.refusals.items()} == {('states', 'CLOCK'): 1}
+                in node.inputs.refused.items()} == {('states', 'CLOCK'): 1}
     finally:
         node.destroy_node()
         rclpy.shutdown(context=context)
