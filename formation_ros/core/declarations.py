@@ -440,9 +440,9 @@ DECLARATIONS = (
           "Unicycles: radius of a differential-drive base's two wheels, m (TurtleBot3 Burger: "
           '0.033 m).', low=above(0.0), high=at_least(10.0), users=PHYSICS),
     Param('world.wheel_track', Kind.DOUBLE, 0.16,
-          'Unicycles: distance between the two wheels, m (TurtleBot3 Burger: 0.160 m); '
-          'within the footprint 2 body.radius.', low=above(0.0), high=at_least(100.0),
-          users=PHYSICS),
+          'Unicycles: distance between the two wheels, m (TurtleBot3 Burger: 0.160 m); a '
+          "base's footprint is body.radius, or wider if the wheels need it.", low=above(0.0),
+          high=at_least(100.0), users=PHYSICS),
     Param('world.wheel_torque', Kind.DOUBLE, 0.2,
           "Unicycles: torque limit of each wheel's velocity servo, N m: with the mass it sets "
           'how fast a base can speed up or brake.', low=above(0.0), high=at_least(1e4),
