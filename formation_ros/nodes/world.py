@@ -20,7 +20,7 @@ import json
 import os
 import shutil
 import time
-from typing import Any, Dict, List, Optional, Set
+from typing import Any, Dict, List, Optional
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.admission import Reason
@@ -90,7 +90,6 @@ class WorldNode(Node):
         self.stamped = config.command.stamped
         self.once = OnceLog(self.get_logger())
         self.refusals: RefusalLog[int] = RefusalLog(self.once, self._refusal_line)
-        self.refused_robots: Set[int] = set()
         self.command_frames = [messages.body_frame(i) if self.body_frame
                                else config.world_frame for i in range(1, self.n + 1)]
         self.inbox = CommandInbox(self.command_frames, self.dim, self.unicycles, self.stamped,
@@ -151,22 +150,16 @@ class WorldNode(Node):
                 'counted in /diagnostics)')
 
     def on_command(self, index: int, data: bytes) -> None:
-        """Keep robot ``index``'s command for the next step, or count and log its refusal."""
+        """Keep robot ``index``'s command for the next step, or count its refusal (logged once)."""
         try:
             message = read_twist_stamped(data) if self.stamped else read_twist(data)
         except CdrError as exc:
-            self.refused_robots.add(index)
             self.refusals.refuse(index, Reason.MALFORMED, str(exc))
             return
         reason = self.inbox.take(index, message.frame_id, message.linear, message.angular,
                                  message.stamp_ns, self.engine.time_ns)
         if reason is not None:
-            self.refused_robots.add(index)
             self.refusals.refuse(index, reason, self._refusal_detail(index, reason, message))
-        elif index in self.refused_robots:
-            self.refused_robots.discard(index)
-            for each in REFUSAL_WORDS:
-                self.refusals.admitted(index, each)
 
     def _refusal_detail(self, index: int, reason: Reason, message: TwistData) -> str:
         """Say what was wrong with a refused command: its frame, its stamp or its values."""
