@@ -30,6 +30,7 @@ from typing import Optional, Sequence, Tuple
 from formation_ros.core.dynamics import NOISE_SEED_OFFSET
 from formation_ros.core.params import FormationConfig, WorldSettings
 from formation_ros.core.unicycle import headings_from_quaternions
+from formation_ros.core.units import NS_PER_S
 from formation_ros.physics.contacts import ClosestApproach, ContactLog, RELEASE_GAP
 from formation_ros.physics.diff_drive import DiffDrive
 from formation_ros.physics.odometry import ODOMETRY_PERIOD, WheelOdometry
@@ -149,7 +150,7 @@ class Engine:
     @property
     def time_s(self) -> float:
         """Return the simulated time since the start, s."""
-        return self.time_ns / 1e9
+        return self.time_ns / NS_PER_S
 
     def apply(self, commands: ArrayLike, stamps_ns: Optional[ArrayLike] = None,
               robots: Optional[Sequence[int]] = None) -> NDArray[np.bool_]:
