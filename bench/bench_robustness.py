@@ -5,6 +5,7 @@
 Robustness benchmark: where the paper's guarantees end for bodies that are not q' = u.
 
 Usage: python bench/bench_robustness.py [--quick] [--seeds 3] [--jobs 1] [--out DIR]
+       python bench/bench_robustness.py --physics [--only PART ...] [--teams TEAM ...] [...]
 
 It sweeps each non-ideality of the plant model (plant.actuator_lag, plant.state_delay,
 plant.pose_noise, plant.max_acceleration; core/dynamics.py), the step (plant.rate), a grid of
@@ -20,6 +21,14 @@ starts, the starts' own start.min_separation = 0.1 m), the settle time (every ro
 c M1, the largest body velocity and whether the run converged (settled). Prints a Markdown
 table per sweep and progress lines on stderr, writes OUT/bench/robustness.json and one figure
 per sweep, OUT/robustness_<sweep>.png (OUT defaults to the repository's docs/).
+
+--physics runs another family instead (bench/physics_robustness.py): the law on the MuJoCo
+engine (formation_sim --engine mujoco) with one world knob at a time (the motors' torque or
+force limit, the payload mass, the floor's friction, the control period, the pose noise), on
+the TurtleBot3-like team of config/unicycle_2d.yaml and the holonomic team of
+config/lab_holonomic.yaml, and the plant model's lag fitted to the engine's step responses;
+it writes OUT/bench/robustness_physics.json and OUT/robustness_physics_*.png and leaves
+robustness.json alone.
 """
 
 import argparse
@@ -33,7 +42,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 BENCH = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(BENCH)
-sys.path[:0] = [ROOT]
+sys.path[:0] = [ROOT, BENCH]
 
 from formation_ros.core.declarations import BY_NAME, ParamError  # noqa: E402
 from formation_ros.core.metrics import SETTLE_TOLERANCE  # noqa: E402
@@ -42,6 +51,7 @@ from formation_ros.core.params_file import load_params_file  # noqa: E402
 from formation_ros.core.safety import guaranteed_min_distance  # noqa: E402
 from formation_ros.core.unicycle import hand_points  # noqa: E402
 from formation_ros.tools.sim import Progress, run_fixed_step, run_metrics  # noqa: E402
+import physics_robustness  # noqa: E402
 
 CONFIGS = {'section5': 'config/paper_section5.yaml', 'unicycle': 'config/unicycle_2d.yaml'}
 POINT_SIZE = 'start.min_separation'
@@ -68,6 +78,8 @@ COMBINED = {
              'note': "value: (delay, gain / the file's gain)"},
 }
 QUICK_DURATION = 2.0
+PHYSICS_PARTS = physics_robustness.PARTS
+PHYSICS_TEAMS = tuple(physics_robustness.TEAMS)
 Settings = Tuple[Tuple[str, float], ...]
 
 
@@ -79,14 +91,25 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument('--quick', action='store_true',
                         help=f'two values per sweep, one seed, {QUICK_DURATION:g} s runs: checks '
                              'the benchmark, measures nothing')
-    parser.add_argument('--seeds', type=int, default=3,
+    parser.add_argument('--seeds', type=int,
                         help='random starts per setting: start.seed of the file, +1, ... '
-                             '(default %(default)s; --quick: 1)')
+                             '(default 3, with --physics 1; --quick: 1)')
     parser.add_argument('--jobs', type=int, default=1,
                         help='runs in parallel, one process each (default %(default)s)')
     parser.add_argument('--redraw', action='store_true',
                         help='run nothing: read OUT/bench/robustness.json of an earlier run, '
                              'recompute its limits and gain rule, rewrite it and the figures')
+    parser.add_argument('--physics', action='store_true',
+                        help='the sweeps on the physics engine and the lag fit instead '
+                             '(bench/physics_robustness.py): OUT/bench/robustness_physics.json'
+                             ', OUT/robustness_physics_{sweeps,fit}.png')
+    parser.add_argument('--only', nargs='+', metavar='PART',
+                        help='with --physics: run only these parts (of: '
+                             f"{', '.join(PHYSICS_PARTS)}) and merge them into the earlier "
+                             'robustness_physics.json')
+    parser.add_argument('--teams', nargs='+', metavar='TEAM',
+                        help=f"with --physics: the teams (of: {', '.join(PHYSICS_TEAMS)}; "
+                             'default all)')
     parser.add_argument('--out', default=os.path.join(ROOT, 'docs'),
                         help='writes OUT/bench/robustness.json and OUT/robustness_<sweep>.png '
                              '(default: %(default)s)')
@@ -97,8 +120,18 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     """Parse and check the command line (argparse exits 2 on a bad one)."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    if args.seeds is None:
+        args.seeds = 1 if args.physics else 3
     if args.seeds < 1 or args.jobs < 1:
         parser.error('--seeds and --jobs must be >= 1')
+    if (args.only or args.teams) and not args.physics:
+        parser.error('--only and --teams go with --physics')
+    unknown = sorted(set(args.only or ()) - set(PHYSICS_PARTS)) + sorted(
+        set(args.teams or ()) - set(PHYSICS_TEAMS))
+    if unknown:
+        parser.error(f"no part or team {', '.join(unknown)}")
+    if args.physics and not args.teams:
+        args.teams = list(PHYSICS_TEAMS)
     if args.quick:
         args.seeds = 1
     return args
@@ -465,6 +498,8 @@ def write_result(path: str, result: Dict[str, Any]) -> None:
 def main(argv: Optional[Sequence[str]] = None) -> int:
     """Run the sweeps, print the tables, write the JSON and the figures; 0 on success."""
     args = parse_args(argv)
+    if args.physics:
+        return physics_robustness.main(args, machine)
     if args.redraw:
         return redraw(args)
     os.makedirs(os.path.join(args.out, 'bench'), exist_ok=True)

@@ -394,3 +394,73 @@ def test_switch_benchmark_line_keeps_each_half_of_the_circle_in_order():
         order = np.argsort(circle[half, 0])
         assert np.all(np.diff(line[half, 0][order]) > 0.0)
     assert line[0, 0] == pytest.approx(0.75) and line[5, 0] == pytest.approx(-0.75)
+
+
+def test_lag_fit_recovers_the_lag_and_the_limit_of_its_own_model():
+    lag_fit = load_bench(os.path.join(ROOT, 'bench', 'lag_fit.py'))
+    t = np.arange(1, 301) * 0.002
+    measured = lag_fit.model_response(t, 0.2, 0.03, 4.0)
+    fit = lag_fit.fit_lag([(t, measured, 0.2)])
+    assert fit.lag == pytest.approx(0.03, abs=1e-4)
+    assert fit.max_acceleration == pytest.approx(4.0, rel=1e-3)
+    assert fit.rms < 1e-6 and fit.relative_rms < 1e-5
+    pure = lag_fit.fit_lag([(t, lag_fit.model_response(t, 2.0, 0.05, 0.0), 2.0)])
+    assert pure.lag == pytest.approx(0.05, abs=1e-4) and pure.max_acceleration == 0.0
+    both = lag_fit.fit_lag([(t, measured, 0.2), (t, lag_fit.model_response(t, 2.0, 0.03, 4.0),
+                                                 2.0)])
+    assert both.lag == pytest.approx(0.03, abs=1e-3) and both.relative_rms == both.rms
+    with pytest.raises(ValueError):
+        lag_fit.fit_lag([(t, measured, 0.0)])
+
+
+def test_robustness_benchmark_on_the_physics_engine_quick_run(tmp_path):
+    script = os.path.join(ROOT, 'bench', 'bench_robustness.py')
+    robustness = load_bench(script)
+    result = subprocess.run([sys.executable, script, '--physics', '--quick', '--only', 'torque',
+                             'fit', '--out', str(tmp_path)], capture_output=True, text=True,
+                            timeout=300, env=dict(os.environ, MPLBACKEND='Agg'))
+    assert result.returncode == 0, result.stdout + result.stderr
+    assert not (tmp_path / 'bench' / 'robustness.json').exists()
+    path = tmp_path / 'bench' / 'robustness_physics.json'
+    data = json.loads(path.read_text())
+    rows = data['sweeps']['torque']['rows']
+    assert {row['team'] for row in rows} == {'turtlebot3', 'holonomic'}
+    assert {row['parameter'] for row in rows} == {'world.wheel_torque', 'world.force_limit'}
+    for row in rows:
+        summary = row['summary']
+        assert summary['starts'] == 1 and summary['contacts'] == 0 and summary['held']
+        assert summary['closest_bodies'] == pytest.approx(row['size'] + summary['footprint_gap'])
+        assert summary['max_abs_u_hat'] <= summary['u_bound'] * (1.0 + 1e-9)
+    fits = data['fit']['fits']
+    for team, entries in fits.items():
+        for entry in entries:
+            for fit in entry['fit'].values():
+                assert 0.0 <= fit['lag'] < 0.1 and fit['relative_rms'] < 0.05
+    assert len(data['fit']['side_by_side']) == sum(len(e) for e in fits.values())
+    assert data['runs'][0]['machine']['nproc'] == os.cpu_count()
+    for name in ('sweeps', 'fit'):
+        assert (tmp_path / f'robustness_physics_{name}.png').stat().st_size > 1000
+    assert '| turtlebot3 | `world.wheel_torque` | 0.2 |' in result.stdout
+    assert 'bench_robustness --physics: 1/' in result.stderr
+    again = subprocess.run([sys.executable, script, '--physics', '--quick', '--only', 'noise',
+                            '--teams', 'holonomic', '--out', str(tmp_path)],
+                           capture_output=True, text=True, timeout=300)
+    assert again.returncode == 0, again.stderr
+    merged = json.loads(path.read_text())
+    assert merged['sweeps']['torque'] == data['sweeps']['torque']
+    assert {row['team'] for row in merged['sweeps']['noise']['rows']} == {'holonomic'}
+    assert len(merged['runs']) == 2 and merged['fit'] == data['fit']
+    redrawn = subprocess.run([sys.executable, script, '--physics', '--redraw', '--out',
+                              str(tmp_path)], capture_output=True, text=True, timeout=120)
+    assert redrawn.returncode == 0 and '| holonomic | `world.pose_noise` |' in redrawn.stdout
+    path.write_text('[1, 2]')
+    bad = subprocess.run([sys.executable, script, '--physics', '--redraw', '--out',
+                          str(tmp_path)], capture_output=True, text=True, timeout=120)
+    assert bad.returncode == 2 and len(bad.stderr.strip().splitlines()) == 1
+    for options in (['--only', 'fit'], ['--physics', '--only', 'gravity'],
+                    ['--physics', '--teams', 'drones']):
+        with pytest.raises(SystemExit) as info:
+            robustness.parse_args(options)
+        assert info.value.code == 2
+    assert robustness.parse_args(['--physics']).seeds == 1
+    assert robustness.parse_args([]).seeds == 3
