@@ -436,7 +436,8 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         return 2
     make = functools.partial(HostsLaunch, robot_hosts=robot_hosts, loss=loss)
     try:
-        return launcher_main(rest + ['--discovery', 'subnet'], make=make, usage=USAGE)
+        return launcher_main(rest + ['--discovery', 'subnet'], make=make, usage=USAGE,
+                             look=False)
     except HostsError as exc:
         say(str(exc))
         return 1

@@ -14,7 +14,8 @@ otherwise left out or restarted); the nodes are then stopped in order (robots, r
 plant or relay together, the recorder last) and, with ``--out`` or ``--record``,
 ``formation_report`` writes the metrics and figures. A recorder that could not write its bag
 (exit code :data:`RECORDING_FAILED`) ends the run only with ``--on-record-failure stop``.
-Exit codes: 0 done, 1 a node died or the report failed, 2 bad usage or parameters,
+Exit codes: 0 done, 1 a node died or the report failed, 2 bad usage or parameters, or another
+team on the domain the user gave (:func:`domain_refusal`, before anything starts),
 :data:`RECORDING_FAILED` (74) the recording stopped early.
 
 The nodes watch the launcher through its process id and start time in their environment
@@ -27,14 +28,15 @@ import os
 import re
 import shutil
 import signal
+import socket
 import subprocess
 import sys
 import time
 from typing import Callable, Mapping, Optional, Sequence, TextIO
 
-from formation_ros.core.exits import RECORDING_FAILED
+from formation_ros.core.exits import RECORDING_FAILED, REFUSED
 from formation_ros.ros.watch import watch_environment
-from formation_ros.tools.domain import choose_domain
+from formation_ros.tools.domain import choose_domain, TeamLook, TeamSeen
 from formation_ros.tools.supervise import describe_returncode, ExitInfo, ProcessSpec, Supervisor
 from formation_ros.tools.system import (DISCOVERY, DISCOVERY_ENV, discovery_problem,
                                         DOMAIN_ENV, domain_problem, ESSENTIAL, FLEET_REMAP,
@@ -119,7 +121,9 @@ Options:
                  range that is safe on every Linux machine). Default: ROS_DOMAIN_ID as set
                  in the environment, else a free domain of the launcher's choosing (one
                  on which no DDS participant is seen), said in its first line with how to
-                 join it (export ROS_DOMAIN_ID=N)
+                 join it (export ROS_DOMAIN_ID=N). A domain given here or in ROS_DOMAIN_ID
+                 is looked at first (a few seconds at most): where another team runs (a
+                 /clock publisher, a plant or a relay) nothing starts, exit code 2
   --no-plant     a lab: no plant and no /clock. The relay (executable 'relay') reads every
                  robot's measured pose (relay.source_topic, relay.source_names and
                  relay.source_type in PARAMS.yaml) and publishes /robot_<i>/pose and
@@ -142,8 +146,8 @@ Executables: 'ros2 run formation_ros <exe>' where the ros2 command knows the pac
 <prefix>/lib/formation_ros/<exe> with the install's Python path set, as 'ros2 run' would.
 
 Exit codes: 0 done, 1 a node exited on its own or the report failed, 2 bad usage or
-parameters, 74 the recording stopped early (the recorder could not write; its bag is readable
-and shorter than the run).
+parameters, or another team on the domain given, 74 the recording stopped early (the recorder
+could not write; its bag is readable and shorter than the run).
 """
 
 
@@ -604,6 +608,60 @@ def _recording_failed(info: ExitInfo) -> bool:
     return info.name == 'record' and info.returncode == RECORDING_FAILED
 
 
+def look_at_domain(options: Options) -> Optional[TeamLook]:
+    """
+    Start looking at the domain the user gave for another team (``tools.domain.TeamLook``).
+
+    None when the launcher chooses the domain itself, or ROS_DOMAIN_ID is not a domain (the
+    nodes refuse it). The look reads the graph only; nothing of the run has started.
+    """
+    env = discovery_environment(options, os.environ)
+    text = env.get(DOMAIN_ENV, '')
+    if not text or domain_problem(text):
+        return None
+    return TeamLook(int(text), env)
+
+
+def domain_refusal(options: Options, look: TeamLook) -> Optional[str]:
+    """
+    Return the line refusing the domain where ``look`` found another team, or None.
+
+    A look that cannot tell is said, and the run starts: its plant still looks.
+    """
+    env = discovery_environment(options, os.environ)
+    domain = int(env[DOMAIN_ENV])
+    seen = look.result()
+    if seen is None:
+        say(f'could not look at ROS_DOMAIN_ID {domain} for another team (no rclpy?); starting, '
+            'its plant refuses one it finds')
+        return None
+    if not seen.found:
+        return None
+    local = env.get(DISCOVERY_ENV, '').upper() == 'LOCALHOST'
+    return refusal_line(domain, seen, options.domain_id is not None,
+                        socket.gethostname() if local else None)
+
+
+def refusal_line(domain: int, seen: TeamSeen, option: bool, host: Optional[str]) -> str:
+    """
+    Return the line refusing ``domain``, where the look ``seen`` found another team.
+
+    option: whether ``--domain-id`` gave the domain (else ROS_DOMAIN_ID); host: where the nodes
+    found are (None: not known, discovery reaches other computers).
+    """
+    nodes = ', '.join(name + (' (publishes /clock)' if name in seen.clock else '')
+                      for name in seen.found)
+    where = f'on this host ({host})' if host else 'on this host or another of the subnet'
+    if option:
+        how, other = f'--domain-id {domain}', 'give another --domain-id, or leave it out'
+    else:
+        how, other = f'ROS_DOMAIN_ID={domain} in the environment', ('export another '
+                                                                    'ROS_DOMAIN_ID, or unset it')
+    return (f'refusing to start: another team runs on ROS_DOMAIN_ID {domain} ({how}): {nodes} '
+            f'{where}; nothing was started. Stop that team, or {other} and the launcher runs '
+            'on a free domain of its own')
+
+
 def say(message: str, stream: Optional[TextIO] = None) -> None:
     """Print one launcher message (on stderr unless ``stream`` is given), if it still can."""
     try:
@@ -614,13 +672,16 @@ def say(message: str, stream: Optional[TextIO] = None) -> None:
 
 
 def main(argv: Optional[Sequence[str]] = None, make: Optional[Callable[..., 'Launch']] = None,
-         usage: str = USAGE) -> int:
+         usage: str = USAGE, look: bool = True) -> int:
     """
     Run the launcher with ``argv`` (default: the command line); return the exit code.
 
     make: the class of the run (default :class:`Launch`; ``formation_ros.tools.hosts`` runs
-    the nodes on several hosts with a subclass), usage: the text of ``--help``.
+    the nodes on several hosts with a subclass), usage: the text of ``--help``; look: whether a
+    domain the user gave is looked at for another team first (:func:`domain_refusal`; hosts.py's
+    hosts have a network of their own).
     """
+    team_look = None
     try:
         options = parse_args(sys.argv[1:] if argv is None else argv)
         if options is None:
@@ -631,8 +692,11 @@ def main(argv: Optional[Sequence[str]] = None, make: Optional[Callable[..., 'Lau
         if options.no_plant and install.prefix is not None and not _has(install.prefix, 'relay'):
             raise UsageError(f'--no-plant needs the relay: no '
                              f'{os.path.join(install.prefix, "lib", PACKAGE, "relay")}')
+        team_look = look_at_domain(options) if look else None
         formation = read_parameters(options)
     except UsageError as exc:
+        if team_look is not None:
+            team_look.cancel()
         if exc.args[0] is None:
             print(usage, end='', file=sys.stderr)
         else:
@@ -647,6 +711,11 @@ def main(argv: Optional[Sequence[str]] = None, make: Optional[Callable[..., 'Lau
             say(f'{exc}: set ROS_DOMAIN_ID or --domain-id')
             return 2
         options = dataclasses.replace(options, domain_id=domain)
+    elif team_look is not None:
+        refusal = domain_refusal(options, team_look)
+        if refusal is not None:
+            say(refusal)
+            return REFUSED
     num_robots = formation.num_robots
     wall_seconds = formation.wall_seconds if options.duration is None else options.duration
     try:

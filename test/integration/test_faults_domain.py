@@ -3,17 +3,20 @@
 
 """Two teams on one domain: refused at the plant's start, named while running, or avoided."""
 
+from collections import Counter
 import os
 import re
 from signal import SIGCONT, SIGSTOP
 import socket
+import subprocess
+import time
 
-from diagnostic_msgs.msg import DiagnosticStatus
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from formation_ros.ros import messages, qos
 from formation_ros.tools import domain
 from geometry_msgs.msg import PoseStamped, TwistStamped
-from helpers import (launch, logged, node, said_once, SimClock, SQUARE, Statuses, stop_when,
-                     wait_exit, write_params)
+from helpers import (launch, LAUNCHER, logged, node, said_once, SimClock, SQUARE, Statuses,
+                     stop_when, wait_exit, write_params)
 from nav_msgs.msg import Odometry
 import pytest
 from rclpy.qos import DurabilityPolicy, QoSProfile, ReliabilityPolicy
@@ -256,3 +259,89 @@ def test_the_launcher_runs_on_a_free_domain_of_its_own(processes, install, probe
     finally:
         holder_node.destroy_node()
         rclpy.shutdown(context=holder)
+
+
+def team_endpoints(probe, topics):
+    """Return how many publishers and subscriptions each node has on each of ``topics``."""
+    found = Counter()
+    for topic in topics:
+        for kind, infos in (('publisher', probe.get_publishers_info_by_topic(topic)),
+                            ('subscription', probe.get_subscriptions_info_by_topic(topic))):
+            found.update((topic, kind, info.node_namespace, info.node_name) for info in infos)
+    return found
+
+
+def children(pid):
+    """Return the command lines of the running processes whose parent is ``pid``."""
+    found = []
+    for entry in os.listdir('/proc'):
+        try:
+            with open(f'/proc/{entry}/stat', encoding='ascii', errors='replace') as stream:
+                parent = int(stream.read().rsplit(')', 1)[1].split()[1])
+            if parent == pid:
+                with open(f'/proc/{entry}/cmdline', 'rb') as stream:
+                    found.append(stream.read().replace(b'\0', b' ').decode(errors='replace'))
+        except (OSError, ValueError, IndexError):
+            continue
+    return found
+
+
+def test_a_second_launcher_on_a_given_domain_refuses_before_starting_anything(
+        processes, install, probe, tmp_path):
+    """
+    A team runs on the test's domain; a second launcher is given that domain twice.
+
+    Once with --domain-id, once through ROS_DOMAIN_ID. Each looks at the graph before anything
+    starts and exits 2 with one line naming the team's plant: no node process of its own, no
+    --out directory, no publisher or subscription on the team's topics meanwhile, and the
+    team's plant hears of nothing and ends normally.
+    """
+    clock = SimClock(probe)
+    shared = []
+    probe.create_subscription(DiagnosticArray, '/diagnostics', lambda message: shared.extend(
+        kv.value for status in message.status for kv in status.values
+        if kv.key == 'topics with more than one publisher'), qos.DIAGNOSTICS)
+    launch(processes, install, SQUARE, per_process=4)
+    assert probe.spin_until(lambda: clock.seconds > 1.0, START_UP), processes.log('launcher')
+    topics = [name for name, _ in probe.get_topic_names_and_types()
+              if name not in ('/parameter_events', '/rosout')]
+    assert '/clock' in topics and '/robot_4/cmd_vel' in topics, topics
+    before = team_endpoints(probe, topics)
+    domain = os.environ['ROS_DOMAIN_ID']
+    without = {k: v for k, v in processes.env.items() if k != 'ROS_DOMAIN_ID'}
+    for option, env in ((['--domain-id', domain], without), ([], dict(processes.env))):
+        out = tmp_path / f'out{len(option)}'
+        second = subprocess.Popen(
+            ['bash', LAUNCHER, SQUARE, '--duration', '0', '--no-plots', '--prefix', install,
+             '--robots-per-process', '4', '--out', str(out), *option], env=env,
+            stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        started = time.monotonic()
+        spawned, extra = set(), Counter()
+
+        def looked():
+            spawned.update(line for line in children(second.pid)
+                           if f'{install}/lib/formation_ros/' in line)
+            extra.update(team_endpoints(probe, topics) - before)
+            return second.poll() is not None
+
+        assert probe.spin_until(looked, 60), 'the second launcher did not end'
+        out_text, err_text = second.communicate()
+        took = time.monotonic() - started
+        assert second.returncode == 2, (out_text, err_text)
+        assert out_text == '', out_text
+        lines = err_text.splitlines()
+        assert len(lines) == 1, err_text
+        how = f'--domain-id {domain}' if option else f'ROS_DOMAIN_ID={domain} in the environment'
+        assert lines[0].startswith(f'launch_formation.sh: refusing to start: another team runs '
+                                   f'on ROS_DOMAIN_ID {domain} ({how}): /plant (publishes '
+                                   f'/clock) on this host ({HOST}); nothing was started.'), lines
+        assert not spawned, spawned
+        assert not extra, extra
+        assert not out.exists()
+        print(f'second launcher ({how}) refused in {took:.2f} s')
+    seconds = clock.seconds
+    info = stop_when(probe, processes, lambda: clock.seconds > seconds + 1.0)
+    assert info.returncode == 0, processes.log('launcher')[-3000:]
+    log = processes.log('launcher')
+    assert 'more than one publisher' not in log and 'another plant' not in log, log[-3000:]
+    assert not any(shared), shared
