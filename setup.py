@@ -30,6 +30,7 @@ setup(
         'console_scripts': [
             'formation_sim = formation_ros.tools.sim:main',
             'formation_report = formation_ros.tools.report:main',
+            'formation_render = formation_ros.tools.render:main',
             'robot = formation_ros.nodes.entry:robot',
             'plant = formation_ros.nodes.entry:plant',
             'reference = formation_ros.nodes.entry:reference',
