@@ -95,6 +95,8 @@ class RelayNode(Node):
         """Refused measurements by robot id (1-based) and reason."""
         self.foreign_types: Dict[str, List[str]] = {}
         self.cycles = 0
+        self.waiting = False
+        """Whether no robot was measured at the last cycle (said once, and once when one is)."""
         self.published_cycles = 0
         self.rate_window = (time.monotonic(), 0)
         self.stale = np.ones(self.n, dtype=bool)
@@ -196,11 +198,13 @@ class RelayNode(Node):
         self._log_staleness(measured, fresh)
         self.stale = ~fresh
         if not np.any(measured):
+            self.waiting = True
             self.once.start('waiting', f'no robot measured yet (robots 1..{self.n} on '
                                        f'{self.sources[0]}, ...): publishing nothing until one '
                                        'is', 'info')
             return
-        if self.once.is_active('waiting'):
+        if self.waiting:
+            self.waiting = False
             missing = (np.flatnonzero(~measured) + 1).tolist()
             self.once.end('waiting', f'robots {(np.flatnonzero(measured) + 1).tolist()} '
                                      f'measured: publishing; not measured yet: '
