@@ -25,10 +25,11 @@ per sweep, OUT/robustness_<sweep>.png (OUT defaults to the repository's docs/).
 --physics runs another family instead (bench/physics_robustness.py): the law on the MuJoCo
 engine (formation_sim --engine mujoco) with one world knob at a time (the motors' torque or
 force limit, the payload mass, the floor's friction, the control period, the pose noise), on
-the TurtleBot3-like team of config/unicycle_2d.yaml and the holonomic team of
-config/lab_holonomic.yaml, and the plant model's lag fitted to the engine's step responses;
-it writes OUT/bench/robustness_physics.json and OUT/robustness_physics_*.png and leaves
-robustness.json alone.
+the TurtleBot3-like team of config/unicycle_2d.yaml (also started across its hexagon:
+bench/physics_crossing.yaml) and the holonomic team of config/lab_holonomic.yaml, and the
+plant model's lag fitted to the engine's step responses; it writes
+OUT/bench/robustness_physics.json and OUT/robustness_physics_*.png and leaves robustness.json
+alone.
 """
 
 import argparse
@@ -98,7 +99,8 @@ def build_parser() -> argparse.ArgumentParser:
                         help='runs in parallel, one process each (default %(default)s)')
     parser.add_argument('--redraw', action='store_true',
                         help='run nothing: read OUT/bench/robustness.json of an earlier run, '
-                             'recompute its limits and gain rule, rewrite it and the figures')
+                             'recompute its limits and gain rule, rewrite it and the figures '
+                             '(with --physics: robustness_physics.json and its figures)')
     parser.add_argument('--physics', action='store_true',
                         help='the sweeps on the physics engine and the lag fit instead '
                              '(bench/physics_robustness.py): OUT/bench/robustness_physics.json'

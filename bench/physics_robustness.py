@@ -12,7 +12,9 @@ Two parts, each selectable with ``--only``:
   the holonomic ones), the payload (``world.mass``), the floor (``world.floor_friction``:
   the wheels slip), the control period (the law's dt, held while the engine steps) and the
   measured poses' noise (``world.pose_noise``). Teams: the six TurtleBot3-like bases of
-  config/unicycle_2d.yaml and the four holonomic bases of config/lab_holonomic.yaml. Each run
+  config/unicycle_2d.yaml, the same bases started across their hexagon
+  (bench/physics_crossing.yaml: they all cross the middle, so the closest approach comes
+  mid-run) and the four holonomic bases of config/lab_holonomic.yaml. Each run
   gives the engine's closest approach of two bodies (every engine step) and its footprints'
   gap, the contact events between robots, the settle time (every error <= 0.05 m from then
   on) and the final error;
@@ -51,6 +53,8 @@ FIGURE = 'robustness_physics_{}.png'
 TEAMS: Dict[str, Dict[str, Any]] = {
     'turtlebot3': {'path': 'config/unicycle_2d.yaml', 'duration': 70.0,
                    'what': 'six TurtleBot3-like differential-drive bases'},
+    'crossing': {'path': 'bench/physics_crossing.yaml', 'duration': 70.0,
+                 'what': 'the same bases started across the hexagon from their places'},
     'holonomic': {'path': 'config/lab_holonomic.yaml', 'duration': 45.0,
                   'what': 'four holonomic bases, commands in their body frame'},
 }
@@ -61,11 +65,14 @@ DEFAULTS = {**{f'world.{name}': getattr(WorldSettings(), name)
                for name in ('wheel_torque', 'force_limit', 'mass', 'floor_friction',
                             'pose_noise')}, CONTROL_DT: DEFAULT_CONTROL_DT}
 PHYSICS_SWEEPS: Dict[str, Dict[str, Any]] = {
-    'torque': {'parameter': {'turtlebot3': 'world.wheel_torque', 'holonomic': 'world.force_limit'},
+    'torque': {'parameter': {'turtlebot3': 'world.wheel_torque', 'crossing': 'world.wheel_torque',
+                             'holonomic': 'world.force_limit'},
                'unit': 'N m per wheel (holonomic: N per axis)',
                'values': {'turtlebot3': [0.2, 0.1, 0.05, 0.02, 0.01, 0.005],
+                          'crossing': [0.2, 0.1, 0.05, 0.02, 0.01, 0.005],
                           'holonomic': [5.0, 2.0, 1.0, 0.5, 0.2, 0.1]},
-               'quick': {'turtlebot3': [0.2, 0.02], 'holonomic': [5.0, 0.5]},
+               'quick': {'turtlebot3': [0.2, 0.02], 'crossing': [0.2, 0.02],
+                         'holonomic': [5.0, 0.5]},
                'note': "the motors' limit; the first value is the default"},
     'mass': {'parameter': 'world.mass', 'unit': 'kg', 'values': [1.0, 2.0, 5.0, 10.0, 20.0, 50.0],
              'quick': [1.0, 10.0], 'note': 'the whole base; the motors stay the same'},
@@ -86,6 +93,8 @@ FIT_SETTINGS: Dict[str, List[Tuple[str, Dict[str, float]]]] = {
                   ('mass 5 kg', {'world.mass': 5.0})],
 }
 STEPS = {'turtlebot3': {'v': 0.2, 'w': 2.0}, 'holonomic': {'x': 0.2}}
+BODY_OF = {'turtlebot3': 'turtlebot3', 'crossing': 'turtlebot3', 'holonomic': 'holonomic'}
+"""Whose bodies a team has: the fit is one per body (the crossing team's are the same)."""
 """The commanded steps: v (m/s) and w (rad/s) of a base, a velocity along x of a point."""
 STEP_DURATION = 1.0
 QUICK_DURATION = 2.0
@@ -293,7 +302,7 @@ def step_response(team: str, overrides: Dict[str, float],
                 'start.positions': [0.0, 0.0, 20.0, 0.0], 'start.headings': [0.0, 0.0],
                 **overrides})
     engine = Engine(validate(raw))
-    steps = STEPS[team]
+    steps = STEPS[BODY_OF[team]]
     unicycle = 'v' in steps
     command = ([[steps['v'], 0.0], [0.0, steps['w']]] if unicycle
                else [[steps['x'], 0.0], [0.0, 0.0]])
@@ -328,21 +337,26 @@ def run_fit(teams: List[str], quick: bool, jobs: int,
     fits: Dict[str, Any] = {}
     side: List[Tuple[str, str, Settings]] = []
     for team in teams:
-        settings_list = FIT_SETTINGS[team][:2] if quick else FIT_SETTINGS[team]
-        fits[team] = []
+        body = BODY_OF[team]
+        settings_list = FIT_SETTINGS[body][:2] if quick else FIT_SETTINGS[body]
         for label, overrides in settings_list:
+            side.append((team, label, canonical(tuple(overrides.items()))))
+            if body in fits and any(f['label'] == label for f in fits[body]):
+                continue
             response = step_response(team, overrides, duration)
             each = {name: fit_lag([(r['t'], r['velocity'], r['step'])]).as_dict()
                     for name, r in response.items()}
             joint = fit_lag([(r['t'], r['velocity'], r['step'])
                              for r in response.values()]).as_dict()
-            fits[team].append({'label': label, 'settings': overrides, 'response': response,
-                               'fit': each, 'joint': joint})
-            print(f'bench_robustness --physics: fit {team} {label}: '
+            model = joint if len(each) > 1 else next(iter(each.values()))
+            fits.setdefault(body, []).append({
+                'label': label, 'settings': overrides, 'response': response, 'fit': each,
+                'joint': joint, 'used': {'lag': model['lag'],
+                                         'max_acceleration': model['max_acceleration']}})
+            print(f'bench_robustness --physics: fit {body} {label}: '
                   + ', '.join(f"{name} tau {f['lag']:.4f} s a {f['max_acceleration']:.3g} "
                               f"rms {f['rms']:.2g}" for name, f in each.items()),
                   file=sys.stderr, flush=True)
-            side.append((team, label, canonical(tuple(overrides.items()))))
     cached = {}
     for entry in sweeps.values():
         for row in entry['rows']:
@@ -353,13 +367,10 @@ def run_fit(teams: List[str], quick: bool, jobs: int,
                if (team, settings) not in cached]
     for job, result in zip(missing, pool_map(engine_job, missing, jobs)):
         cached[(job[0], job[1])] = result
-    ideal_work = []
-    for team, label, settings in side:
-        fit = next(f for f in fits[team] if f['label'] == label)
-        model = fit['joint'] if team == 'turtlebot3' else fit['fit']['x']
-        fit['used'] = {'lag': model['lag'], 'max_acceleration': model['max_acceleration']}
-        ideal_work.append((team, model['lag'], model['max_acceleration'], durations[team],
-                           DEFAULT_CONTROL_DT))
+    used = {(team, label): next(f for f in fits[BODY_OF[team]] if f['label'] == label)['used']
+            for team, label, _ in side}
+    ideal_work = [(team, used[(team, label)]['lag'], used[(team, label)]['max_acceleration'],
+                   durations[team], DEFAULT_CONTROL_DT) for team, label, _ in side]
     plain = [(team, 0.0, 0.0, durations[team], DEFAULT_CONTROL_DT) for team in teams]
     results = list(pool_map(ideal_job, ideal_work + plain, jobs))
     rows = []
@@ -367,7 +378,7 @@ def run_fit(teams: List[str], quick: bool, jobs: int,
         rows.append({'team': team, 'label': label, 'engine': cached[(team, settings)],
                      'lag_model': ideal,
                      'ideal': results[len(ideal_work) + teams.index(team)],
-                     'used': next(f for f in fits[team] if f['label'] == label)['used']})
+                     'used': used[(team, label)]})
     return {'step_duration': duration, 'control_dt': DEFAULT_CONTROL_DT, 'fits': fits,
             'side_by_side': rows}
 
@@ -408,7 +419,7 @@ def markdown(table: Dict[str, Any]) -> str:
 def fit_markdown(fit: Dict[str, Any]) -> str:
     """Markdown tables of the fits and of the side-by-side runs."""
     lines = ['\n### the lag model fitted to the step responses\n',
-             '| team | world | step | tau (s) | a | RMS error | RMS / step |',
+             '| bases | world | step | tau (s) | a | RMS error | RMS / step |',
              '|---|---|---|---:|---:|---:|---:|']
     units = {'v': 'm/s', 'w': 'rad/s', 'x': 'm/s'}
     for team, entries in fit['fits'].items():
@@ -442,7 +453,7 @@ def fit_markdown(fit: Dict[str, Any]) -> str:
     return '\n'.join(lines)
 
 
-COLOURS = {'turtlebot3': 'tab:orange', 'holonomic': 'tab:green'}
+COLOURS = {'turtlebot3': 'tab:orange', 'crossing': 'tab:blue', 'holonomic': 'tab:green'}
 
 
 def x_of(sweep: str, value: float) -> float:
@@ -466,7 +477,7 @@ def sweeps_figure(plt: Any, table: Dict[str, Any], path: str) -> None:
             touched = [(x, y) for x, y, r in zip(xs, ratio, rows) if r['summary']['contacts']]
             if touched:
                 top.scatter(*zip(*touched), marker='x', s=80, color='k', zorder=3,
-                            label='contact' if team == 'turtlebot3' else None)
+                            label=f'{team}: contact')
             settle = [(x, r['summary']['settle_time']) for x, r in zip(xs, rows)
                       if r['summary']['settle_time'] is not None]
             if settle:
