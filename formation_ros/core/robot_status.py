@@ -2,16 +2,18 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-What a robot reports in ``/diagnostics``: its values and its level, from what it knows.
+What a robot says of itself: its ``/diagnostics`` values and level, its first log line.
 
 :func:`status_values` gives the values of a robot's status (input ages, neighbours in range,
-command sizes), :func:`status_level` its level and message. The keys and what they mean:
-docs/ros_interface.md ("Topics", ``/diagnostics``) and docs/faults.md.
+command sizes), :func:`status_level` its level and message, :func:`startup_line` what it logs
+as it starts. The keys and what they mean: docs/ros_interface.md ("Topics", ``/diagnostics``)
+and docs/faults.md.
 """
 
 from typing import Any, Dict, Mapping, Optional, Tuple
 
 from formation_ros.core.law import Command
+from formation_ros.core.params import FormationConfig
 import numpy as np
 from numpy.typing import NDArray
 
@@ -69,3 +71,19 @@ def status_level(shared: Mapping[str, str], waiting: bool, stale: bool, flooding
     if flooding:
         return 'warn', 'flooding: states beyond the state rate dropped'
     return 'ok', 'lockstep' if lockstep else 'controlling'
+
+
+def startup_line(config: FormationConfig, index: int, command_frame: str, sim_time: bool) -> str:
+    """Return the line robot ``index`` (0-based) logs as it starts: its constants and modes."""
+    law, body, robot = config.law(), config.body, config.robot
+    assert robot is not None
+    return (f'robot {index + 1}/{config.num_robots}: vertex '
+            f'{np.round(config.vertices[index], 4)}, R_i = {config.sensing_radii[index]:g} m, '
+            f'b = {config.repulsion_radius:g} m, bound c*M1 = {law.u_bound:.4g} m/s, '
+            + (f'unicycle, hand point {body.hand_distance:g} m ahead, ' if body.is_unicycle
+               else '')
+            + f"commands as {'TwistStamped' if config.command.stamped else 'Twist'} in "
+              f'{command_frame}, '
+            + ('lockstep' if config.lockstep else f'{robot.control_rate:g} Hz')
+            + (', team transport' if config.team_transport else '')
+            + (", simulated time from the states' stamps" if sim_time else ''))

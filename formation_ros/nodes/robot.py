@@ -28,10 +28,9 @@ from formation_ros.core.control import Commands, Control, Sensed
 from formation_ros.core.declarations import CommandFrame, Exe, PoseType
 from formation_ros.core.frames import FrameSample
 from formation_ros.core.law import Command
-from formation_ros.core.params import FormationConfig
-from formation_ros.core.reference_track import ReferenceTrack
+from formation_ros.core.reference_track import reference_values, ReferenceTrack
 from formation_ros.core.robot_intake import Refused, StateIntake
-from formation_ros.core.robot_status import status_level, status_values
+from formation_ros.core.robot_status import startup_line, status_level, status_values
 from formation_ros.core.team import team_values
 from formation_ros.core.timeline import Mode, Shape, TeamState
 from formation_ros.core.units import NS_PER_S
@@ -60,17 +59,6 @@ from rclpy.publisher import Publisher
 
 LAST_WORD = 0.5
 """How long a stopping robot waits for its last (zero) command to be received, s."""
-REFERENCE_VALUES = ('num_robots', 'dim', 'world_frame', 'repulsion_radius')
-REFERENCE_PREFIXES = ('reference.', 'formation.', 'formations.')
-"""Parameters that decide how a robot checks the reference's samples and the changes (with
-every ``reference.*``, ``formation.*`` and ``formations.*``): a fleet's robot that has the
-first robot's values hears the reference and the changes through it."""
-
-
-def reference_values(config: FormationConfig) -> Dict[str, Any]:
-    """Return the values of ``config`` that decide how the reference and changes are checked."""
-    return {name: value for name, value in config.values.items()
-            if name in REFERENCE_VALUES or name.startswith(REFERENCE_PREFIXES)}
 
 
 class RobotNode(Node):
@@ -83,9 +71,9 @@ class RobotNode(Node):
 
         ``leader``: the first robot of this process (a fleet's other robots); this robot then
         hears the reference and the changes through it, with ``transport: team`` always, else
-        if it has the leader's :func:`reference_values`. ``reports``: whether it publishes on
-        /diagnostics itself (a fleet's first robot publishes the others' statuses,
-        :attr:`reported`).
+        if it has the leader's ``core.reference_track.reference_values``. ``reports``: whether
+        it publishes on /diagnostics itself (a fleet's first robot publishes the others'
+        statuses, :attr:`reported`).
         """
         given = list(kwargs.pop('parameter_overrides', None) or [])
         super().__init__('robot', parameter_overrides=wall_clock_overrides(given), **kwargs)
@@ -111,8 +99,8 @@ class RobotNode(Node):
         self.once = OnceLog(self.get_logger())
         self.steady = Clock(clock_type=ClockType.STEADY_TIME)
         self.state_clock = StateClock(self)
-        shares = leader is not None and (config.team_transport or reference_values(config)
-                                         == reference_values(leader.config))
+        shares = leader is not None and (config.team_transport or reference_values(config.values)
+                                         == reference_values(leader.config.values))
         self.inputs = InputGate(self, StateIntake(
             config.world_frame, self.timeout_ns, self.sim_time, self.state_clock.follows_states,
             'a unicycle' if self.unicycle else 'command.frame body'), self.state_clock,
@@ -173,17 +161,8 @@ class RobotNode(Node):
         if not self.lockstep:
             self.watchdog = Wake(self, self.on_watchdog, self.steady)
             self.watchdog.arm(self.watch_ns / NS_PER_S)
-        self.get_logger().info(
-            f'robot {self.index + 1}/{config.num_robots}: vertex {np.round(self.vertex, 4)}, '
-            f'R_i = {self.sensing_radius:g} m, '
-            f'b = {config.repulsion_radius:g} m, bound c*M1 = {self.law.u_bound:.4g} m/s, '
-            + (f'unicycle, hand point {config.body.hand_distance:g} m ahead, '
-               if self.unicycle else '')
-            + f"commands as {'TwistStamped' if config.command.stamped else 'Twist'} in "
-              f'{self.command_frame}, '
-            + ('lockstep' if self.lockstep else f'{settings.control_rate:g} Hz')
-            + (', team transport' if config.team_transport else '')
-            + (", simulated time from the states' stamps" if self.sim_time else ''))
+        self.get_logger().info(startup_line(config, self.index, self.command_frame,
+                                            self.sim_time))
 
     def join(self, link: 'RobotsLink', output: Optional[Output], control: Control,
              senses: Callable[[], Sensed], leader: 'RobotNode') -> None:

@@ -3,9 +3,21 @@
 
 """A robot's status: its values from what it knows, and the first level that holds."""
 
+import os
+
 from formation_ros.core.law import Command
-from formation_ros.core.robot_status import status_level, status_values
+from formation_ros.core.params import load_params_file, validate
+from formation_ros.core.reference_track import reference_values
+from formation_ros.core.robot_status import startup_line, status_level, status_values
 import numpy as np
+
+SQUARE = os.path.join(os.path.dirname(__file__), '..', '..', 'config', 'square_4.yaml')
+
+
+def square(**changes):
+    values = load_params_file(SQUARE)
+    values.update({'robot_id': 2, **changes})
+    return validate(values, 'robot')
 
 
 def test_values_count_neighbours_in_range_and_size_the_command():
@@ -33,3 +45,17 @@ def test_the_level_is_the_first_that_holds():
     assert status_level({}, False, False, True, False)[1].startswith('flooding')
     assert status_level({}, False, False, False, True) == ('ok', 'lockstep')
     assert status_level({}, False, False, False, False) == ('ok', 'controlling')
+
+
+def test_the_startup_line_names_the_robot_its_constants_and_modes():
+    line = startup_line(square(**{'plant.lockstep': True}), 1, 'world', True)
+    assert line.startswith('robot 2/4: vertex ') and 'R_i = 2 m' in line
+    assert line.endswith("lockstep, simulated time from the states' stamps"), line
+    assert 'Hz' in startup_line(square(), 1, 'world', False)
+
+
+def test_robots_share_a_track_only_with_the_values_that_decide_it():
+    first = reference_values(square().values)
+    assert first == reference_values(square(**{'controller.gain': 3.0}).values)
+    assert first != reference_values(square(**{'reference.kind': 'circle',
+                                                'reference.radius': 1.0}).values)
