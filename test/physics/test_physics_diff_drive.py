@@ -158,3 +158,13 @@ def test_wheel_odometry_drifts_when_the_wheels_slip():
     odometry = engine.odometry()[0][:, 0]
     assert truth[1] - truth[0] > 2.0 * engine.model.footprint - 0.01
     assert odometry[0] - truth[0] > 0.1 and truth[1] - odometry[1] > 0.1
+
+
+def test_wheel_speeds_clip_to_the_limits_and_invert_to_the_command():
+    model = DiffDrive(wheel_radius=0.033, track=0.16, footprint=0.11, mass=1.0,
+                      wheel_torque=0.2, friction=1.0, max_linear=0.22, max_angular=2.84)
+    commands = np.array([[0.1, 0.5], [-0.2, -2.0], [0.0, 1.0], [0.5, 0.0], [0.0, -9.0]])
+    wheels = model.wheel_speeds(commands)
+    assert wheels[2].tolist() == pytest.approx([-0.08 / 0.033, 0.08 / 0.033])
+    assert model.body_rates(wheels) == pytest.approx(
+        np.array([[0.1, 0.5], [-0.2, -2.0], [0.0, 1.0], [0.22, 0.0], [0.0, -2.84]]))
