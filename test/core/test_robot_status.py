@@ -57,5 +57,5 @@ def test_the_startup_line_names_the_robot_its_constants_and_modes():
 def test_robots_share_a_track_only_with_the_values_that_decide_it():
     first = reference_values(square().values)
     assert first == reference_values(square(**{'controller.gain': 3.0}).values)
-    assert first != reference_values(square(**{'reference.kind': 'circle',
-                                                'reference.radius': 1.0}).values)
+    circle = square(**{'reference.kind': 'circle', 'reference.radius': 1.0})
+    assert first != reference_values(circle.values)
