@@ -54,7 +54,9 @@ DEFAULT_FPS = 10.0
 DEFAULT_MAX_FRAMES = 150
 MAX_FRAMES = 1000
 GIF_COLORS = 128
-"""Colours of the GIF's one palette (made from the first and last frames)."""
+"""Colours of the GIF's one palette (:func:`gif_palette`)."""
+PALETTE_SHADES = (0.6, 0.85, 1.0)
+"""The robots' colours enter the palette at these brightnesses."""
 CAMERAS = ('follow', 'fixed')
 ELEVATION = -50.0
 """The camera looks down at this angle, degrees."""
@@ -75,6 +77,8 @@ SHADOW_SIZE = 1024
 """The shadow map's side, pixels: with OSMesa MuJoCo's default 4096 takes most of a frame's time."""
 LINE_WIDTH = 2.0
 """Paths and sensing circles, pixels."""
+LINE_SHADE = 0.7
+"""A path's colour is its robot's at this brightness: the lights brighten lines past it."""
 MARKER_HEIGHT = 0.003
 """Half the height of a desired-position disc, m (it lies on the floor)."""
 LIFT = 0.02
@@ -423,6 +427,7 @@ class Frames:
         self.mujoco.mjv_initGeom(geom, kind, np.asarray(size, dtype=float),
                                  np.asarray(pos, dtype=float), np.eye(3).ravel(), rgba)
         geom.category = self.mujoco.mjtCatBit.mjCAT_DECOR
+        geom.specular = 0.0
         scene.ngeom += 1
         return geom
 
@@ -456,6 +461,7 @@ class Frames:
                 self._line(start, end, FORMATION_COLOR)
         for robot in range(trajectory.num_robots):
             color = robot_color(robot)
+            color[:3] *= LINE_SHADE
             marker = robot_color(robot, 0.45)
             if dim == 2:
                 self._geom(mj.mjtGeom.mjGEOM_CYLINDER,
@@ -510,6 +516,26 @@ def check_out(path: str) -> Optional[str]:
     return None
 
 
+def gif_palette(samples: Sequence[NDArray[np.uint8]], num_robots: int) -> Any:
+    """
+    Return the GIF's palette (a Pillow 'P' image) of sample frames (H, W, 3) of a run.
+
+    :data:`GIF_COLORS` colours: the robots' colours at a few shades (their paths and circles
+    take them whatever the samples show), the rest the samples' own by median cut.
+    """
+    from PIL import Image
+    shades = np.array([robot_color(robot)[:3] * shade for robot in range(min(num_robots,
+                                                                             len(COLORS)))
+                       for shade in PALETTE_SHADES] + [FORMATION_COLOR[:3]])
+    fixed = np.clip(np.round(255.0 * shades), 0, 255).astype(int).ravel().tolist()
+    adaptive = Image.fromarray(np.concatenate(list(samples), axis=0)).quantize(
+        GIF_COLORS - len(fixed) // 3, method=Image.Quantize.MEDIANCUT)
+    colours = adaptive.getpalette()[:3 * (GIF_COLORS - len(fixed) // 3)] + fixed
+    palette = Image.new('P', (1, 1))
+    palette.putpalette(colours + [0] * (768 - len(colours)))
+    return palette
+
+
 def render_run(trajectory: Trajectory, config: FormationConfig, path: str,
                options: RenderOptions = RenderOptions(), stream: TextIO = sys.stderr,
                quiet: bool = False, backend: Optional[str] = None) -> Rendered:
@@ -554,8 +580,7 @@ def render_run(trajectory: Trajectory, config: FormationConfig, path: str,
 
             last = len(plan.indices) - 1
             ends = {0: draw(0), last: draw(last)}
-            palette = Image.fromarray(np.concatenate([ends[0], ends[last]], axis=0)).quantize(
-                GIF_COLORS, method=Image.Quantize.MEDIANCUT)
+            palette = gif_palette([ends[0], ends[last]], trajectory.num_robots)
             for position in range(len(plan.indices)):
                 pixels = ends[position] if position in ends else draw(position)
                 frames.append(Image.fromarray(pixels).quantize(
