@@ -4,16 +4,26 @@
 """The launcher's look at a domain it was given, without DDS: the free shortcut and the line."""
 
 import os
+import socket
 
 from formation_ros.tools import domain
 from formation_ros.tools.launcher import refusal_line
 
 
-def test_a_domain_with_no_participant_here_needs_no_look():
-    free = next(d for d in domain.candidates(os.getuid()) if not domain.participants_here(d))
-    look = domain.TeamLook(free, {'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST'})
+def test_a_domain_with_no_participant_here_needs_no_look(monkeypatch):
+    monkeypatch.setattr(domain, 'participants_here', lambda number: 0)
+    look = domain.TeamLook(7, {'ROS_AUTOMATIC_DISCOVERY_RANGE': 'LOCALHOST'})
     assert look.child is None
     assert look.result() == domain.TeamSeen()
+
+
+def test_participants_here_counts_the_ports_bound_on_this_host():
+    free = next(d for d in domain.candidates(os.getuid()) if not domain.participants_here(d))
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as first, \
+            socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as third:
+        first.bind(('127.0.0.1', domain.participant_ports(free)[0]))
+        third.bind(('127.0.0.1', domain.participant_ports(free, 3)[2]))
+        assert domain.participants_here(free) == 2
 
 
 def test_the_refusal_names_what_was_found_and_what_to_do():
