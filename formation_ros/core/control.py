@@ -7,7 +7,8 @@ The commands of K >= 1 robots of one process: their points, the law, their comma
 :class:`Control` is the one path from what the robots sensed to what they publish: the points
 the law acts on (positions, or hand points for unicycles: docs/equations.md U1-U5), u of eqs.
 (14), (25) from ``core.law.robot_commands``, then (v, w) for unicycles or u turned into the
-body frame (``command.frame: body``). A robot process is K = 1, a process's link to its robots (``nodes.robots_link``) K.
+body frame (``command.frame: body``). A robot process is K = 1, a process's link to its
+robots (``nodes.robots_link``) K.
 """
 
 from dataclasses import dataclass
