@@ -712,7 +712,12 @@ def main(argv: Optional[Sequence[str]] = None, make: Optional[Callable[..., 'Lau
             return 2
         options = dataclasses.replace(options, domain_id=domain)
     elif team_look is not None:
-        refusal = domain_refusal(options, team_look)
+        try:
+            refusal = domain_refusal(options, team_look)
+        except KeyboardInterrupt:
+            team_look.cancel()
+            say('stopped (SIGINT) while looking at the domain; nothing was started')
+            return 128 + signal.SIGINT
         if refusal is not None:
             say(refusal)
             return REFUSED
