@@ -74,7 +74,7 @@ TRAIL_POINTS = 40
 """A robot's path is drawn through at most this many of its samples."""
 CIRCLE_SEGMENTS = 48
 SHADOW_SIZE = 1024
-"""The shadow map's side, pixels: with OSMesa MuJoCo's default 4096 takes most of a frame's time."""
+"""The shadow map's side, pixels: with OSMesa, MuJoCo's default 4096 took most of a frame."""
 LINE_WIDTH = 2.0
 """Paths and sensing circles, pixels."""
 LINE_SHADE = 0.7
