@@ -217,3 +217,26 @@ def test_help_names_the_options(capsys):
     for option in ('--out', '--fps', '--width', '--height', '--max-frames', '--camera',
                    '--sensing'):
         assert option in text
+
+
+@pytest.mark.parametrize('mode', render.CAMERAS)
+def test_the_camera_keeps_every_point_it_frames_in_the_picture(mode):
+    rng = np.random.default_rng(4)
+    frames = 30
+    spread = np.linspace(0.5, 8.0, frames)[:, None, None]
+    points = rng.uniform(-1.0, 1.0, (frames, 10, 3)) * spread + (3.0, -2.0, 0.0)
+    points[..., 2] = 0.05
+    fovy, aspect = 45.0, 4.0 / 3.0
+    lookat, distance = render.plan_camera(points, mode, 3, fovy, aspect, 1.0)
+    right, up, forward = render.camera_axes()
+    tan_y = math.tan(math.radians(0.5 * fovy))
+    for k in range(frames):
+        shown = points.reshape(-1, 3) if mode == 'fixed' else points[k]
+        eye = lookat[k] - distance[k] * forward
+        relative = shown - eye
+        depth = relative @ forward
+        assert np.all(depth > 0.0)
+        assert np.all(np.abs(relative @ up) / depth <= tan_y)
+        assert np.all(np.abs(relative @ right) / depth <= tan_y * aspect)
+    if mode == 'follow':
+        assert distance[0] < 0.5 * distance[-1], 'the camera does not follow the team'
