@@ -94,11 +94,6 @@ class StartGate:
         """Whether the domain was found free of another team (the look is over)."""
         return self.phase in (Phase.WAITING, Phase.RUNNING)
 
-    @property
-    def waiting(self) -> bool:
-        """Whether the clock is held (looking at the domain, or for the robots)."""
-        return self.phase in (Phase.LOOKING, Phase.WAITING)
-
     def look_due(self, now: float, at_once: bool = False) -> bool:
         """
         Return whether the node should look up the /clock publishers now (and count the look).

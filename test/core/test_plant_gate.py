@@ -22,19 +22,19 @@ def test_domain_verdict_names_another_team_by_name_announcement_or_clock():
 
 def test_the_look_waits_for_look_time_then_starts_on_a_free_domain():
     gate = StartGate(10.0, hold=True, own_name=OWN)
-    assert gate.phase is Phase.LOOKING and gate.waiting and not gate.looked
+    assert gate.phase is Phase.LOOKING and not gate.looked
     assert not gate.look_due(10.0 + LOOK_TIME - 0.01)
     assert gate.look_due(10.0 + LOOK_TIME)
     assert gate.heard(None, [], False, 12.0) is Verdict.FREE
     assert gate.phase is Phase.LOOKING
     assert gate.heard([], [], False, 12.0) is Verdict.FREE
-    assert gate.phase is Phase.WAITING and gate.looked and gate.waiting
+    assert gate.phase is Phase.WAITING and gate.looked
 
 
 def test_without_holding_for_the_robots_the_look_starts_the_run():
     gate = StartGate(0.0, hold=False, own_name=OWN)
     gate.heard([], [], False, LOOK_TIME)
-    assert gate.phase is Phase.RUNNING and not gate.waiting
+    assert gate.phase is Phase.RUNNING and gate.looked
 
 
 def test_a_silent_publisher_of_its_own_name_is_a_leftover_and_the_plant_starts():
