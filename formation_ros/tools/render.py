@@ -103,7 +103,7 @@ class RenderOptions:
     width, height: the frame in pixels; fps: frames per second of the GIF; speed: simulated
     seconds per second of GIF (None: as ``tools.animate.plan_frames`` chooses); max_frames:
     at most this many frames; camera: one of :data:`CAMERAS`; sensing: draw the sensing
-    circles; shadows: draw shadows (with OSMesa a frame takes about four times as long).
+    circles; shadows: draw shadows (with OSMesa, about 1.5 times the CPU of a frame).
     """
 
     width: int = DEFAULT_WIDTH
@@ -641,7 +641,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument('--sensing', action='store_true',
                         help="also draw each robot's sensing circle (radius R_i)")
     parser.add_argument('--no-shadows', action='store_true',
-                        help='draw no shadows (with OSMesa about four times faster)')
+                        help='draw no shadows (with OSMesa, a third less CPU per frame)')
     parser.add_argument('--quiet', action='store_true', help='print no progress')
     return parser
 
