@@ -13,8 +13,8 @@ offscreen renderer draws them from a camera that frames the team (``follow``: th
 is, zooming out as it spreads; ``fixed``: everything the run visits). Each robot has a colour
 of its own, and beside its body are drawn, as extra geoms of the frame: its desired position
 in force (a flat disc of its colour), its recent path and, with ``--sensing``, its sensing
-circle (radius R_i about its control point). Nothing is simulated: the picture is the run as
-it was recorded.
+circle (radius R_i about its control point; paths and circles for teams of up to
+:data:`MAX_LINED_ROBOTS`). Nothing is simulated: the picture is the run as it was recorded.
 
 Rendering needs an OpenGL backend that draws without a display: OSMesa (the Debian package
 ``libosmesa6``, which ``scripts/setup_env.sh`` installs) or EGL. ``MUJOCO_GL=osmesa`` or
@@ -73,6 +73,8 @@ TRAIL_FRACTION = 0.15
 TRAIL_POINTS = 40
 """A robot's path is drawn through at most this many of its samples."""
 CIRCLE_SEGMENTS = 48
+MAX_LINED_ROBOTS = 200
+"""Paths and sensing circles are drawn for teams of at most this many robots."""
 SHADOW_SIZE = 1024
 """The shadow map's side, pixels: with OSMesa, MuJoCo's default 4096 took most of a frame."""
 LINE_WIDTH = 2.0
@@ -343,7 +345,9 @@ class Frames:
         self.height = float(scene.model.height)
         self.radii = np.asarray(config.sensing_radii, dtype=float)
         n = trajectory.num_robots
-        decorations = n * (3 + TRAIL_POINTS + (CIRCLE_SEGMENTS if options.sensing else 0))
+        self.lines = n <= MAX_LINED_ROBOTS
+        decorations = n * (3 + (TRAIL_POINTS + (CIRCLE_SEGMENTS if options.sensing else 0)
+                                if self.lines else 0))
         self.model.vis.quality.shadowsize = SHADOW_SIZE
         self.model.vis.global_.offwidth = max(options.width, self.model.vis.global_.offwidth)
         self.model.vis.global_.offheight = max(options.height,
@@ -470,6 +474,8 @@ class Frames:
             else:
                 self._geom(mj.mjtGeom.mjGEOM_SPHERE, (0.5 * self.footprint, 0.0, 0.0),
                            desired[robot], marker)
+            if not self.lines:
+                continue
             for start, end in zip(path[:-1, robot], path[1:, robot]):
                 self._line(start, end, color)
             if self.options.sensing:
