@@ -99,6 +99,8 @@ class WorldNode(Node):
                            int(CATCH_UP * self.world.realtime_factor * NS_PER_S))
         self.steady = Clock(clock_type=ClockType.STEADY_TIME)
         self.contacts_logged = 0
+        self.late = np.zeros(self.n, dtype=np.int64)
+        """(N,) commands of each robot already stale when the step timer applied them."""
         self.rate_window = (time.monotonic_ns(), 0)
         self.output_dir = self.world.output_dir
         self.output_failure: Optional[str] = None
@@ -181,6 +183,7 @@ class WorldNode(Node):
         rows, commands, stamps = self.inbox.drain()
         if len(rows):
             self.engine.apply(commands, stamps, robots=rows)
+            self._note_late(rows, stamps)
         due = self.pacer.due(now, self.engine.steps)
         while due > 0:
             steps = min(due, self.steps_per_pose - self.engine.steps % self.steps_per_pose)
@@ -189,6 +192,17 @@ class WorldNode(Node):
             if self.engine.steps % self.steps_per_pose == 0:
                 self._publish()
         self._log_contacts()
+
+    def _note_late(self, rows: NDArray[np.intp], stamps: NDArray[np.int64]) -> None:
+        """Count commands already older than ``world.cmd_timeout`` when applied; log once each."""
+        ages = self.engine.time_ns - stamps
+        late = ages > self.world.cmd_timeout_ns
+        self.late[rows[late]] += 1
+        for index, age in zip(rows[late].tolist(), ages[late].tolist()):
+            self.once.start(f'late-{index}', (
+                f'robot {index + 1}: cmd_vel stamped {age / NS_PER_S:.3g} s before the '
+                "world's time, older than world.cmd_timeout: its motors stay stopped (a sender "
+                'far behind, or on another clock?); counted in /diagnostics'), 'error')
 
     def _publish(self) -> None:
         """Publish /clock, then every robot's measured pose and odometry, all at one stamp."""
@@ -280,7 +294,10 @@ class WorldNode(Node):
             'contacts': self.engine.contacts.count,
             'min body distance [m]': self.engine.closest.distance,
             'robots with live commands': ', '.join(map(str, live.tolist())) or 'none',
-            'refused cmd_vel messages': self.refusals.refusals.count()}
+            'refused cmd_vel messages': self.refusals.refusals.count(),
+            'robots with stale cmd_vel on arrival': ', '.join(
+                f'{i + 1}: {count}' for i, count in enumerate(self.late.tolist()) if count)
+            or 'none'}
         values.update({f'robot {index + 1}: refused cmd_vel messages ({reason.name.lower()})':
                        count for (index, reason), count in self.refusals.refusals.items()})
         contacts = self.engine.contacts.count
@@ -327,6 +344,8 @@ class WorldNode(Node):
             'simulated_time_let_go': self.pacer.dropped_s,
             'contact_events': [{'i': e.i, 'j': e.j, 't': e.t}
                                for e in self.engine.contacts.events],
+            'stale_command_messages': {str(i + 1): count for i, count
+                                       in enumerate(self.late.tolist()) if count},
             'model': self.engine.model.kind.value,
             'timestep': self.world.timestep,
             'refused_command_messages': {

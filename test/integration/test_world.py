@@ -104,6 +104,8 @@ def test_commands_drive_the_bodies_stale_ones_stop_them_bad_ones_are_counted(
         bad.publish(command(math.nan, now_ns(), 'robot_2/base_link'))
         bad.publish(command(0.2, now_ns(), 'world'))
         bad.publish(b'\x00\x01\x00\x00' + bytes(range(9)))
+        if clock.seconds > 2 * TIMEOUT:
+            bad.publish(command(0.2, 0, 'robot_2/base_link'))
 
     sent = []
 
@@ -118,7 +120,8 @@ def test_commands_drive_the_bodies_stale_ones_stop_them_bad_ones_are_counted(
     assert moved[1] - start1[1] > 0.1 and abs(moved[2] - start1[2]) < 0.01, moved
 
     last = sent[-1] * 1e-9
-    assert probe.spin_until(lambda: clock.seconds > last + TIMEOUT + 1.0 + BRAKING, 30)
+    assert probe.spin_until(lambda: send_bad() or clock.seconds > last + TIMEOUT + 1.0
+                            + BRAKING, 30)
     held = poses.at(1, last + TIMEOUT - 0.05)[1] - poses.at(1, last + 0.05)[1]
     assert held > 0.05 * (TIMEOUT - 0.1), 'the command holds until its timeout'
     stopped, final = poses.at(1, last + TIMEOUT + BRAKING), poses.latest(1)
@@ -140,7 +143,8 @@ def test_commands_drive_the_bodies_stale_ones_stop_them_bad_ones_are_counted(
     assert log.count('contact 1: ') == 1
     for text in ('robot 2: ignoring cmd_vel with non-finite values',
                  'robot 2: ignoring cmd_vel with a frame other than its command frame',
-                 'robot 2: ignoring cmd_vel with bytes that are not a whole TwistStamped'):
+                 'robot 2: ignoring cmd_vel with bytes that are not a whole TwistStamped',
+                 'robot 2: cmd_vel stamped '):
         assert log.count(text) == 1, log
 
     processes.send_signal('world', signal.SIGINT)
@@ -154,6 +158,7 @@ def test_commands_drive_the_bodies_stale_ones_stop_them_bad_ones_are_counted(
     assert all(refused[reason].get('2', 0) > 0 for reason in ('malformed', 'frame',
                                                               'non_finite')), refused
     assert not any(robots.get('1') for robots in refused.values()), refused
+    assert stats['stale_command_messages'].get('2', 0) > 0, stats['stale_command_messages']
     import mujoco
     model = mujoco.MjModel.from_xml_path(str(out / 'world.xml'))
     assert model.nu == 4
