@@ -5,15 +5,18 @@
 
 import json
 import os
+import re
 import subprocess
 
 from helpers import exe
 
-EXECUTABLES = ('robot', 'plant', 'reference', 'record', 'world', 'formation_sim',
-               'formation_report')
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+with open(os.path.join(ROOT, 'setup.py'), encoding='utf-8') as setup:
+    EXECUTABLES = tuple(re.findall(r"^\s*'(\w+) = formation_ros\.", setup.read(), re.M))
 
 
 def test_install_layout(install):
+    assert {'robot', 'plant', 'world', 'formation_sim', 'formation_render'} <= set(EXECUTABLES)
     for name in EXECUTABLES:
         path = exe(install, name)
         assert os.path.isfile(path) and os.access(path, os.X_OK), path
