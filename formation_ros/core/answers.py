@@ -4,8 +4,9 @@
 """
 When a robot answers a state: at most about one per state period, once, and when it waits.
 
-:class:`AnswerBudget` is a token bucket on the robot's own clock (simulated time beside a plant,
-wall-clock time with the relay): it gains ``1 + RATE_MARGIN`` answers per expected state period
+:class:`AnswerBudget` is a token bucket on the robot's own clock (simulated time beside a plant
+or a world, wall-clock time with the relay in a lab; the period: ``RobotSettings.answer_period``
+in ``core.params``): it gains ``1 + RATE_MARGIN`` answers per expected state period
 and holds at most :data:`BURST`, so over T s a robot answers at most
 ``(1 + RATE_MARGIN) T / period + BURST`` states. :class:`AnswerPolicy` decides for each state
 heard: answer, send the last answer again, drop it (a copy, a flood) or wait (start-up, stale

@@ -5,8 +5,9 @@
 Another team on a ROS 2 domain: which of the nodes a look found show one, without ROS.
 
 One rule for every looker (docs/faults.md, another team on the domain): a team runs where the
-graph lists a ``/clock`` publisher (a plant's simulated time) or a node named ``plant`` or
-``relay`` (:data:`HUBS`: one per team), other than the looker. The plant looks before its first
+graph lists a ``/clock`` publisher (a plant's or a world's simulated time) or a node named
+``plant``, ``relay`` or ``world`` (:data:`HUBS`: one of each per team at most), other than the
+looker. The plant looks before its first
 state, leaving out itself and a silent ``/clock`` publisher of its own name (what a killed plant
 leaves behind); the launcher looks before it starts anything (``tools.domain``). Imports nothing
 but the standard library: the launcher's ``--help`` stays light.
@@ -14,12 +15,13 @@ but the standard library: the launcher's ``--help`` stays light.
 
 from typing import Collection, List, Optional, Sequence
 
-HUBS = ('plant', 'relay')
-"""The names of the nodes a team runs one of: the plant, or in a lab the relay."""
+HUBS = ('plant', 'relay', 'world')
+"""The names of the nodes a team runs one of: the plant, the relay (a lab) or the world (a
+simulated lab, with its relay)."""
 
 
 def is_hub(name: str) -> bool:
-    """Tell whether the fully qualified node ``name`` is a plant or a relay (any namespace)."""
+    """Tell whether the fully qualified node ``name`` is a team's hub (any namespace)."""
     return name.rsplit('/', 1)[-1] in HUBS
 
 
@@ -36,7 +38,8 @@ def occupants(clock_publishers: Sequence[str], nodes: Sequence[str] = (),
     node. Every ``/clock`` publisher and every plant or relay counts, except the looker's name:
     under it a ``/clock`` publisher counts only when it runs elsewhere (``running``) or
     ``/clock`` was heard, else it is what a killed plant left (DDS forgets it within about
-    20 s), and a listed node only when it runs elsewhere (it is the looker itself).
+    20 s), and a listed node only when it runs elsewhere (it is the looker itself). Every
+    plant, relay or world counts: a world alone (its team not started yet) is a team too.
     """
     found = set()
     for name in clock_publishers:

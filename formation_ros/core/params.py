@@ -78,6 +78,17 @@ class PlantSettings:
         return steps_per_publish(self.rate, self.publish_rate)
 
 
+def world_robot_rates(relay_rate: float) -> Tuple[Tuple[str, float], ...]:
+    """
+    Return the rates a robot on simulated time beside a world and its relay is given.
+
+    relay_rate: ``relay.rate``, Hz of simulated time there. A robot reads ``plant.rate`` and
+    ``plant.publish_rate`` only for the period of its states (``state_period``); beside a
+    world they are the relay's, one state per step.
+    """
+    return (('plant.rate', relay_rate), ('plant.publish_rate', relay_rate))
+
+
 def steps_per_publish(rate: float, publish_rate: float) -> int:
     """Return the plant's steps between two published states (free-running): rate in Hz."""
     return max(1, int(round(rate / publish_rate)))
@@ -98,7 +109,8 @@ class RobotSettings:
     A robot node's own parameters.
 
     plant_period: the simulated time between two states of the plant, s (``state_period``);
-    relay_period: the wall-clock time between two relay cycles, s (1 / ``relay.rate``);
+    relay_period: the time between two relay cycles, s (1 / ``relay.rate``: wall-clock time in
+    a lab, simulated time beside a world);
     parameter_services: whether every robot node of a fleet offers the parameter services
     (``fleet.parameter_services``; the fleet's first robot always does).
     """
@@ -111,6 +123,19 @@ class RobotSettings:
     plant_period: float = 0.02
     relay_period: float = 0.02
     parameter_services: bool = True
+
+    def answer_period(self, sim_time: bool) -> float:
+        """
+        Return the time between two states the robot's answer budget expects, s.
+
+        On the wall clock the states are a lab relay's: ``relay_period``. On simulated time
+        they are stamped with it: ``plant_period``, the states' period that ``plant.rate``
+        and ``plant.publish_rate`` give. Beside a world there is no plant, and the relay's
+        cycles are on the world's /clock: the launcher and ``launch/world.launch.py`` give the
+        robots both rates as ``relay.rate`` (:func:`world_robot_rates`), so that the budget
+        expects a state every ``relay_period`` of simulated time.
+        """
+        return self.plant_period if sim_time else self.relay_period
 
 
 @dataclass(frozen=True)

@@ -7,13 +7,18 @@ Relay node (executable ``relay``): the range sensor of the plant, without the bo
 In a lab the bodies are real and a motion-capture system measures them: :class:`RelayNode`
 reads each robot's measured pose (``relay.source_topic``, a PoseStamped or an Odometry) and
 publishes what the plant would, every robot's ``pose`` and ``neighbors`` with the one sensing
-rule of ``core.sensing``, all with one wall-clock stamp per cycle at ``relay.rate``. A
+rule of ``core.sensing``, all with one wall-clock stamp per cycle at ``relay.rate``. Beside a
+simulated lab (the ``world`` node) it runs on the world's ``/clock`` (``use_sim_time:=true``):
+a cycle is due every ``1 / relay.rate`` s of simulated time, stamped with it, and a
+measurement's age is simulated time since it arrived (:meth:`RelayNode.now_ns`). A
 measurement is admitted by ``core.admission`` (frame, finite values, a unit quaternion, whole
 bytes; every refusal counted and logged once through ``ros.once.RefusalLog``) and by its stamp
 (:meth:`RelayNode._advances`: later than the last one taken). The rules and the stale robots:
 docs/lab.md and docs/faults.md ("the motion capture repeats a lost body's last pose")::
 
     ros2 run formation_ros relay --ros-args --params-file config/lab_turtlebot3.yaml
+    ros2 run formation_ros relay --ros-args --params-file config/world_turtlebot3.yaml \\
+        -p use_sim_time:=true
 """
 
 import time
@@ -36,10 +41,12 @@ from formation_ros.ros.once import OnceLog, RefusalLog
 from formation_ros.ros.parameters import declare_parameters
 from formation_ros.ros.runner import run
 from formation_ros.ros.team import announced
+from formation_ros.ros.wake import Wake
 from geometry_msgs.msg import PoseArray, PoseStamped
 from nav_msgs.msg import Odometry
 import numpy as np
-from rclpy.clock import Clock, ClockType
+from rclpy.clock import Clock, ClockType, JumpThreshold
+from rclpy.duration import Duration
 from rclpy.node import Node
 from scipy.spatial import cKDTree
 
@@ -60,9 +67,8 @@ class RelayNode(Node):
         self.team_keys = announced(team)
         settings = config.relay
         assert settings is not None
-        if self.get_parameter('use_sim_time').value:
-            raise ParamError([('use_sim_time', 'must be false: the relay stamps its states '
-                                               'with wall-clock time (a lab has no /clock)')])
+        self.sim_time = bool(self.get_parameter('use_sim_time').value)
+        """Whether the relay runs on a simulated world's /clock (else the host's clocks)."""
         self.settings = settings
         self.n, self.dim = config.num_robots, config.dim
         self.world_frame = config.world_frame
@@ -118,14 +124,25 @@ class RelayNode(Node):
                 PoseArray, topics.robot_topic(i, topics.NEIGHBOURS), qos.STATE))
         self.diagnostics_pub = self.create_publisher(
             DiagnosticArray, topics.DIAGNOSTICS, qos.DIAGNOSTICS)
-        self.timer = self.create_timer(1.0 / settings.rate, self.on_cycle, clock=self.steady)
+        self.period_ns = max(1, int(round(NS_PER_S / settings.rate)))
+        self.due_ns: Optional[int] = None
+        """Simulated time the next cycle is due at (on simulated time; None: the first)."""
+        if self.sim_time:
+            self.clock_moved = Wake(self, self.on_clock, self.steady)
+            self.jump_handle = self.get_clock().create_jump_callback(
+                JumpThreshold(min_forward=Duration(nanoseconds=1), min_backward=None),
+                post_callback=lambda jump: self.clock_moved.arm())
+        else:
+            self.timer = self.create_timer(1.0 / settings.rate, self.on_cycle,
+                                           clock=self.steady)
         self.diagnostics_timer = self.create_timer(PERIOD, self.on_diagnostics,
                                                    clock=self.steady)
         shown = ', '.join(self.sources[:3]) + (', ...' if self.n > 3 else '')
         self.get_logger().info(
             f'relay: {self.n} robots ({config.body.kind.value}s) measured on {shown} '
             f'({self.source_type_name}), publishing pose and neighbors in '
-            f"'{self.world_frame}' at {settings.rate:g} Hz, stale after {settings.max_age:g} s")
+            f"'{self.world_frame}' at {settings.rate:g} Hz, stale after {settings.max_age:g} s"
+            + (' (simulated time, /clock)' if self.sim_time else ''))
 
     def _refusal_line(self, robot: int, reason: Reason, detail: str) -> str:
         """Return the log line of robot ``robot``'s measurements refused for ``reason``."""
@@ -165,7 +182,7 @@ class RelayNode(Node):
         elif self._advances(index, pose.stamp_ns):
             self.positions[index] = pose.position
             self.orientations[index] = pose.orientation
-            self.received_ns[index] = time.monotonic_ns()
+            self.received_ns[index] = self.now_ns()
             self.measurements[index] += 1
 
     def _advances(self, index: int, stamp_ns: int) -> bool:
@@ -189,10 +206,31 @@ class RelayNode(Node):
                             'taking its measurements from here on')
         return True
 
+    def now_ns(self) -> int:
+        """
+        Return the time measurements are aged by, ns: the steady clock, or the simulated time.
+
+        In a lab a measurement's age is this host's time since it arrived (a mocap PC's clock
+        need not agree); beside a world on ``/clock`` it is simulated time since it arrived, so
+        a world running below real time does not age its measurements faster than it moves.
+        """
+        return self.get_clock().now().nanoseconds if self.sim_time else time.monotonic_ns()
+
+    def on_clock(self) -> None:
+        """On simulated time: run a cycle when one is due (every relay period of /clock)."""
+        now = self.now_ns()
+        due = self.due_ns
+        if due is not None and due - self.period_ns <= now < due:
+            return
+        if due is None or not due <= now < due + self.period_ns:
+            due = now
+        self.due_ns = due + self.period_ns
+        self.on_cycle()
+
     def on_cycle(self) -> None:
         """Publish the pose and sensor reading of every fresh robot, all with one stamp."""
         self.cycles += 1
-        now = time.monotonic_ns()
+        now = self.now_ns()
         measured = self.received_ns != NEVER
         fresh = measured & (now - self.received_ns <= self.max_age_ns)
         self._log_staleness(measured, fresh)
@@ -271,7 +309,7 @@ class RelayNode(Node):
         measured = self.received_ns != NEVER
         stale = [i + 1 for i in np.flatnonzero(self.stale & measured).tolist()]
         never = [i + 1 for i in np.flatnonzero(~measured).tolist()]
-        ages = (time.monotonic_ns() - self.received_ns[measured & ~self.stale]) / NS_PER_S
+        ages = (self.now_ns() - self.received_ns[measured & ~self.stale]) / NS_PER_S
         values = {'cycle rate achieved [Hz]': rate,
                   'cycle rate target [Hz]': self.settings.rate,
                   'cycles published': self.published_cycles,

@@ -105,7 +105,7 @@ class RobotNode(Node):
             config.world_frame, self.timeout_ns, self.sim_time, self.state_clock.follows_states,
             'a unicycle' if self.unicycle else 'command.frame body'), self.state_clock,
             self.once, leader.inputs.expected if shares and leader is not None else {})
-        period = settings.plant_period if self.sim_time else settings.relay_period
+        period = settings.answer_period(self.sim_time)
         self.watch_ns = max(1, int(round(NS_PER_S / settings.control_rate)))
         self.policy = AnswerPolicy(max(1, int(round(period * NS_PER_S))), self.timeout_ns,
                                    self.watch_ns, settings.wait_for_subscribers)

@@ -30,6 +30,13 @@ def test_the_launcher_runs_nothing_yet_so_every_clock_plant_and_relay_counts():
     assert occupants([], ['/relay']) == ['/relay']
 
 
-def test_hubs_are_named_plant_or_relay_in_any_namespace():
+def test_hubs_are_named_plant_relay_or_world_in_any_namespace():
     assert is_hub('/plant') and is_hub('/lab/relay')
     assert not is_hub('/plant_2') and not is_hub('/robot_1/robot') and not is_hub('/planter')
+
+
+def test_a_world_is_a_team_with_or_without_its_clock():
+    assert is_hub('/world') and is_hub('/lab/world') and not is_hub('/world_2')
+    assert occupants([], ['/world']) == ['/world']
+    assert occupants(['/world'], ['/world', '/relay']) == ['/relay', '/world']
+    assert occupants([], ['/world'], OWN) == ['/world']
