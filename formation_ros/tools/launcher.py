@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-The formation launcher: plant (or, in a lab, relay), reference node, N robots, the recorder.
+The formation launcher: plant (or relay, or world and relay), reference, N robots, the recorder.
 
 ``scripts/launch_formation.sh`` runs this module (``python -m formation_ros.tools.launcher``)
 with an interpreter that can import the installed package; the options and messages are those
@@ -60,22 +60,27 @@ Usage: scripts/launch_formation.sh PARAMS.yaml [--duration S] [--out DIR] [--rec
                                    [--robots-per-process K] [--prefix DIR] [--no-plots]
                                    [--discovery localhost|subnet] [--domain-id N]
                                    [--no-plant [--cmd-topic TEMPLATE] [--source-topic TEMPLATE]]
+                                   [--world]
 
 Starts the plant, the reference node and N robot nodes (N = num_robots in PARAMS.yaml), robot i
 in namespace /robot_<i>, all with the same parameters file, the reference node and robots
 on the plant's simulated time (/clock). With --no-plant (a lab), the relay instead of the
 plant, and the reference node and the robots on wall-clock time. Output lines are prefixed with
-the node's name. Stops every process it started when the duration ends, on Ctrl-C, SIGTERM or
-SIGHUP (then still writes the report of --out / --record), and when the plant (the relay), the
-reference node or the recorder exits on its own; what happens when a robot exits on its own is
+the node's name. With --world, a simulated lab: the physics world (MuJoCo) and the relay on
+its measured poses instead of the plant, every node on the world's /clock. Stops every process
+it started when the duration ends, on Ctrl-C, SIGTERM or SIGHUP (then still writes the report
+of --out / --record), and when the plant (the world, the relay), the reference node or the
+recorder exits on its own; what happens when a robot exits on its own is
 set by --on-exit. If the launcher itself is killed (even with kill -9), every node notices
 within 0.1 s and stops as on Ctrl-C.
 
 Options:
   --duration S   wall-clock seconds to run; 0 runs until Ctrl-C
                  (default: 'duration' in PARAMS.yaml divided by plant.realtime_factor;
-                 with --no-plant, 'duration' itself)
-  --out DIR      run directory: the plant writes trajectory.npz and plant_stats.json there,
+                 with --no-plant, 'duration' itself; with --world, divided by
+                 world.realtime_factor)
+  --out DIR      run directory: the plant writes trajectory.npz and plant_stats.json there
+                 (the world: trajectory.npz, world.xml and world_stats.json),
                  PARAMS.yaml is copied there, and formation_report writes metrics.json and the
                  figures there at the end (the directory must not exist yet, or be empty).
                  With --no-plant only together with --record: the report is made from the bag
@@ -131,6 +136,16 @@ Options:
                  time (use_sim_time false). A robot sends its first command once its base
                  driver subscribes to its command topic (wait_for_subscribers 1; 2 with
                  --record). The relay's exit stops the run, as the plant's does
+  --world        a simulated lab: the world (executable 'world', MuJoCo: docs/physics.md)
+                 publishes /clock and every robot's /robot_<i>/measured_pose and takes
+                 /robot_<i>/cmd_vel; the relay reads those poses (the file's
+                 relay.source_topic must be the world's, as by default) and, with the
+                 reference node and the robots, runs on the world's /clock (use_sim_time
+                 true; the robots are given relay.rate as the rate of their states:
+                 plant.rate and plant.publish_rate). With --out the world writes its
+                 outputs there and the report is made from them; its contacts and
+                 closest approach end the output. Not with --no-plant, --cmd-topic or
+                 plant.lockstep
   --cmd-topic TEMPLATE
                  (with --no-plant) remap each robot's cmd_vel onto its base's topic:
                  {i} is the robot id, {name} its entry of relay.source_names, e.g.
@@ -138,7 +153,8 @@ Options:
                  topic per robot. Not with --robots-per-process above 1 (a fleet's
                  remappings apply to all its robots). Default: /robot_<i>/cmd_vel
   --source-topic TEMPLATE
-                 (with --no-plant) the relay's relay.source_topic instead of PARAMS.yaml's,
+                 (with --no-plant or --world) the relay's relay.source_topic instead of
+                 PARAMS.yaml's,
                  e.g. /vrpn_mocap/{name}/pose: {i} and {name} as for --cmd-topic
   -h, --help     show this help
 
@@ -164,10 +180,11 @@ def read_parameters(options: 'Options') -> Formation:
     from formation_ros.core.declarations import ParamError
     from formation_ros.core.file_guard import ParamsFileError
     try:
-        return read_formation(options.params, plant=not options.no_plant,
+        return read_formation(options.params, plant=not (options.no_plant or options.world),
                               cmd_topic=options.cmd_topic, source_topic=options.source_topic,
                               robots_per_process=options.robots_per_process,
-                              cmd_option='--cmd-topic', source_option='--source-topic')
+                              cmd_option='--cmd-topic', source_option='--source-topic',
+                              world=options.world)
     except ParamsFileError as exc:
         raise UsageError(f'parameters file {exc.summary}') from None
     except ParamError as exc:
@@ -200,6 +217,9 @@ class Options:
     source_topic: Optional[str] = None
     cmd_topics: tuple[str, ...] = ()
     """Robot i's command topic at index i - 1, from ``cmd_topic`` (:func:`read_parameters`)."""
+    world: bool = False
+    relay_rate: float = 50.0
+    """``relay.rate`` of PARAMS (:func:`read_parameters`): the robots' state rate on a world."""
 
 
 def parse_args(argv: Sequence[str]) -> Optional[Options]:
@@ -213,6 +233,7 @@ def parse_args(argv: Sequence[str]) -> Optional[Options]:
     values: dict[str, Optional[str]] = dict.fromkeys(needs)
     params = None
     no_plant = False
+    world = False
     plots = True
     args = list(argv)
     while args:
@@ -222,6 +243,8 @@ def parse_args(argv: Sequence[str]) -> Optional[Options]:
             return None
         if arg == '--no-plant':
             no_plant = True
+        elif arg == '--world':
+            world = True
         elif arg == '--no-plots':
             plots = False
         elif arg.startswith('--') and name in values:
@@ -257,16 +280,25 @@ def parse_args(argv: Sequence[str]) -> Optional[Options]:
     domain_id = values['domain-id']
     if domain_id is not None and domain_problem(domain_id):
         raise UsageError(f'--domain-id {domain_problem(domain_id)}')
-    _check_lab_options(no_plant, values)
+    _check_lab_options(no_plant, values, world)
     prefix = values['prefix'] or os.environ.get('FORMATION_PREFIX') or None
     return Options(params, None if duration is None else float(duration), values['out'],
                    values['record'], prefix, on_exit, on_record_failure, int(per_process),
                    discovery, None if domain_id is None else int(domain_id), no_plant,
-                   plots, values['cmd-topic'], values['source-topic'])
+                   plots, values['cmd-topic'], values['source-topic'], world=world)
 
 
-def _check_lab_options(no_plant: bool, values: Mapping[str, Optional[str]]) -> None:
-    """Refuse the options that a run with (or without) the plant cannot honour."""
+def _check_lab_options(no_plant: bool, values: Mapping[str, Optional[str]],
+                       world: bool = False) -> None:
+    """Refuse the options that a run with (or without) the plant or with a world cannot honour."""
+    if world:
+        if no_plant:
+            raise UsageError('--world is a lab of its own: leave out --no-plant (the world '
+                             'replaces the plant, the relay reads the world)')
+        if values['cmd-topic'] is not None:
+            raise UsageError("--cmd-topic does not fit --world: the world reads every robot's "
+                             'command on /robot_<i>/cmd_vel')
+        return
     if not no_plant:
         if values['cmd-topic'] is not None:
             raise UsageError("--cmd-topic needs --no-plant: the plant reads every robot's "
@@ -367,15 +399,15 @@ def find_install(prefix: Optional[str], env: Mapping[str, str]) -> Install:
 
 def run_of(options: Options, num_robots: int) -> Run:
     """Return what ``options`` start for ``num_robots`` robots (``formation_ros.tools.system``)."""
-    return Run(num_robots, plant=not options.no_plant, record=options.record,
-               output_dir=options.out if not options.no_plant else None,
+    return Run(num_robots, plant=not (options.no_plant or options.world), world=options.world,
+               record=options.record, output_dir=options.out if not options.no_plant else None,
                robots_per_process=options.robots_per_process, cmd_topics=options.cmd_topics,
-               source_topic=options.source_topic)
+               source_topic=options.source_topic, relay_rate=options.relay_rate)
 
 
 def node_specs(install: Install, options: Options, num_robots: int,
                env: Mapping[str, str]) -> list[ProcessSpec]:
-    """Return the specs of plant (or relay), reference and robots, in the order they start."""
+    """Return the specs of plant (or world, relay), reference and robots, in starting order."""
     return [_spec(install, node, options, env) for node in plan(run_of(options, num_robots))
             if node.name != RECORDER]
 
@@ -588,7 +620,8 @@ class Launch:
             from formation_ros.core.trajectory import CHUNKS_DIR
             if not any(os.path.exists(os.path.join(options.out, name))
                        for name in (TRAJECTORY_FILE, CHUNKS_DIR)):
-                say(f'the plant wrote no trajectory to {options.out}')
+                maker = 'world' if options.world else 'plant'
+                say(f'the {maker} wrote no trajectory to {options.out}')
                 return 1
             source, target = options.out, options.out
         else:
@@ -600,7 +633,25 @@ class Launch:
         if code != 0:
             say(f'formation_report failed ({describe_returncode(code)})')
             return 1
+        if options.world and options.out is not None:
+            say(world_summary(options.out), sys.stdout)
         return 0
+
+
+def world_summary(out: str) -> str:
+    """Return the line of the world's contacts and closest approach from its world_stats.json."""
+    import json
+    where = os.path.join(out, 'world_stats.json')
+    try:
+        with open(where, encoding='utf-8') as stream:
+            stats = json.load(stream)
+        return (f"world: {stats['contacts']} contacts between robots, closest approach of two "
+                f"bodies {stats['min_body_distance']:.4g} m (footprints "
+                f"{stats['min_footprint_gap']:+.4g} m apart), {stats['simulated_time']:.2f} s "
+                f"simulated at {stats['achieved_realtime_factor']:.3g} x real time "
+                f'({where})')
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        return f'world: no statistics in {where} ({exc})'
 
 
 def _recording_failed(info: ExitInfo) -> bool:
@@ -692,6 +743,11 @@ def main(argv: Optional[Sequence[str]] = None, make: Optional[Callable[..., 'Lau
         if options.no_plant and install.prefix is not None and not _has(install.prefix, 'relay'):
             raise UsageError(f'--no-plant needs the relay: no '
                              f'{os.path.join(install.prefix, "lib", PACKAGE, "relay")}')
+        for needed in ('world', 'relay'):
+            if options.world and install.prefix is not None and not _has(install.prefix,
+                                                                         needed):
+                raise UsageError(f'--world needs the {needed}: no '
+                                 f'{os.path.join(install.prefix, "lib", PACKAGE, needed)}')
         team_look = look_at_domain(options) if look else None
         formation = read_parameters(options)
     except UsageError as exc:
@@ -702,7 +758,8 @@ def main(argv: Optional[Sequence[str]] = None, make: Optional[Callable[..., 'Lau
         else:
             say(exc.args[0])
         return 2
-    options = dataclasses.replace(options, cmd_topics=formation.cmd_topics)
+    options = dataclasses.replace(options, cmd_topics=formation.cmd_topics,
+                                  relay_rate=formation.relay_rate)
     chosen = ''
     if options.domain_id is None and not os.environ.get(DOMAIN_ENV):
         try:
@@ -739,7 +796,8 @@ def main(argv: Optional[Sequence[str]] = None, make: Optional[Callable[..., 'Lau
     processes = ('' if per_process == 1 else
                  f' in {-(-num_robots // per_process)} fleet processes of up to {per_process}')
     network = discovery_environment(options, os.environ)
-    lab = ', no plant (relay, wall-clock time)' if options.no_plant else ''
+    lab = (', no plant (relay, wall-clock time)' if options.no_plant else
+           ", on the world (world and relay, the world's /clock)" if options.world else '')
     domain = network.get(DOMAIN_ENV) or '0'
     join = (f' (a free domain of its own: {chosen}; to join it: export ROS_DOMAIN_ID={domain} '
             'before ros2 topic echo ...)' if chosen else '')

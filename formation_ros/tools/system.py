@@ -2,15 +2,17 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-What a formation run starts, in one place: the launcher and both launch files plan from here.
+What a formation run starts, in one place: the launcher and the launch files plan from here.
 
 A run is the simulated system (``plant``, ``reference`` and the robots on the plant's simulated
-time) or a lab (``relay`` instead of the plant, turning measured poses into each robot's pose
-and neighbours; reference and robots on wall-clock time, as there is no ``/clock``), with the
-recorder in front when recording. :func:`plan` returns its nodes as :class:`NodePlan` s: the
-executable, namespace, own arguments, parameter overrides (on top of the one parameters file)
-and remappings. ``formation_ros.tools.launcher`` turns them into command lines
-(:func:`ros_arguments`), ``launch/formation.launch.py`` and ``launch/lab.launch.py`` into
+time), a lab (``relay`` instead of the plant, turning measured poses into each robot's pose
+and neighbours; reference and robots on wall-clock time, as there is no ``/clock``) or a
+simulated lab (the physics ``world`` with the relay on its measured poses; relay, reference
+and robots on the world's ``/clock``), with the recorder in front when recording.
+:func:`plan` returns its nodes as :class:`NodePlan` s: the executable, namespace, own
+arguments, parameter overrides (on top of the one parameters file) and remappings.
+``formation_ros.tools.launcher`` turns them into command lines (:func:`ros_arguments`),
+``launch/formation.launch.py``, ``launch/lab.launch.py`` and ``launch/world.launch.py`` into
 ``launch_ros`` nodes (:func:`launch_nodes`), so that the two ways to start a run cannot drift
 apart. The discovery settings of the nodes (:func:`network_variables`), which processes end the
 run (:data:`ESSENTIAL`) and the order of stopping (:func:`stop_stages`) are also shared; a
@@ -52,7 +54,8 @@ FLEET_REMAP = ('cannot be used with more than one robot per process: the ROS arg
                "fleet apply to all of its robots (each named 'robot'), so their cmd_vel "
                'cannot be remapped one by one')
 RECORDER = 'record'
-ESSENTIAL = ('plant', 'relay', 'reference', RECORDER)
+WORLD = 'world'
+ESSENTIAL = ('plant', WORLD, 'relay', 'reference', RECORDER)
 """The processes whose end ends a run; the launcher's ``--on-exit`` says what a robot's does."""
 
 
@@ -84,20 +87,25 @@ class Run:
     """
     What to start.
 
-    plant: the simulated system (False: a lab, the relay instead of the plant); record: bag
-    directory of the recorder (None: no recorder); output_dir: where the plant writes its
-    trajectory (None: nowhere); robots_per_process: above 1, ``fleet`` processes;
+    plant: the simulated system (False: a lab, the relay instead of the plant); world: a
+    simulated lab (with ``plant`` False: the world and the relay on its measured poses, every
+    node on the world's /clock); record: bag directory of the recorder (None: no recorder);
+    output_dir: where the plant or the world writes its trajectory (None: nowhere);
+    robots_per_process: above 1, ``fleet`` processes;
     cmd_topics: robot i's command topic at index i - 1 (empty: ``/robot_<i>/cmd_vel``, no
-    remapping); source_topic: ``relay.source_topic`` for the relay (None: the file's).
+    remapping); source_topic: ``relay.source_topic`` for the relay (None: the file's);
+    relay_rate: ``relay.rate`` of the file (Hz), the rate of the robots' states beside a world.
     """
 
     num_robots: int
     plant: bool = True
+    world: bool = False
     record: Optional[str] = None
     output_dir: Optional[str] = None
     robots_per_process: int = 1
     cmd_topics: Tuple[str, ...] = ()
     source_topic: Optional[str] = None
+    relay_rate: float = 50.0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -106,18 +114,22 @@ class Formation:
 
     num_robots: int
     wall_seconds: float
-    """Default length of a run, s: ``duration`` / ``plant.realtime_factor`` (a lab: real time)."""
+    """Default length of a run, s: ``duration`` / ``plant.realtime_factor`` (a lab: real time;
+    a world: ``duration`` / ``world.realtime_factor``)."""
     cmd_topics: Tuple[str, ...] = ()
+    relay_rate: float = 50.0
 
 
 def plan(run: Run) -> List[NodePlan]:
     """
     Return the nodes of ``run`` in the order they start.
 
-    The recorder first (it must hear everything), then the plant or the relay, the reference
-    node and the robots. With the plant the reference and the robots run on its ``/clock``; in
-    a lab they are told ``use_sim_time: false`` (a file that says otherwise would stop them).
-    A robot's first command waits for 1 subscriber of its cmd_vel (the plant, or in a lab the
+    The recorder first (it must hear everything), then the plant, the world and the relay,
+    or the relay, the reference node and the robots. With the plant the reference and the
+    robots run on its ``/clock``; beside a world the relay does too, and the robots are given
+    the relay's rate as that of their states (``core.params.world_robot_rates``); in a lab they
+    are told ``use_sim_time: false`` (a file that says otherwise would stop them). A robot's
+    first command waits for 1 subscriber of its cmd_vel (the plant, the world, or in a lab the
     base driver on the remapped topic), 2 when the recorder listens too (remapped onto the
     same topics). Raises PlanError for remapped commands in fleets.
     """
@@ -130,12 +142,22 @@ def plan(run: Run) -> List[NodePlan]:
             plant.append(('plant.wait_for_subscribers', 2))
         nodes.append(NodePlan('plant', 'plant', parameters=tuple(plant)))
     else:
-        relay = (() if run.source_topic is None
-                 else (('relay.source_topic', run.source_topic),))
+        if run.world:
+            world = (() if run.output_dir is None
+                     else (('world.output_dir', run.output_dir),))
+            nodes.append(NodePlan(WORLD, WORLD, parameters=world))
+        relay: Tuple[Tuple[str, Any], ...] = (() if run.source_topic is None
+                                              else (('relay.source_topic', run.source_topic),))
+        if run.world:
+            relay += (('use_sim_time', True),)
         nodes.append(NodePlan('relay', 'relay', parameters=relay))
-    sim_time = ('use_sim_time', run.plant)
+    sim_time = ('use_sim_time', run.plant or run.world)
     nodes.append(NodePlan('reference', 'reference', parameters=(sim_time,)))
-    robot = (('wait_for_subscribers', 2 if run.record is not None else 1), sim_time)
+    robot: Tuple[Tuple[str, Any], ...] = (
+        ('wait_for_subscribers', 2 if run.record is not None else 1), sim_time)
+    if run.world:
+        from formation_ros.core.params import world_robot_rates
+        robot += world_robot_rates(run.relay_rate)
     per_process = run.robots_per_process
     if per_process == 1:
         for i in range(1, run.num_robots + 1):
@@ -198,15 +220,16 @@ def ros_arguments(node: NodePlan, params_file: str) -> List[str]:
     return args
 
 
-def launch_file_nodes(arguments: Mapping[str, str], plant: bool = True) -> List[Any]:
+def launch_file_nodes(arguments: Mapping[str, str], plant: bool = True,
+                      world: bool = False) -> List[Any]:
     """
     Return the ``launch_ros`` nodes of a launch file for its launch arguments' values.
 
     arguments: ``params_file``, ``record``, ``robots_per_process``, ``discovery``,
-    ``domain_id``, and ``output_dir`` (with the plant: ``launch/formation.launch.py``) or
-    ``cmd_topic`` and ``source_topic`` (without: ``launch/lab.launch.py``); '' is not given.
-    The parameters file is checked as the launcher checks it. Raises ValueError (ParamError,
-    PlanError) with what is wrong.
+    ``domain_id``, and ``output_dir`` (with the plant: ``launch/formation.launch.py``; with
+    ``world``: ``launch/world.launch.py``) or ``cmd_topic`` and ``source_topic`` (a lab:
+    ``launch/lab.launch.py``); '' is not given. The parameters file is checked as the launcher
+    checks it. Raises ValueError (ParamError, PlanError) with what is wrong.
     """
     params_file = arguments['params_file']
     per_process = int(arguments.get('robots_per_process') or 1)
@@ -221,14 +244,16 @@ def launch_file_nodes(arguments: Mapping[str, str], plant: bool = True) -> List[
         raise PlanError(f'domain_id {domain_problem(domain_id)}')
     env = network_variables(arguments.get('discovery') or None,
                             None if domain_id is None else int(domain_id), os.environ)
-    formation = read_formation(params_file, plant=plant,
+    formation = read_formation(params_file, plant=plant and not world,
                                cmd_topic=arguments.get('cmd_topic') or None,
                                source_topic=arguments.get('source_topic') or None,
-                               robots_per_process=per_process)
-    run = Run(formation.num_robots, plant=plant, record=arguments.get('record') or None,
+                               robots_per_process=per_process, world=world)
+    run = Run(formation.num_robots, plant=plant and not world, world=world,
+              record=arguments.get('record') or None,
               output_dir=arguments.get('output_dir') or None, robots_per_process=per_process,
               cmd_topics=formation.cmd_topics,
-              source_topic=arguments.get('source_topic') or None)
+              source_topic=arguments.get('source_topic') or None,
+              relay_rate=formation.relay_rate)
     return launch_nodes(plan(run), params_file, env, on_record_failure)
 
 
@@ -353,25 +378,28 @@ def topics_of(template: str, num_robots: int, names: Sequence[str],
 
 def read_formation(params_file: str, plant: bool = True, cmd_topic: Optional[str] = None,
                    source_topic: Optional[str] = None, robots_per_process: int = 1,
-                   cmd_option: str = 'cmd_topic', source_option: str = 'source_topic'
-                   ) -> Formation:
+                   cmd_option: str = 'cmd_topic', source_option: str = 'source_topic',
+                   world: bool = False) -> Formation:
     """
     Check ``params_file`` for every program a run starts; return what the run needs of it.
 
     cmd_topic: template of the robots' command topics (None: no remapping); source_topic:
     ``relay.source_topic`` instead of the file's (None: the file's); cmd_option /
-    source_option: how the caller spells them (``--cmd-topic``). Raises ParamError for the
-    file, PlanError (one line, naming the option) for the templates and for a lab (no
-    ``plant``) with ``transport: team``.
+    source_option: how the caller spells them (``--cmd-topic``); world: a simulated lab (the
+    world node too; ``plant`` is then False). Raises ParamError for the file, PlanError (one
+    line, naming the option) for the templates, for a lab (no ``plant``) with ``transport:
+    team`` and for a world whose relay would not read it (:func:`world_problem`).
     """
     from formation_ros.core.declarations import Exe, ParamError
-    from formation_ros.core.params import validate_for_every_executable
+    from formation_ros.core.params import validate, validate_for_every_executable
     from formation_ros.core.params_file import load_params_file
     raw = load_params_file(params_file)
     if source_topic is not None:
         raw['relay.source_topic'] = source_topic
     try:
         checked = validate_for_every_executable(raw)
+        if world:
+            checked[Exe.WORLD] = validate(raw, Exe.WORLD)
     except ParamError as exc:
         mine = [line for line in (f'{key} {message}' for key, message in exc.problems)
                 if 'relay.source_topic' in line]
@@ -392,5 +420,43 @@ def read_formation(params_file: str, plant: bool = True, cmd_topic: Optional[str
         if robots_per_process > 1:
             raise PlanError(f'{cmd_option} {FLEET_REMAP}')
         cmd_topics = topics_of(cmd_topic, config.num_robots, relay.source_names, cmd_option)
-    seconds = config.duration / (config.plant.realtime_factor if plant else 1.0)
-    return Formation(config.num_robots, seconds, cmd_topics)
+    factor = config.plant.realtime_factor if plant else 1.0
+    if world:
+        settings = checked[Exe.WORLD].world
+        assert settings is not None
+        factor = settings.realtime_factor
+        problem = world_problem(checked[Exe.RELAY], config.lockstep, source_option)
+        if problem is not None:
+            raise PlanError(problem)
+    return Formation(config.num_robots, config.duration / factor, cmd_topics, relay.rate)
+
+
+def world_problem(config: Any, lockstep: bool = False,
+                  source_option: str = 'source_topic') -> Optional[str]:
+    """
+    Return why the relay of ``config`` (a FormationConfig of the relay) cannot run on a world.
+
+    lockstep: ``plant.lockstep`` of the file.
+    The world publishes robot i's pose on ``/robot_<i>/measured_pose`` and, for unicycles, its
+    wheel odometry on ``/robot_<i>/odom``: the relay must read one of them with its type. A
+    lockstep file does not fit either: the world runs free.
+    """
+    from formation_ros.ros.topics import MEASURED_POSE, ODOM
+    relay = config.relay
+    assert relay is not None
+    kind = relay.source_type.value
+    topics = {'pose': MEASURED_POSE}
+    if config.body.is_unicycle:
+        topics['odometry'] = ODOM
+    wanted = topics.get(kind)
+    given = [relay.source(i) for i in range(1, config.num_robots + 1)]
+    if wanted is None or given != [robot_topic(i, wanted)
+                                   for i in range(1, config.num_robots + 1)]:
+        first = robot_topic(1, wanted or MEASURED_POSE)
+        return (f"the world's relay reads the world: relay.source_topic gives {given[0]!r} "
+                f'({kind}) for robot 1, not {first!r}; remove relay.source_topic (and '
+                f'relay.source_names, relay.source_type) from the file or pass {source_option} '
+                f"'/robot_{{i}}/measured_pose'")
+    if lockstep:
+        return 'plant.lockstep does not fit a world: the world runs free (set it false)'
+    return None

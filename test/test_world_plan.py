@@ -1,0 +1,112 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""A simulated lab: launch_formation.sh --world and launch/world.launch.py agree, bad ones refused."""
+
+import os
+
+from formation_ros.core.params_file import load_params_file, write_params_file
+import pytest
+from test_package import launched_nodes
+from test_scripts import make_fake_install, run
+from test_system_plan import launcher_views, node_view
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+WORLD = os.path.join(ROOT, 'config', 'world_turtlebot3.yaml')
+LAB = os.path.join(ROOT, 'config', 'lab_turtlebot3.yaml')
+
+
+@pytest.fixture
+def world_launch_file(monkeypatch):
+    """Give the test launch/world.launch.py on stand-ins (``test_package.load_launch_file``)."""
+    from test_package import load_launch_file
+    return load_launch_file(monkeypatch, 'world.launch.py')
+
+
+@pytest.fixture
+def world_install(tmp_path):
+    """Give the test an install prefix of stand-in nodes, world and relay included."""
+    return make_fake_install(tmp_path, ('plant', 'world', 'relay', 'reference', 'robot',
+                                        'record', 'fleet'))
+
+
+def test_the_world_relay_reference_and_robots_run_on_the_worlds_clock():
+    from formation_ros.core.declarations import BY_NAME as schema, Exe
+    views = launcher_views(WORLD, ['--world', '--out', '/nonexistent/w', '--record', '/nonexistent/w_bag'])
+    assert [view['executable'] for view in views] == ['record', 'world', 'relay',
+                                                      'reference'] + ['robot'] * 4
+    record, world, relay, reference, *robots = views
+    assert record['parameters'] == {'record.path': '/nonexistent/w_bag'}
+    assert world['parameters'] == {'world.output_dir': '/nonexistent/w'}
+    assert relay['parameters'] == {'use_sim_time': True}
+    assert reference['parameters'] == {'use_sim_time': True}
+    rate = load_params_file(WORLD)['relay.rate']
+    for i, robot in enumerate(robots, start=1):
+        assert robot['parameters'] == {'robot_id': i, 'wait_for_subscribers': 2,
+                                       'use_sim_time': True, 'plant.rate': rate,
+                                       'plant.publish_rate': rate}
+        assert robot['remappings'] == []
+    for view in views:
+        for name in view['parameters']:
+            assert name == 'use_sim_time' or Exe(view['executable']) in schema[name].users
+
+
+@pytest.mark.parametrize('argv, arguments', [
+    ((), {}),
+    (('--out', '/nonexistent/w'), {'output_dir': '/nonexistent/w'}),
+    (('--robots-per-process', '2', '--record', '/nonexistent/w_bag'),
+     {'robots_per_process': '2', 'record': '/nonexistent/w_bag'}),
+    (('--source-topic', '/robot_{i}/measured_pose'),
+     {'source_topic': '/robot_{i}/measured_pose'}),
+])
+def test_world_launch_file_starts_what_the_launcher_starts(world_launch_file, argv, arguments):
+    nodes = launched_nodes(world_launch_file, params_file=WORLD, **arguments)
+    assert [node_view(node) for node in nodes] == launcher_views(WORLD, ['--world', *argv])
+
+
+def test_world_launch_file_defaults_to_the_turtlebot3_like_team(world_launch_file):
+    nodes = launched_nodes(world_launch_file)
+    assert node_view(nodes[0])['executable'] == 'world'
+    assert node_view(nodes[0])['params_file'].endswith('config/world_turtlebot3.yaml')
+
+
+def lockstep(tmp_path):
+    path = str(tmp_path / 'lockstep.yaml')
+    write_params_file(path, dict(load_params_file(WORLD), **{'plant.lockstep': True}))
+    return path
+
+
+@pytest.mark.parametrize('params, args, says', [
+    (LAB, (), "the world's relay reads the world: relay.source_topic gives "
+              "'/vrpn_mocap/tb1/pose' (pose) for robot 1, not '/robot_1/measured_pose'"),
+    (WORLD, ('--source-topic', '/mocap/robot_{i}'), "the world's relay reads the world"),
+    (WORLD, ('--no-plant',), '--world is a lab of its own: leave out --no-plant'),
+    (WORLD, ('--cmd-topic', '/tb{i}/cmd_vel'), '--cmd-topic does not fit --world'),
+    (None, (), 'plant.lockstep does not fit a world'),
+])
+def test_world_runs_that_cannot_work_are_refused_in_one_line(world_install, tmp_path, params,
+                                                             args, says):
+    result = run('launch_formation.sh', params or lockstep(tmp_path), '--world', *args,
+                 '--prefix', str(world_install))
+    assert result.returncode == 2
+    assert result.stderr.startswith(f'launch_formation.sh: {says}'), result.stderr
+    assert len(result.stderr.splitlines()) == 1, result.stderr
+    assert result.stdout == ''
+
+
+def test_an_install_without_the_world_is_refused(world_install):
+    (world_install / 'lib' / 'formation_ros' / 'world').unlink()
+    result = run('launch_formation.sh', WORLD, '--world', '--prefix', str(world_install))
+    assert result.returncode == 2
+    assert result.stderr == ('launch_formation.sh: --world needs the world: no '
+                             f"{world_install / 'lib' / 'formation_ros' / 'world'}\n")
+
+
+def test_help_tells_the_world_option():
+    usage = run('launch_formation.sh', '--help').stdout
+    assert '[--world]' in usage and '--world        a simulated lab' in usage
+
+
+def test_world_launch_file_refuses_a_lab_file(world_launch_file):
+    with pytest.raises(ValueError, match="the world's relay reads the world"):
+        launched_nodes(world_launch_file, params_file=LAB)
