@@ -23,6 +23,7 @@ import numpy as np
 import pytest
 from rclpy.clock import Clock, ClockType
 from rclpy.qos import QoSProfile, ReliabilityPolicy
+from rosgraph_msgs.msg import Clock as ClockMsg
 import wire
 
 START_UP = 90.0
@@ -303,19 +304,75 @@ def test_a_frozen_source_goes_stale_an_unstamped_one_is_taken_a_restarted_one_re
     assert 'Traceback' not in log
 
 
-def test_relay_refuses_sim_time_and_a_source_that_is_its_own_output(install, processes,
-                                                                    probe, tmp_path):
+def test_relay_refuses_a_source_that_is_its_own_output(install, processes, probe, tmp_path):
     params = write_params(tmp_path, 'square_4.yaml', {'relay.source_topic': '/robot_{i}/pose'})
     processes.start(node(install, 'relay', params, process='looped'))
-    processes.start(node(install, 'relay', write_params(tmp_path, 'square_4.yaml', {},
-                                                        name='plain.yaml'),
-                         '-p', 'use_sim_time:=true', process='sim_time'))
-    for name, words in (('looped', "parameter 'relay.source_topic'"),
-                        ('sim_time', "parameter 'use_sim_time'")):
-        assert probe.spin_until(lambda: not processes.running(name), START_UP)
-        info = processes.exit_info(name)
-        assert info.returncode == 2, processes.log(name)
-        assert words in processes.log(name) and 'Traceback' not in processes.log(name)
+    assert probe.spin_until(lambda: not processes.running('looped'), START_UP)
+    info = processes.exit_info('looped')
+    assert info.returncode == 2, processes.log('looped')
+    log = processes.log('looped')
+    assert "parameter 'relay.source_topic'" in log and 'Traceback' not in log
+
+
+SLOW_WORLD = 0.25
+"""Simulated seconds per wall-clock second of the probe's world (below real time)."""
+TICK_NS = 10_000_000
+"""The probe world's /clock and measured poses: every 10 ms of simulated time."""
+
+
+def test_relay_on_a_worlds_clock_stamps_and_ages_in_simulated_time(
+        install, processes, probe, tmp_path):
+    """
+    A world at a quarter of real time: /clock and measured poses every 10 ms simulated.
+
+    The relay (use_sim_time) publishes a cycle every 20 ms of simulated time (relay.rate 50
+    Hz; a cycle late by a tick the probe's world missed, the next one on time), stamped with
+    it; robot 2, no longer measured, is stale only after relay.max_age of
+    simulated time (0.2 s: 0.8 s of wall-clock time here), not of wall-clock time.
+    """
+    params = write_params(tmp_path, 'square_4.yaml', {})
+    outputs = Outputs(probe, 4)
+    processes.start(node(install, 'relay', params, '-p', 'use_sim_time:=true'))
+    clock = probe.create_publisher(ClockMsg, '/clock', qos.CLOCK)
+    sources = [probe.create_publisher(PoseStamped, f'/robot_{i}/measured_pose', qos.MEASUREMENT)
+               for i in range(1, 5)]
+    world = {'began': None, 'ns': -1, 'measured': {1, 2, 3, 4}, 'last_2': None}
+
+    def step():
+        now = steady_s()
+        if world['began'] is None:
+            world['began'] = now
+        t_ns = int((now - world['began']) * SLOW_WORLD * NS_PER_S) // TICK_NS * TICK_NS
+        if t_ns == world['ns']:
+            return
+        world['ns'] = t_ns
+        message = ClockMsg()
+        message.clock.sec, message.clock.nanosec = divmod(t_ns, NS_PER_S)
+        clock.publish(message)
+        for i in world['measured']:
+            sources[i - 1].publish(wire.pose_stamped_bytes(t_ns, 'world', POSITIONS[i - 1]))
+        if 2 in world['measured']:
+            world['last_2'] = t_ns
+
+    def cycles(count):
+        step()
+        return len(outputs.poses[1]) >= count
+
+    assert probe.spin_until(lambda: cycles(20), START_UP), processes.log('relay')
+    stamps = [fields.stamp_to_ns(m.header.stamp) for m in outputs.poses[1]]
+    assert stamps[-1] <= world['ns'] < 5 * NS_PER_S, 'stamped with the simulated time'
+    gaps = np.diff(stamps)
+    assert np.all(gaps >= TICK_NS) and np.median(gaps) == 20_000_000, gaps
+    assert 19e6 <= np.mean(gaps) <= 25e6, gaps
+    world['measured'].discard(2)
+    assert probe.spin_until(lambda: step() or world['ns'] > world['last_2'] + 150_000_000, 30)
+    fresh = fields.stamp_to_ns(outputs.poses[2][-1].header.stamp)
+    assert fresh >= world['last_2'] + 100_000_000, 'stale after 0.2 s simulated, not wall'
+    assert probe.spin_until(lambda: step() or world['ns'] > world['last_2'] + 400_000_000, 30)
+    last = fields.stamp_to_ns(outputs.poses[2][-1].header.stamp)
+    assert last <= world['last_2'] + 200_000_000 + TICK_NS, (last, world['last_2'])
+    assert fields.stamp_to_ns(outputs.poses[1][-1].header.stamp) > world['last_2'] + 3e8
+    assert 'simulated time, /clock' in processes.log('relay')
 
 
 def test_mocap_dropout_stops_one_robot_and_the_others_keep_it_in_their_lists(

@@ -92,8 +92,11 @@ def test_the_team_forms_on_the_world_through_the_relay(processes, install, probe
     source, changes = TEAMS[team]
     params = write_params(tmp_path, source, dict(changes, num_robots=3))
     config = load_config(params)
+    start = config.start
+    if config.body.is_unicycle:
+        start = hand_points(start, config.start_headings, config.body.hand_distance)
+    assert np.min(np.linalg.norm(start - config.vertices, axis=1)) > 1.5 * TOLERANCE
     watched = Team(probe, config)
-    assert not watched.formed()
     out = tmp_path / 'run'
     launch(processes, install, params, out=out, options=('--world',), per_process=3)
     info = stop_when(probe, processes, watched.formed, timeout=START_UP + 60)
