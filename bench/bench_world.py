@@ -215,7 +215,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     print(f"| {args.robots} | {args.rate:g} | {processes} | {row['measured_wall_s']:.1f} | "
           f"{row['realtime_factor_measured']:.4f} | {row['realtime_factor_world']:.4f} | "
           f"{row['states']} | {100 * (row['fresh_fraction'] or 0):.2f} % | {row['contacts']} | "
-          f"{load_before[0]:.2f} / {load_after[0]:.2f} |")
+          f'{load_before[0]:.2f} / {load_after[0]:.2f} |')
     if args.json:
         with open(args.json, 'w', encoding='utf-8') as stream:
             json.dump(row, stream, indent=2)
