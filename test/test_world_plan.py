@@ -1,7 +1,7 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""A simulated lab: launch_formation.sh --world and launch/world.launch.py agree, bad ones refused."""
+"""A simulated lab: launch_formation.sh --world and world.launch.py agree; misfits refused."""
 
 import os
 
@@ -32,7 +32,8 @@ def world_install(tmp_path):
 
 def test_the_world_relay_reference_and_robots_run_on_the_worlds_clock():
     from formation_ros.core.declarations import BY_NAME as schema, Exe
-    views = launcher_views(WORLD, ['--world', '--out', '/nonexistent/w', '--record', '/nonexistent/w_bag'])
+    views = launcher_views(WORLD, ['--world', '--out', '/nonexistent/w', '--record',
+                                   '/nonexistent/w_bag'])
     assert [view['executable'] for view in views] == ['record', 'world', 'relay',
                                                       'reference'] + ['robot'] * 4
     record, world, relay, reference, *robots = views
