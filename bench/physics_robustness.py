@@ -51,11 +51,11 @@ import numpy as np  # noqa: E402
 RESULT = 'robustness_physics.json'
 FIGURE = 'robustness_physics_{}.png'
 TEAMS: Dict[str, Dict[str, Any]] = {
-    'turtlebot3': {'path': 'config/unicycle_2d.yaml', 'duration': 70.0,
+    'turtlebot3': {'path': 'config/unicycle_2d.yaml', 'duration': 90.0,
                    'what': 'six TurtleBot3-like differential-drive bases'},
-    'crossing': {'path': 'bench/physics_crossing.yaml', 'duration': 70.0,
+    'crossing': {'path': 'bench/physics_crossing.yaml', 'duration': 120.0,
                  'what': 'the same bases started across the hexagon from their places'},
-    'holonomic': {'path': 'config/lab_holonomic.yaml', 'duration': 45.0,
+    'holonomic': {'path': 'config/lab_holonomic.yaml', 'duration': 60.0,
                   'what': 'four holonomic bases, commands in their body frame'},
 }
 CONTROL_DT = 'control.dt'
@@ -456,22 +456,34 @@ def fit_markdown(fit: Dict[str, Any]) -> str:
 COLOURS = {'turtlebot3': 'tab:orange', 'crossing': 'tab:blue', 'holonomic': 'tab:green'}
 
 
-def x_of(sweep: str, value: float) -> float:
-    """Where a value goes on its panel's x axis (log axes: no noise is drawn at 1 mm)."""
-    return 1e-3 if sweep == 'noise' and value == 0.0 else float(value)
+NOISE_ZERO_X = 1e-3
+"""Where the noise panel draws no noise (log axis), m."""
+TICKS = {'torque': [1.0, 0.5, 0.2, 0.1, 0.05, 0.02], 'mass': [1.0, 2.0, 5.0, 10.0, 20.0, 50.0],
+         'friction': [1.0, 0.3, 0.1, 0.03, 0.01], 'rate': [0.02, 0.05, 0.1, 0.2, 0.4],
+         'noise': [NOISE_ZERO_X, 0.01, 0.03, 0.1, 0.3]}
+X_LABELS = {'torque': "the motors' limit / the default (0.2 N m per wheel; holonomic: 5 N)",
+            'mass': 'world.mass (kg)', 'friction': 'world.floor_friction',
+            'rate': 'control period dt (s)', 'noise': 'world.pose_noise (m)'}
+
+
+def x_of(sweep: str, team: str, value: float) -> float:
+    """Where a value goes on its panel's log x axis (torque: over the default; no noise)."""
+    if sweep == 'torque':
+        return float(value) / DEFAULTS[sweep_parameter(sweep, team)]
+    return NOISE_ZERO_X if sweep == 'noise' and value == 0.0 else float(value)
 
 
 def sweeps_figure(plt: Any, table: Dict[str, Any], path: str) -> None:
     """Draw the closest approach over the footprints' size and the settle time per knob."""
     sweeps = list(table)
-    figure, axes = plt.subplots(2, len(sweeps), figsize=(3.2 * len(sweeps), 6.0),
+    figure, axes = plt.subplots(2, len(sweeps), figsize=(3.2 * len(sweeps), 6.2),
                                 squeeze=False)
     for column, sweep in enumerate(sweeps):
         top, bottom = axes[0][column], axes[1][column]
-        for team in sorted({row['team'] for row in table[sweep]['rows']}):
+        for team in [t for t in TEAMS if any(r['team'] == t for r in table[sweep]['rows'])]:
             rows = [r for r in table[sweep]['rows'] if r['team'] == team
                     and 'refused' not in r['summary']]
-            xs = [x_of(sweep, r['value']) for r in rows]
+            xs = [x_of(sweep, team, r['value']) for r in rows]
             ratio = [r['summary']['closest_bodies'] / r['size'] for r in rows]
             top.plot(xs, ratio, marker='o', color=COLOURS[team], label=team)
             touched = [(x, y) for x, y, r in zip(xs, ratio, rows) if r['summary']['contacts']]
@@ -482,29 +494,33 @@ def sweeps_figure(plt: Any, table: Dict[str, Any], path: str) -> None:
                       if r['summary']['settle_time'] is not None]
             if settle:
                 bottom.plot(*zip(*settle), marker='o', color=COLOURS[team], label=team)
-            unsettled = [x for x, r in zip(xs, rows) if r['summary']['settle_time'] is None]
+            unsettled = [(x, r['summary'].get('duration', 0.0)) for x, r in zip(xs, rows)
+                         if r['summary']['settle_time'] is None]
             if unsettled:
-                duration = max(r['summary'].get('duration', 0.0) for r in rows) or None
-                bottom.scatter(unsettled, [duration or 0.0] * len(unsettled), marker='v',
-                               color=COLOURS[team], label=f'{team}: not settled')
+                bottom.scatter(*zip(*unsettled), marker='v', s=50, color=COLOURS[team],
+                               label=f'{team}: not settled by the end')
         top.axhline(1.0, color='k', linestyle='--', linewidth=1.0)
         for axis in (top, bottom):
             axis.set_xscale('log')
+            axis.set_xticks(TICKS[sweep])
+            axis.set_xticklabels(['0' if sweep == 'noise' and x == NOISE_ZERO_X else f'{x:g}'
+                                  for x in TICKS[sweep]], fontsize=7)
+            axis.minorticks_off()
             axis.grid(True, alpha=0.3)
             if sweep in ('torque', 'friction'):
                 axis.invert_xaxis()
-        parameter = PHYSICS_SWEEPS[sweep]['parameter']
-        name = parameter if isinstance(parameter, str) else ' / '.join(parameter.values())
-        bottom.set_xlabel(f"{name} ({table[sweep]['unit'].split(' (')[0]})", fontsize=8)
+        bottom.set_xlabel(X_LABELS[sweep], fontsize=7)
         top.set_title(f'{sweep} (harsher to the right)', fontsize=9)
         top.set_ylim(bottom=0.0)
         bottom.set_ylim(bottom=0.0)
         if column == 0:
             top.set_ylabel("closest approach / footprints' size 2 r")
-            bottom.set_ylabel('settle time (s), v: not settled')
-            top.legend(fontsize=7)
-    figure.suptitle('On the physics engine: closest approach (dashed: footprints touch) '
-                    'and settle time', fontsize=10)
+            bottom.set_ylabel('settle time (s); v: not settled')
+            top.legend(fontsize=7, loc='lower left')
+        if column == len(sweeps) - 1:
+            bottom.legend(fontsize=6, loc='lower left')
+    figure.suptitle('On the physics engine: closest approach of two bodies (dashed: their '
+                    'footprints touch) and settle time, one knob at a time', fontsize=10)
     figure.tight_layout()
     figure.savefig(path, dpi=90)
     plt.close(figure)
