@@ -146,12 +146,14 @@ def ros2_run_problem(command, variables):
     if len(files) != 1 or not os.path.isfile(files[0]):
         return f'no parameters file: {files}'
     raw = load_params_file(files[0])
-    lab = any(name.startswith('relay.') for name in raw)
+    world = any(name.startswith('world.') for name in raw)
+    lab = any(name.startswith('relay.') for name in raw) and not world
     sim_time = overrides.pop('use_sim_time', False)
-    if executable in ON_SIM_TIME and sim_time is lab:
+    on_sim_time = ON_SIM_TIME + (('relay',) if world else ())
+    if executable in on_sim_time and sim_time is lab:
         return 'a lab runs on wall-clock time' if lab else 'needs -p use_sim_time:=true'
-    if executable not in ON_SIM_TIME and sim_time:
-        return 'the plant, recorder and relay must not wait for /clock'
+    if executable not in on_sim_time and sim_time:
+        return 'the plant, world, recorder and lab relay must not wait for /clock'
     raw.update(overrides)
     if executable == 'robot':
         match = re.fullmatch(r'/robot_([0-9]+)', namespace or '')
@@ -193,6 +195,12 @@ def test_every_ros2_run_line_starts_as_written(path):
      '-p use_sim_time:=true', '__ns'),
     ('ros2 run formation_ros plant --ros-args --params-file config/square_4.yaml '
      '-p controller.gian:=2.0', 'unknown parameter'),
+    ('ros2 run formation_ros relay --ros-args --params-file config/world_3d.yaml',
+     'needs -p use_sim_time:=true'),
+    ('ros2 run formation_ros relay --ros-args --params-file config/lab_holonomic.yaml '
+     '-p use_sim_time:=true', 'must not wait for /clock'),
+    ('ros2 run formation_ros world --ros-args --params-file config/world_3d.yaml '
+     '-p use_sim_time:=true', 'must not wait for /clock'),
     ('ros2 run formation_ros plant --ros-args --params-file config/square_4.yaml '
      '-p controller.gain:=2', 'must be a double'),
     ('ros2 run formation_ros robot --ros-args -r __ns:=/robot_9 --params-file $P '
