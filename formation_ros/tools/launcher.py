@@ -128,7 +128,7 @@ Options:
                  on which no DDS participant is seen), said in its first line with how to
                  join it (export ROS_DOMAIN_ID=N). A domain given here or in ROS_DOMAIN_ID
                  is looked at first (a few seconds at most): where another team runs (a
-                 /clock publisher, a plant or a relay) nothing starts, exit code 2
+                 /clock publisher, a plant, a relay or a world) nothing starts, exit code 2
   --no-plant     a lab: no plant and no /clock. The relay (executable 'relay') reads every
                  robot's measured pose (relay.source_topic, relay.source_names and
                  relay.source_type in PARAMS.yaml) and publishes /robot_<i>/pose and
