@@ -411,10 +411,10 @@ DECLARATIONS = (
           "Message type of the measured poses: 'pose' (geometry_msgs/PoseStamped) or "
           "'odometry' (nav_msgs/Odometry).", choices=_choices(SourceType), users=RELAY),
     Param('relay.rate', Kind.DOUBLE, 50.0,
-          'Cycles per second of the relay, Hz (wall clock): each publishes every pose and '
-          'neighbour list with one stamp; robots on wall-clock time answer at most about one '
-          'state per cycle.', low=above(0.0), high=at_least(10000.0),
-          users=RELAY | {Exe.ROBOT}),
+          'Cycles per second of the relay, Hz (of wall-clock time in a lab, of simulated '
+          'time beside a world): each publishes every pose and neighbour list with one '
+          'stamp; robots answer at most about one state per cycle.', low=above(0.0),
+          high=at_least(10000.0), users=RELAY | {Exe.ROBOT}),
     Param('relay.max_age', Kind.DOUBLE, 0.2,
           'A robot whose latest measurement is older than this is stale, s: it gets no pose '
           "(its watchdog stops it) but stays in the others' neighbour lists at its last "

@@ -62,7 +62,7 @@ machine, 2026-12-03)."""
 SETTLE = 0.15
 """With every participant bound on this host seen and its nodes named, how long the graph must
 stay the same before the look ends with no team found, s (a participant's endpoints come in
-one burst; a plant or relay is found by its name as soon as its nodes are named)."""
+one burst; a plant, relay or world is found by its name as soon as its nodes are named)."""
 DOMAIN_ENV = 'ROS_DOMAIN_ID'
 DISCOVERY_ENV = 'ROS_AUTOMATIC_DISCOVERY_RANGE'
 PROBE_NODE = 'formation_domain_probe'
