@@ -66,7 +66,8 @@ def lockstep_run(processes, probe, install, tmp_path, transport):
     clock = SimClock(probe)
     statuses = {}
     diagnostics = probe.create_subscription(DiagnosticArray, '/diagnostics', lambda message: (
-        statuses.update({status.name: (status.message, {pair.key for pair in status.values})
+        statuses.update({status.name: (status.message,
+                                       {pair.key: pair.value for pair in status.values})
                          for status in message.status})), qos.DIAGNOSTICS)
     robots = [f'formation_ros/robot_{i}' for i in range(1, 5)]
 
@@ -82,8 +83,12 @@ def lockstep_run(processes, probe, install, tmp_path, transport):
     assert robot_subscribers(probe, '/formation/shape') == leaders
     assert robot_subscribers(probe, '/formation/status') == leaders
     assert robot_subscribers(probe, '/clock') == []
-    info = stop_when(probe, processes, lambda: clock.seconds >= UNTIL and every_robot_reports(),
-                     name=transport)
+    try:
+        info = stop_when(probe, processes,
+                         lambda: clock.seconds >= UNTIL and every_robot_reports(), name=transport)
+    except AssertionError as exc:
+        raise AssertionError(f'{exc}\nsimulated time {clock.seconds} s; the robots\' last '
+                             f'statuses: {statuses}') from None
     probe.destroy_subscription(clock.subscription)
     probe.destroy_subscription(diagnostics)
     assert info.returncode == 0, processes.log(transport)
