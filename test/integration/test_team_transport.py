@@ -87,8 +87,8 @@ def lockstep_run(processes, probe, install, tmp_path, transport):
         info = stop_when(probe, processes,
                          lambda: clock.seconds >= UNTIL and every_robot_reports(), name=transport)
     except AssertionError as exc:
-        raise AssertionError(f'{exc}\nsimulated time {clock.seconds} s; the robots\' last '
-                             f'statuses: {statuses}') from None
+        raise AssertionError(f'{exc}\nsimulated time {clock.seconds} s; last statuses of '
+                             f'the robots: {statuses}') from None
     probe.destroy_subscription(clock.subscription)
     probe.destroy_subscription(diagnostics)
     assert info.returncode == 0, processes.log(transport)
