@@ -15,7 +15,7 @@ from typing import Dict, List, Optional, Sequence, Union
 
 from formation_ros.core.admission import Reason, refusal, Refusals
 from formation_ros.core.plant import Commands
-from formation_ros.core.transport import commands_of
+from formation_ros.core.transport import command_of, commands_of
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -63,8 +63,8 @@ class CommandIntake:
                 return reason
         else:
             stamp_ns = self.state_stamp_ns
-        self.commands.store(index, (linear[0], angular[2]) if self.unicycles
-                            else linear[:self.dim], stamp_ns)
+        self.commands.store(index, command_of(linear, angular, self.dim, self.unicycles),
+                            stamp_ns)
         self.arrived_ns[index] = arrived_ns
         return None
 

@@ -83,6 +83,12 @@ def command_vectors(u: ArrayLike,
     return linear, angular
 
 
+def command_of(linear: Sequence[float], angular: Sequence[float], dim: int,
+               unicycle: bool) -> Tuple[float, ...]:
+    """Return a twist's command: linear[:dim], or (v, w) = (linear.x, angular.z) if unicycle."""
+    return (linear[0], angular[2]) if unicycle else tuple(linear[:dim])
+
+
 def commands_of(linear: ArrayLike, angular: ArrayLike, dim: int,
                 unicycle: bool) -> NDArray[np.float64]:
     """Return the commands (K, dim), or (K, 2) (v, w) for unicycles, of (K, 3) twists."""

@@ -20,6 +20,7 @@ import math
 from typing import Optional, Sequence, Tuple
 
 from formation_ros.core.admission import Reason, refusal
+from formation_ros.core.transport import command_of
 import numpy as np
 from numpy.typing import NDArray
 
@@ -59,7 +60,7 @@ class CommandInbox:
         linear, angular: (3,) m/s and rad/s; frame_id, stamp_ns: its header's (a Twist's are
         not looked at); now_ns: the world's simulated time, ns.
         """
-        values = (linear[0], angular[2]) if self.unicycles else tuple(linear[:self.dim])
+        values = command_of(linear, angular, self.dim, self.unicycles)
         finite = all(math.isfinite(value) for value in values)
         expected = self.command_frames[index]
         reason = refusal(frame_id if self.stamped else expected, expected, finite)

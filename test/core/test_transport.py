@@ -6,8 +6,8 @@
 from formation_ros.core.frames import frame_from_pose, STATIONARY
 from formation_ros.core.law import make_law, robot_command, robot_commands
 from formation_ros.core.sensing import neighbour_lists, sensed_pairs, sensor_radii
-from formation_ros.core.transport import (command_vectors, commands_of, robot_indices,
-                                          robot_name, state_rows)
+from formation_ros.core.transport import (command_of, command_vectors, commands_of,
+                                          robot_indices, robot_name, state_rows)
 from formation_ros.core.unicycle import quaternions_from_headings
 import numpy as np
 import pytest
@@ -51,6 +51,8 @@ def test_command_twists_are_what_cmd_vel_carries(unicycle):
         assert linear.tolist() == [[0.5, -0.25, 0.0], [1.0, 2.0, 0.0]]
         assert not angular.any()
     assert np.array_equal(commands_of(linear, angular, 2, unicycle), u)
+    for k in range(len(u)):
+        assert command_of(linear[k], angular[k], 2, unicycle) == tuple(u[k])
 
 
 def test_a_fleets_sensing_is_the_whole_teams_for_its_robots():
