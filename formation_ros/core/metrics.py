@@ -5,7 +5,8 @@
 Numbers that show the controller kept its promises, from sampled runs (Section 5).
 
 Inputs are sampled trajectories: t (T,) in s, q and q_desired (T, N, dim) in m, u and u_hat
-(T, N, dim) in m/s. The same functions serve ``formation_sim`` and the bag report.
+(T, N, dim) in m/s (NaN rows: commands the run cannot tell, ``core.trajectory``). The same
+functions serve ``formation_sim`` and the bag report.
 """
 
 import math
@@ -99,6 +100,38 @@ def dis_all_series(t: ArrayLike,
     return times[index], np.array([dis_all(positions[k]) for k in index])
 
 
+def largest_component(values: ArrayLike) -> Optional[float]:
+    """Return the largest |component| of (..., dim) values, NaN left out; None if all are NaN."""
+    magnitudes = np.abs(np.asarray(values, dtype=float))
+    known = magnitudes[~np.isnan(magnitudes)]
+    return float(np.max(known)) if known.size else None
+
+
+def unknown_commands(values: ArrayLike) -> int:
+    """Return how many (sample, robot) commands (..., dim) are unknown (a NaN component)."""
+    return int(np.count_nonzero(np.any(np.isnan(np.asarray(values, dtype=float)), axis=-1)))
+
+
+def above(values: ArrayLike, bound: float) -> int:
+    """Return how many components of ``values`` exceed ``bound`` (beyond rounding); NaN not."""
+    magnitudes = np.abs(np.asarray(values, dtype=float))
+    return int(np.count_nonzero(magnitudes > bound * (1.0 + 1e-12)))
+
+
+def held_metrics(u_hat_held: ArrayLike, u_bound: float) -> dict[str, Any]:
+    """
+    Return the metrics.json keys of u_hat_held (``core.trajectory``): (T, N, dim) m/s.
+
+    The held command read at the body's heading at each sample is u_hat turned by the heading
+    turned since the state it answered; a rotation keeps the Euclidean norm, so its components
+    stay within sqrt(2) c M1 (``u_hat_held_bound``), not c M1 (u_bound, m/s).
+    """
+    bound = math.sqrt(2.0) * u_bound
+    return {'max_abs_u_hat_held_component': largest_component(u_hat_held),
+            'u_hat_held_bound': bound,
+            'u_hat_held_above_bound': above(u_hat_held, bound)}
+
+
 def compute_metrics(t: ArrayLike, q: ArrayLike, u: ArrayLike, u_hat: ArrayLike,
                     q_desired: ArrayLike, u_bound: float,
                     extra: Optional[Mapping[str, Any]] = None) -> dict[str, Any]:
@@ -106,13 +139,16 @@ def compute_metrics(t: ArrayLike, q: ArrayLike, u: ArrayLike, u_hat: ArrayLike,
     Return the metrics.json dictionary of a run.
 
     u_bound: c * M1 (m/s), the bound every component of u_hat must keep; with a fixed reference
-    u equals u_hat. extra: more keys to merge (e.g. reference kind, integrator).
+    u equals u_hat. extra: more keys to merge (e.g. reference kind, integrator). Commands the
+    run cannot tell (NaN) are left out of the maxima (None if every one is) and counted under
+    ``unknown_commands``, a key only present when there are some.
     """
     times = np.asarray(t, dtype=float)
     positions = np.asarray(q, dtype=float)
     errors = formation_errors(positions, q_desired)
     settle = settle_time(times, errors)
     bounded = np.asarray(u_hat, dtype=float)
+    unknown = unknown_commands(bounded)
     num_robots, dim = positions.shape[1], positions.shape[2]
     metrics: dict[str, Any] = {
         'num_robots': int(num_robots),
@@ -126,11 +162,13 @@ def compute_metrics(t: ArrayLike, q: ArrayLike, u: ArrayLike, u_hat: ArrayLike,
         'final_mean_error': float(np.mean(errors[-1])),
         'settle_tolerance': SETTLE_TOLERANCE,
         'settle_time': settle,
-        'max_abs_u_component': float(np.max(np.abs(u))),
-        'max_abs_u_hat_component': float(np.max(np.abs(bounded))),
+        'max_abs_u_component': largest_component(u),
+        'max_abs_u_hat_component': largest_component(bounded),
         'u_bound': float(u_bound),
-        'bound_violations': int(np.count_nonzero(np.abs(bounded) > u_bound * (1.0 + 1e-12))),
+        'bound_violations': above(bounded, u_bound),
     }
+    if unknown:
+        metrics['unknown_commands'] = unknown
     metrics.update(extra or {})
     return metrics
 
@@ -194,7 +232,7 @@ def segment_metrics(trajectory: Trajectory, events: Sequence[Event],
             row.update({
                 'settle_time': None if settled is None else settled - part.start,
                 'min_pair_distance': float(np.min(dis_min_series(trajectory.q[span]))),
-                'max_abs_u_hat_component': float(np.max(np.abs(trajectory.u_hat[span]))),
+                'max_abs_u_hat_component': largest_component(trajectory.u_hat[span]),
                 'final_max_error': float(np.max(errors[part.stop - 1]))})
             if trajectory.q_body is not None:
                 row['min_body_distance'] = float(np.min(dis_min_series(trajectory.q_body[span])))

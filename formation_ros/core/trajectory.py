@@ -3,7 +3,7 @@
 
 """A sampled formation run and its ``trajectory.npz`` file."""
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 import os
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
@@ -16,6 +16,10 @@ TRAJECTORY_FILE = 'trajectory.npz'
 ARRAYS = ('t', 'q', 'u', 'u_hat', 'q_desired', 'q_od')
 BODY_ARRAYS = ('heading', 'q_body', 'body_command')
 """Arrays of a unicycle run, beside :data:`ARRAYS` (which then describe the hand points)."""
+HELD_ARRAYS = ('u_held', 'u_hat_held')
+"""Arrays of a run whose commands need a heading (unicycles, body-frame commands): the command
+held at each sample read at the body's heading then, beside u (read at the heading answered)."""
+OPTIONAL_ARRAYS = BODY_ARRAYS + HELD_ARRAYS
 
 
 @dataclass(frozen=True)
@@ -30,6 +34,14 @@ class Trajectory:
     For unicycles q, u and u_hat are those of the hand points (what the law controls), and
     heading (T, N) in rad, q_body (T, N, 2) the axle centres in m and body_command (T, N, 2)
     the (v, w) held, in m/s and rad/s, describe the bodies; all three are None for points.
+
+    u is what each robot commanded: its published command read at the orientation of the
+    state it answered (``core.commanded``; NaN where the run cannot tell). Where that needs a
+    heading (unicycles, body-frame commands) u_held (T, N, dim) m/s is the command held at each
+    sample read at the body's heading at that sample instead (a world's true heading), and
+    u_hat_held (T, N, dim) m/s that in the formation frame (eq. 25 inverted): u_hat rotated by
+    the heading turned since the state answered, so within sqrt(2) c M1, not c M1, per
+    component. Both None otherwise.
     """
 
     t: NDArray[np.float64]
@@ -41,6 +53,8 @@ class Trajectory:
     heading: Optional[NDArray[np.float64]] = None
     q_body: Optional[NDArray[np.float64]] = None
     body_command: Optional[NDArray[np.float64]] = None
+    u_held: Optional[NDArray[np.float64]] = None
+    u_hat_held: Optional[NDArray[np.float64]] = None
 
     @property
     def num_robots(self) -> int:
@@ -60,7 +74,7 @@ class Trajectory:
         formation_sim run; ``np.load`` reads either kind. Written whole or not at all
         (:func:`save_atomically`): an OSError leaves no partial file.
         """
-        arrays = {name: getattr(self, name) for name in ARRAYS + BODY_ARRAYS
+        arrays = {name: getattr(self, name) for name in ARRAYS + OPTIONAL_ARRAYS
                   if getattr(self, name) is not None}
         save_atomically(path, lambda stream: np.savez(stream, **arrays))
 
@@ -79,11 +93,19 @@ class Trajectory:
         shapes = np.asarray(vertices, dtype=float)
         per_sample = shapes if shapes.ndim == 3 else [shapes] * len(frames)
         return cls(t=np.asarray(t, dtype=float), q=q, u=u,
-                   u_hat=np.array([to_frame_velocity(u_k, q_k, f)
-                                   for u_k, q_k, f in zip(u, q, frames)]),
+                   u_hat=frame_velocities(u, q, frames),
                    q_desired=np.array([desired_positions(v, f)
                                        for v, f in zip(per_sample, frames)]),
                    q_od=np.array([f.q_od for f in frames]))
+
+    def with_held(self, u_held: ArrayLike, frames: Sequence[FrameSample]) -> 'Trajectory':
+        """
+        Return a copy with u_held (T, N, dim) m/s and its u_hat_held (eq. 25 inverted at q).
+
+        frames: the T reference samples the trajectory was built with (:meth:`from_frames`).
+        """
+        held = np.array(u_held, dtype=float)
+        return replace(self, u_held=held, u_hat_held=frame_velocities(held, self.q, frames))
 
     @classmethod
     def load(cls, path: str) -> 'Trajectory':
@@ -94,11 +116,21 @@ class Trajectory:
             missing = [name for name in ARRAYS if name not in data]
             if missing:
                 raise ValueError(f"{path}: missing arrays {', '.join(missing)}")
-            return cls(**{name: data[name] for name in ARRAYS + BODY_ARRAYS
+            return cls(**{name: data[name] for name in ARRAYS + OPTIONAL_ARRAYS
                           if name in data})
 
 
+def frame_velocities(u: ArrayLike, q: ArrayLike,
+                     frames: Sequence[FrameSample]) -> NDArray[np.float64]:
+    """Return u (T, N, dim) m/s in the formation frame of each sample, eq. (25) inverted."""
+    return np.array([to_frame_velocity(u_k, q_k, f)
+                     for u_k, q_k, f in zip(np.asarray(u, dtype=float),
+                                            np.asarray(q, dtype=float), frames)])
+
+
 CHUNKS_DIR = 'trajectory_chunks'
+CHUNK_EXTRAS = BODY_ARRAYS + ('u_held',)
+"""Arrays a chunk may hold beside t, q and u (u_hat_held is computed from u_held on reading)."""
 
 
 class ChunkWriter:
@@ -108,7 +140,8 @@ class ChunkWriter:
     A process that keeps its samples only here holds at most one chunk in memory, and a run cut
     short (even by SIGKILL) loses at most the chunk not yet written: :func:`read_chunks` reads
     back every complete file. t in s; q, u (N, dim); for unicycles also heading (N,), q_body
-    (N, 2) and body_command (N, 2) (:data:`BODY_ARRAYS`, read back by :func:`read_body_chunks`).
+    (N, 2) and body_command (N, 2) (:data:`BODY_ARRAYS`, read back by :func:`read_body_chunks`)
+    and u_held (N, dim) (read back by :func:`read_held_chunks`).
 
     A chunk that cannot be written (a full disk) is removed, and the writer stops: :meth:`flush`
     raises that OSError once, then :attr:`failed` holds it and samples are no longer kept, so
@@ -123,13 +156,13 @@ class ChunkWriter:
         self._t: List[float] = []
         self._q: List[NDArray[np.float64]] = []
         self._u: List[NDArray[np.float64]] = []
-        self._body: Dict[str, List[NDArray[np.float64]]] = {name: [] for name in BODY_ARRAYS}
+        self._body: Dict[str, List[NDArray[np.float64]]] = {name: [] for name in CHUNK_EXTRAS}
         self.failed: Optional[OSError] = None
         self.written_until: Optional[float] = None
         """Time of the last sample in the chunks written, s (None before any)."""
 
     def append(self, t: float, q: ArrayLike, u: ArrayLike, **body: ArrayLike) -> None:
-        """Keep one sample until the next :meth:`flush`; body: the :data:`BODY_ARRAYS`."""
+        """Keep one sample until the next :meth:`flush`; body: :data:`CHUNK_EXTRAS`."""
         if self.failed is not None:
             return
         self._t.append(float(t))
@@ -149,7 +182,7 @@ class ChunkWriter:
                        if len(values) == len(self._t)})
         last = self._t[-1]
         self._t, self._q, self._u = [], [], []
-        self._body = {name: [] for name in BODY_ARRAYS}
+        self._body = {name: [] for name in CHUNK_EXTRAS}
         try:
             save_atomically(path, lambda stream: np.savez(stream, **arrays))
         except OSError as exc:
@@ -213,13 +246,30 @@ def read_body_chunks(folder: str) -> Optional[Dict[str, NDArray[np.float64]]]:
 
     None when the chunks hold none (point bodies). Call after :func:`read_chunks` succeeded.
     """
-    parts: Dict[str, List[NDArray[np.float64]]] = {name: [] for name in BODY_ARRAYS}
+    return _optional_chunks(folder, BODY_ARRAYS)
+
+
+def read_held_chunks(folder: str) -> Optional[NDArray[np.float64]]:
+    """
+    Read back u_held (T, N, dim) of the chunks in ``folder``, m/s.
+
+    None when the chunks hold none (commands that need no heading, or an older writer). Call
+    after :func:`read_chunks` succeeded.
+    """
+    parts = _optional_chunks(folder, ('u_held',))
+    return None if parts is None else parts['u_held']
+
+
+def _optional_chunks(folder: str,
+                     names: Sequence[str]) -> Optional[Dict[str, NDArray[np.float64]]]:
+    """Return the arrays ``names`` of every chunk, concatenated; None if a chunk lacks one."""
+    parts: Dict[str, List[NDArray[np.float64]]] = {name: [] for name in names}
     for name in _chunk_files(folder):
         with np.load(os.path.join(folder, name)) as data:
-            if not all(key in data for key in BODY_ARRAYS):
+            if not all(key in data for key in names):
                 return None
-            for key in BODY_ARRAYS:
+            for key in names:
                 parts[key].append(data[key])
-    if not parts[BODY_ARRAYS[0]]:
+    if not parts[names[0]]:
         return None
     return {key: np.concatenate(values) for key, values in parts.items()}

@@ -11,6 +11,8 @@ ROS bridge give a lab (Gazebo with ros_gz_bridge): ``/clock``, each robot's grou
 odometry on ``/robot_<i>/odom``; it drives the bodies from ``/robot_<i>/cmd_vel``, whose
 callbacks only store (``physics.intake``). It counts contacts between robots and, with
 ``world.output_dir``, writes ``world.xml``, ``trajectory.npz`` and ``world_stats.json``.
+Before its first step it looks at the domain through the plant's start gate
+(``core.plant_gate``, ``ros.clock_look``): beside another plant or world it refuses (exit 2).
 How to start it, what it refuses and writes: docs/physics.md ("The world node"); its topics:
 docs/ros_interface.md.
 """
@@ -24,24 +26,29 @@ from typing import Any, Dict, List, Optional
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.admission import Reason
+from formation_ros.core.commanded import commanded_velocity, HeardOrientations, needs_orientation
 from formation_ros.core.declarations import CommandFrame, Exe
+from formation_ros.core.exits import ENGINE_FAILED, REFUSED
+from formation_ros.core.plant_gate import leftover_line, Phase, StartGate, Verdict
 from formation_ros.core.trajectory import (CHUNKS_DIR, ChunkWriter, read_body_chunks,
-                                           read_chunks, save_atomically, Trajectory,
-                                           TRAJECTORY_FILE)
+                                           read_chunks, read_held_chunks, save_atomically,
+                                           Trajectory, TRAJECTORY_FILE)
 from formation_ros.core.unicycle import hand_points, hand_velocity, quaternions_from_headings
 from formation_ros.core.units import NS_PER_S
-from formation_ros.physics.engine import Engine
+from formation_ros.physics.engine import Engine, Unstable
 from formation_ros.physics.intake import CommandInbox
 from formation_ros.physics.pacing import Pacer
 from formation_ros.physics.parts import rotated
 from formation_ros.physics.scene import WORLD_FILE
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import (CdrError, encode_clock, encode_odometry, encode_pose_stamped,
-                                   read_twist, read_twist_stamped, TwistData)
+                                   read_pose_stamped, read_twist, read_twist_stamped, TwistData)
+from formation_ros.ros.clock_look import look_at_clock, refusal
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.once import OnceLog, RefusalLog
 from formation_ros.ros.parameters import declare_parameters
 from formation_ros.ros.runner import run
+from formation_ros.ros.team import identity, PublisherWatch, TeamCheck
 from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
 from nav_msgs.msg import Odometry
 import numpy as np
@@ -67,6 +74,14 @@ stats)."""
 CHUNK_PERIOD = 1.0
 ODOMETRY_HEIGHT = 0.0
 """The height of an odometry pose, m: wheel odometry is planar."""
+HEARD_KEPT = 256
+"""States kept per robot to read a held command at the orientation it answered: 5 s at 50 Hz,
+more than a command is ever held (``world.cmd_timeout``)."""
+UNSTABLE_SETTINGS = {True: ('timestep', 'mass', 'wheel_torque', 'wheel_radius', 'floor_friction'),
+                     False: ('timestep', 'mass', 'force_limit', 'torque_limit', 'floor_friction')}
+"""The world.* settings named with their values when the engine blows up, for unicycles and
+for points: those the unstable cases combined (docs/physics.md, "When the engine blows
+up")."""
 REFUSAL_WORDS = {Reason.MALFORMED: 'bytes that are not a whole {kind}',
                  Reason.FRAME: 'a frame other than its command frame',
                  Reason.NON_FINITE: 'non-finite values',
@@ -105,6 +120,14 @@ class WorldNode(Node):
         self.output_dir = self.world.output_dir
         self.output_failure: Optional[str] = None
         self.chunks: Optional[ChunkWriter] = None
+        self.gate = StartGate(time.monotonic(), False, self.get_fully_qualified_name())
+        self.team_check = TeamCheck(self, WORLD_STATUS)
+        self.graph = PublisherWatch(self, self.team_check)
+        self.refusal: Optional[str] = None
+        self.exit_code: Optional[int] = None
+        self.clock_heard = 0
+        self.clock_sub = self.create_subscription(ClockMsg, topics.CLOCK, self.on_clock,
+                                                  qos.CLOCK, raw=True)
         self._start_output()
 
         self.clock_pub = self.create_publisher(ClockMsg, topics.CLOCK, qos.CLOCK)
@@ -120,6 +143,16 @@ class WorldNode(Node):
             raw=True) for i in range(1, self.n + 1)]
         self.diagnostics_pub = self.create_publisher(DiagnosticArray, topics.DIAGNOSTICS,
                                                      qos.DIAGNOSTICS)
+        self.heard: Optional[HeardOrientations] = None
+        """The orientations of the states the robots heard (``pose``), to read what each
+        commanded (``_sample``); only when a command needs one, is stamped and is recorded."""
+        if (self.chunks is not None and self.stamped
+                and needs_orientation(self.unicycles, self.body_frame)):
+            self.heard = HeardOrientations(self.n, HEARD_KEPT)
+            self.state_subs = [self.create_subscription(
+                PoseStamped, topics.robot_topic(i, topics.POSE),
+                lambda data, index=i - 1: self.on_state_heard(index, data),
+                qos.recording(qos.STATE_INPUT), raw=True) for i in range(1, self.n + 1)]
         tick = max(MIN_TICK, 1.0 / (self.world.pose_rate * self.world.realtime_factor))
         self.timer = self.create_timer(tick, self.on_timer, clock=self.steady)
         self.diagnostics_timer = self.create_timer(PERIOD, self.on_diagnostics,
@@ -151,6 +184,33 @@ class WorldNode(Node):
         return (f'robot {index + 1}: ignoring cmd_vel with {what} ({detail}; logged once, '
                 'counted in /diagnostics)')
 
+    def on_clock(self, data: bytes) -> None:
+        """While the world looks at the domain: count /clock messages, which only others send."""
+        self.clock_heard += 1
+
+    def _look_at_domain(self, now: float) -> bool:
+        """
+        Look up the other /clock publishers when the gate asks; return whether the domain is ours.
+
+        The plant's gate decides (``core.plant_gate``): refuse (exit REFUSED) beside another
+        plant or world, take a silent one of this name for a killed world's, or go on looking.
+        """
+        if not self.gate.look_due(now):
+            return False
+        verdict, others = look_at_clock(self.graph, self.team_check, self.gate,
+                                        self.clock_heard > 0, now)
+        if self.gate.phase is Phase.REFUSED:
+            self.refusal = refusal(self.graph, self.gate, self.context.get_domain_id(), now)
+            self.get_logger().error(self.refusal)
+            self.exit_code = REFUSED
+            return False
+        if not self.gate.looked:
+            return False
+        if verdict is Verdict.LEFTOVER and others:
+            self.once.start('leftover-clock', leftover_line(others[0], now - self.gate.created))
+        self.destroy_subscription(self.clock_sub)
+        return True
+
     def on_command(self, index: int, data: bytes) -> None:
         """Keep robot ``index``'s command for the next step, or count its refusal (logged once)."""
         try:
@@ -174,6 +234,8 @@ class WorldNode(Node):
 
     def on_timer(self) -> None:
         """Apply the commands kept, run the steps due, publishing at every pose period."""
+        if not self.gate.looked and not self._look_at_domain(time.monotonic()):
+            return
         now = time.monotonic_ns()
         if self.pacer.started_ns is None:
             self.pacer.start(now, self.engine.steps)
@@ -185,13 +247,26 @@ class WorldNode(Node):
             self.engine.apply(commands, stamps, robots=rows)
             self._note_late(rows, stamps)
         due = self.pacer.due(now, self.engine.steps)
-        while due > 0:
-            steps = min(due, self.steps_per_pose - self.engine.steps % self.steps_per_pose)
-            self.engine.step(steps)
-            due -= steps
-            if self.engine.steps % self.steps_per_pose == 0:
-                self._publish()
+        try:
+            while due > 0:
+                steps = min(due, self.steps_per_pose - self.engine.steps % self.steps_per_pose)
+                self.engine.step(steps)
+                due -= steps
+                if self.engine.steps % self.steps_per_pose == 0:
+                    self._publish()
+        except Unstable as exc:
+            self._blew_up(exc)
         self._log_contacts()
+
+    def _blew_up(self, exc: Unstable) -> None:
+        """Stop at the step that made a pose absurd: say so in one line; exit ENGINE_FAILED."""
+        self.timer.cancel()
+        self.exit_code = ENGINE_FAILED
+        values = ', '.join(f'world.{name} {getattr(self.world, name):g}'
+                           for name in UNSTABLE_SETTINGS[self.unicycles])
+        self.get_logger().error(
+            f'world: the physics engine blew up: {exc}; stopped there, no pose published '
+            f'after it ({values}: a shorter timestep, or less extreme bodies)')
 
     def _note_late(self, rows: NDArray[np.intp], stamps: NDArray[np.int64]) -> None:
         """Count commands already older than ``world.cmd_timeout`` when applied; log once each."""
@@ -235,22 +310,45 @@ class WorldNode(Node):
         """Return the commands driving the motors now (N, width); zero for stale or none."""
         return np.where(self.engine.live()[:, None], self.engine.command, 0.0)
 
+    def on_state_heard(self, index: int, data: bytes) -> None:
+        """Keep the orientation of a state robot ``index`` heard (its ``pose``), by its stamp."""
+        assert self.heard is not None
+        try:
+            pose = read_pose_stamped(data, exact=True)
+        except CdrError:
+            return
+        if pose.frame_id == self.config.world_frame:
+            self.heard.hear(index, pose.stamp_ns, pose.orientation)
+
     def _sample(self, t_ns: int) -> None:
-        """Keep one trajectory sample as the plant writes it (hand points for unicycles)."""
+        """
+        Keep one trajectory sample as the plant writes it (hand points for unicycles).
+
+        u: what each robot commanded, its held command read at the orientation of the state it
+        answered (``core.commanded``; NaN where the world did not hear that state, or for
+        unstamped commands, which do not say which state); u_held, for commands that need a
+        heading: the held command read at the body's true heading now.
+        """
         assert self.chunks is not None
         positions, headings = self.engine.planar_state()
         held = self._held()
         t = t_ns / NS_PER_S
+        if not needs_orientation(self.unicycles, self.body_frame):
+            self.chunks.append(t, positions, held)
+            return
+        answered = (self.heard.rows(self.engine.stamp_ns) if self.heard is not None
+                    else np.full((self.n, 4), np.nan))
+        commanded = commanded_velocity(held, answered, self.unicycles,
+                                       self.config.body.hand_distance, self.body_frame)
         if self.unicycles:
             distance = self.config.body.hand_distance
-            self.chunks.append(t, hand_points(positions, headings, distance),
-                               hand_velocity(held, headings, distance), heading=headings,
-                               q_body=positions, body_command=held)
+            self.chunks.append(t, hand_points(positions, headings, distance), commanded,
+                               heading=headings, q_body=positions, body_command=held,
+                               u_held=hand_velocity(held, headings, distance))
             return
-        velocity = held.copy()
-        if self.body_frame:
-            velocity[:, :2] = rotated(held[:, :2], headings)
-        self.chunks.append(t, positions, velocity)
+        at_truth = held.copy()
+        at_truth[:, :2] = rotated(held[:, :2], headings)
+        self.chunks.append(t, positions, commanded, u_held=at_truth)
 
     def _log_contacts(self) -> None:
         """Log each new contact between two robots once: the pair and the simulated time."""
@@ -273,7 +371,7 @@ class WorldNode(Node):
         factor = rate * self.world.timestep
         target = self.world.realtime_factor
         running = self.pacer.started_ns is not None
-        behind = running and factor < KEPT_UP * target
+        behind = running and wall >= PERIOD / 2 and factor < KEPT_UP * target
         if behind:
             self.once.start('behind', f'world: stepping at {factor:.2f} x real time of '
                                       f'{target:g} asked (too many robots for this machine, '
@@ -293,6 +391,7 @@ class WorldNode(Node):
             'steps': self.engine.steps,
             'contacts': self.engine.contacts.count,
             'min body distance [m]': self.engine.closest.distance,
+            **identity(self),
             'robots with live commands': ', '.join(map(str, live.tolist())) or 'none',
             'refused cmd_vel messages': self.refusals.refusals.count(),
             'robots with stale cmd_vel on arrival': ', '.join(
@@ -305,8 +404,11 @@ class WorldNode(Node):
             level, message = 'warn', (f'{contacts} contacts, '
                                       f'{self.refusals.refusals.count()} refused commands, '
                                       f'{factor:.2f} x real time of {target:g}')
+        elif self.refusal is not None:
+            level, message = 'error', self.refusal
         else:
-            level, message = 'ok', 'running' if running else 'starting'
+            level, message = 'ok', 'running' if running else (
+                'starting' if self.gate.looked else self.gate.phase.value)
         self.diagnostics_pub.publish(diagnostics(WORLD_STATUS, level, message, values))
 
     def write_chunk(self) -> None:
@@ -348,6 +450,9 @@ class WorldNode(Node):
                                        in enumerate(self.late.tolist()) if count},
             'model': self.engine.model.kind.value,
             'timestep': self.world.timestep,
+            'unstable': None if self.engine.failure is None else {
+                'robot': self.engine.failure.robot, 't': self.engine.failure.t,
+                'what': self.engine.failure.what},
             'refused_command_messages': {
                 reason.name.lower(): {str(index + 1): count for (index, why), count
                                       in self.refusals.refusals.items() if why is reason}
@@ -368,13 +473,18 @@ class WorldNode(Node):
         except ValueError:
             return None
         reference = self.config.reference()
-        trajectory = Trajectory.from_frames(t, q, u, [reference.sample(s) for s in t],
-                                            self.config.vertices)
+        frames = [reference.sample(s) for s in t]
+        trajectory = Trajectory.from_frames(t, q, u, frames, self.config.vertices)
         body = read_body_chunks(self.chunks.folder) if self.unicycles else None
-        return trajectory if body is None else replace(trajectory, **body)
+        if body is not None:
+            trajectory = replace(trajectory, **body)
+        held = read_held_chunks(self.chunks.folder)
+        return trajectory if held is None else trajectory.with_held(held, frames)
 
     def finish(self) -> None:
         """Log a summary; with ``world.output_dir`` write world_stats.json and trajectory.npz."""
+        if self.refusal is not None:
+            return
         if self.pacer.started_ns is None:
             self.get_logger().info('world: stopped before the first step')
             return
@@ -386,7 +496,8 @@ class WorldNode(Node):
             f'{self.world.realtime_factor:g}), {stats["contacts"]} contacts between robots, '
             f"min body distance {stats['min_body_distance']:.4g} m, "
             f'{self.refusals.refusals.count()} cmd_vel messages refused'
-            + (f'; output stopped early: {self.output_failure}' if self.output_failure else ''))
+            + (f'; output stopped early: {self.output_failure}' if self.output_failure else '')
+            + ('; the engine blew up' if self.engine.failure is not None else ''))
         if not self.output_dir or self.output_failure is not None:
             return
         text = (json.dumps(stats, indent=2) + '\n').encode()

@@ -25,14 +25,16 @@ import struct
 import tempfile
 from typing import Any, Dict, List, Optional, Tuple
 
+from formation_ros.core.commanded import (commanded_velocity, needs_orientation,
+                                          UNKNOWN_ORIENTATION)
 from formation_ros.core.declarations import CommandFrame
 from formation_ros.core.events import timeline_events
 from formation_ros.core.file_guard import read_params_file_text
-from formation_ros.core.frames import advance, FrameSample, from_body_frame
+from formation_ros.core.frames import advance, FrameSample
 from formation_ros.core.params import check_shape, FormationConfig, ParamError
 from formation_ros.core.timeline import Mode, named_shape, Shape, TeamState, Timeline
 from formation_ros.core.trajectory import Trajectory
-from formation_ros.core.unicycle import hand_points, hand_velocity, headings_from_quaternions
+from formation_ros.core.unicycle import hand_points, headings_from_quaternions
 from formation_ros.core.units import NS_PER_S
 from formation_ros.ros import topics as names
 from formation_ros.ros.bag_writer import BagError, BagWriter, PARAMS_FILE, TYPESTORE
@@ -468,20 +470,24 @@ def trajectory_from_topics(recorded: Recorded,
     """
     Rebuild the run from recorded messages.
 
-    Samples are the state stamps at which every robot's pose was recorded; u_i at a sample is
-    the command robot i sent for that state (or its latest earlier one, zero before its first);
-    desired positions come from the recorded reference samples (or, if none were recorded, from
-    the reference in the parameters) and the formation vertices. Returns (Trajectory, info).
-    Unicycles: the headings are the poses' orientations, the commands (v, w) are linear.x and
-    angular.z, and q, u are those of the hand points (``Trajectory`` with its body arrays).
-    Poses in a frame other than ``world_frame`` are left out (counted in the info); body-frame
-    commands of points are turned into the world by the orientation of the pose they answer.
+    Samples are the state stamps at which every robot's pose was recorded; the command held by
+    robot i at a sample is the one it sent for that state (or its latest earlier one, zero
+    before its first); desired positions come from the recorded reference samples (or, if none
+    were recorded, from the reference in the parameters) and the formation vertices. Returns
+    (Trajectory, info). Unicycles: the headings are the poses' orientations, the commands (v,
+    w) are linear.x and angular.z, and q, u are those of the hand points (``Trajectory`` with
+    its body arrays). Poses in a frame other than ``world_frame`` are left out (counted in the
+    info). Where a command needs an orientation (unicycles, body-frame commands of points), u
+    is what the robot commanded, read at the orientation of the pose it answered
+    (``core.commanded``: the robot's own /robot_<i>/pose at the command's stamp), NaN where
+    that pose was not recorded or the command has no stamp to name it; u_held reads it at the
+    pose of each sample instead (``Trajectory.with_held``).
     """
     n, dim = config.num_robots, config.dim
     unicycles = config.body.is_unicycle
     body_frame = not unicycles and config.command.frame is CommandFrame.BODY
+    oriented = needs_orientation(unicycles, body_frame)
     poses: Dict[int, Dict[int, Any]] = {}
-    headings: Dict[int, Dict[int, float]] = {}
     orientations: Dict[Tuple[int, int], Tuple[float, ...]] = {}
     other_frame = 0
     for i in range(1, n + 1):
@@ -492,10 +498,7 @@ def trajectory_from_topics(recorded: Recorded,
             stamp = stamp_to_ns(message.header.stamp)
             poses.setdefault(stamp, {})[i - 1] = position_of(message, dim)
             o = message.pose.orientation
-            if unicycles:
-                headings.setdefault(stamp, {})[i - 1] = float(
-                    headings_from_quaternions([o.x, o.y, o.z, o.w]))
-            elif body_frame:
+            if oriented:
                 orientations[(i, stamp)] = (o.x, o.y, o.z, o.w)
     stamps = sorted(stamp for stamp, seen in poses.items() if len(seen) == n)
     if len(stamps) < 2:
@@ -504,19 +507,19 @@ def trajectory_from_topics(recorded: Recorded,
         raise BagError(f'fewer than two moments with the poses of all robots recorded{frames}')
     q = np.array([[poses[stamp][i] for i in range(n)] for stamp in stamps])
     width = 2 if unicycles else dim
-    u = np.zeros((len(stamps), n, width))
+    held = np.zeros((len(stamps), n, width))
+    answered = np.full((len(stamps), n, 4), np.nan)
     for i in range(1, n + 1):
         commands = _commands_by_state(recorded, i, config)
-        if body_frame:
-            commands = {stamp: from_body_frame(np.array([value]),
-                                               np.array([orientations[(i, stamp)]]))[0]
-                        for stamp, value in commands.items() if (i, stamp) in orientations}
         if not commands:
             continue
         known = np.array(sorted(commands))
         index = np.searchsorted(known, stamps, side='right') - 1
         values = np.array([commands[int(k)] for k in known])
-        u[:, i - 1] = np.where((index >= 0)[:, None], values[np.maximum(index, 0)], 0.0)
+        held[:, i - 1] = np.where((index >= 0)[:, None], values[np.maximum(index, 0)], 0.0)
+        if oriented and config.command.stamped:
+            answered[:, i - 1] = [orientations.get((i, int(known[k])), UNKNOWN_ORIENTATION)
+                                  if k >= 0 else UNKNOWN_ORIENTATION for k in index.tolist()]
     frames, source = _frames_at(stamps, recorded.get(names.REFERENCE, []), config)
     shapes = recorded_shapes(recorded, config)
     states = recorded_states(recorded, config)
@@ -529,18 +532,23 @@ def trajectory_from_topics(recorded: Recorded,
         info[EVENTS] = events
     if other_frame:
         info['poses_in_another_frame'] = other_frame
-    if not unicycles:
-        trajectory = Trajectory.from_frames(np.array(stamps) / NS_PER_S, q, u, frames,
-                                            vertices)
-        return trajectory, info
-    heading = np.array([[headings[stamp][i] for i in range(n)] for stamp in stamps])
+    t = np.array(stamps) / NS_PER_S
+    if not oriented:
+        return Trajectory.from_frames(t, q, held, frames, vertices), info
     l_value = config.body.hand_distance
-    trajectory = Trajectory.from_frames(np.array(stamps) / NS_PER_S,
-                                        hand_points(q, heading, l_value),
-                                        hand_velocity(u, heading, l_value), frames,
-                                        vertices)
-    return (replace(trajectory, heading=heading, q_body=q, body_command=u),
-            info)
+    sampled = np.array([[orientations[(i, stamp)] for i in range(1, n + 1)]
+                        for stamp in stamps])
+    shape = (len(stamps), n, dim)
+    u = commanded_velocity(held.reshape(-1, width), answered.reshape(-1, 4), unicycles,
+                           l_value, body_frame).reshape(shape)
+    u_held = commanded_velocity(held.reshape(-1, width), sampled.reshape(-1, 4), unicycles,
+                                l_value, body_frame).reshape(shape)
+    if not unicycles:
+        return Trajectory.from_frames(t, q, u, frames, vertices).with_held(u_held, frames), info
+    heading = headings_from_quaternions(sampled)
+    trajectory = Trajectory.from_frames(t, hand_points(q, heading, l_value), u, frames,
+                                        vertices).with_held(u_held, frames)
+    return replace(trajectory, heading=heading, q_body=q, body_command=held), info
 
 
 def recorded_shapes(recorded: Recorded, config: FormationConfig) -> Timeline[Shape]:
@@ -580,7 +588,9 @@ def _commands_by_state(recorded: Recorded, robot: int,
     Return robot ``robot``'s recorded commands by the stamp of the state each answers.
 
     A TwistStamped carries that stamp; a Twist (``command.type: twist``) does not, and is taken
-    to answer the robot's latest pose recorded before it (by the recorder's receive times).
+    to answer the robot's latest pose recorded before it (by the recorder's receive times): a
+    guess, so such a command is not read at that pose's orientation
+    (:func:`trajectory_from_topics`).
     Values: (dim,) linear velocities, or (v, w) for unicycles.
     """
     linear_only = not config.body.is_unicycle

@@ -43,7 +43,8 @@ from formation_ros.core.events import Event, EventKind, timeline_events, with_sh
 from formation_ros.core.file_guard import ParamsFileError
 from formation_ros.core.frames import desired_positions, FrameSample
 from formation_ros.core.law import team_command
-from formation_ros.core.metrics import body_metrics, compute_metrics, segment_metrics
+from formation_ros.core.metrics import (body_metrics, compute_metrics, held_metrics,
+                                        segment_metrics)
 from formation_ros.core.params import (FormationConfig, load_config,
                                        validate_for_every_executable)
 from formation_ros.core.params_file import load_params_file
@@ -439,8 +440,14 @@ def run_metrics(trajectory: Trajectory, config: FormationConfig, integrator: str
                       'guaranteed_min_hand_point_distance': guaranteed_min_distance(
                           trajectory.q[0], config.vertices, config.law(),
                           config.reference().sample(float(trajectory.t[0])))})
+    if trajectory.u_hat_held is not None:
+        extra.update(held_metrics(trajectory.u_hat_held, config.law().u_bound))
     metrics = compute_metrics(trajectory.t, trajectory.q, trajectory.u, trajectory.u_hat,
                               trajectory.q_desired, config.law().u_bound, extra)
+    if metrics.get('unknown_commands'):
+        metrics['unknown_commands_reason'] = (
+            'the states they answered were not heard' if config.command.stamped
+            else 'unstamped commands do not say which state they answered')
     if events:
         metrics['segments'] = segment_metrics(trajectory, events)
     return metrics
@@ -453,6 +460,20 @@ def plant_metrics(run: FixedStepRun, config: FormationConfig) -> dict:
             'max_abs_u_hat_sent': run.largest_u_hat,
             'max_abs_body_velocity': run.largest_velocity.tolist(),
             'plant_collisions': run.counts.collisions}
+
+
+def _u_hat_line(metrics: dict) -> str:
+    """Return the summary line of u_hat: what the robots commanded, and what it cannot tell."""
+    unknown = metrics.get('unknown_commands', 0)
+    largest = metrics['max_abs_u_hat_component']
+    why = (f"{unknown} of the {metrics['num_samples'] * metrics['num_robots']} sampled "
+           f"commands not known: {metrics.get('unknown_commands_reason', 'not recorded')}")
+    if largest is None:
+        return (f'  max |u_hat| component: not known ({why}; bound c*M1 = '
+                f"{metrics['u_bound']:.4g} m/s)")
+    return (f'  max |u_hat| component: {largest:.4g} m/s (bound c*M1 = '
+            f"{metrics['u_bound']:.4g} m/s, {metrics['bound_violations']} above"
+            + (f'; {why})' if unknown else ')'))
 
 
 def _limit(metrics: dict, name: str, unit: str) -> str:
@@ -491,10 +512,15 @@ def format_summary(metrics: dict, out_dir: Optional[str] = None) -> str:
         f"  settle time (every error <= {metrics['settle_tolerance']} m): {settle_text}",
         f"  final max error: {metrics['final_max_error']:.3g} m",
         f"  min pair distance: {metrics['min_pair_distance']:.4g} m ({collision})",
-        f"  max |u_hat| component: {metrics['max_abs_u_hat_component']:.4g} m/s "
-        f"(bound c*M1 = {metrics['u_bound']:.4g} m/s, {metrics['bound_violations']} above)",
-        f"  max |u| component: {metrics['max_abs_u_component']:.4g} m/s",
+        _u_hat_line(metrics),
+        f"  max |u| component: {_measured(metrics['max_abs_u_component'], 'm/s')}",
     ]
+    if 'max_abs_u_hat_held_component' in metrics:
+        lines.append(
+            '  max |u_hat_held| component (each held command read at the heading the body had '
+            'at the sample, not the one it answered): '
+            f"{_measured(metrics['max_abs_u_hat_held_component'], 'm/s')} (bound sqrt(2) c M1 = "
+            f"{metrics['u_hat_held_bound']:.4g} m/s, {metrics['u_hat_held_above_bound']} above)")
     if metrics.get('body_kind') == 'unicycle':
         touching = 2.0 * metrics['body_radius']
         guaranteed = metrics['guaranteed_min_hand_point_distance']
