@@ -40,8 +40,8 @@ from formation_ros.core.frames import FrameSample
 from formation_ros.core.params import FormationConfig, load_config, validate
 from formation_ros.core.params_file import parse_params_text
 from formation_ros.core.plant import PLANT_STATS_FILE
-from formation_ros.core.trajectory import (CHUNKS_DIR, read_body_chunks, read_chunks, Trajectory,
-                                           TRAJECTORY_FILE)
+from formation_ros.core.trajectory import (CHUNKS_DIR, read_body_chunks, read_chunks,
+                                           read_held_chunks, Trajectory, TRAJECTORY_FILE)
 from formation_ros.ros import topics as names
 from formation_ros.ros.bag_writer import BagError, PARAMS_FILE
 from formation_ros.tools.animate import (AnimationError, DEFAULT_DPI, DEFAULT_FPS, describe,
@@ -124,11 +124,14 @@ def _load_chunks(path: str, params: str, chunks: str, notes: Optional[List[str]]
         raise ReportError(f'{chunks}: {q.shape[1]} robots in {q.shape[2]}D, but params.yaml '
                           f'says {config.num_robots} in {config.dim}D')
     reference = config.reference()
-    trajectory = Trajectory.from_frames(t, q, u, [reference.sample(s) for s in t],
-                                        config.vertices)
+    frames = [reference.sample(s) for s in t]
+    trajectory = Trajectory.from_frames(t, q, u, frames, config.vertices)
     body = read_body_chunks(chunks) if config.body.is_unicycle else None
     if body is not None:
         trajectory = replace(trajectory, **body)
+    held = read_held_chunks(chunks)
+    if held is not None:
+        trajectory = trajectory.with_held(held, frames)
     if notes is not None:
         notes.append(f'{path}: no trajectory.npz (the plant did not finish): rebuilt '
                      f'{len(t)} samples up to t = {t[-1]:.2f} s from {CHUNKS_DIR}/')
