@@ -63,8 +63,12 @@ def test_points_taking_twists_in_their_own_frames_reach_the_formation(
     from_bag = json.loads((out / 'metrics.json').read_text())
     assert from_bag['source'] == 'rosbag2'
     assert from_bag['final_max_error'] < 0.02 and from_bag['collisions'] == 0
-    assert 0.5 < from_bag['max_abs_u_component'] <= bound + 1e-9
+    assert from_bag['max_abs_u_component'] <= bound + 1e-9
+    assert from_bag['unknown_commands'] > 0
+    assert from_bag['unknown_commands_reason'] == ('unstamped commands do not say which state '
+                                                   'they answered')
     assert from_bag['bound_violations'] == 0
+    assert 0.5 < from_bag['max_abs_u_hat_held_component'] <= math.sqrt(2.0) * bound + 1e-9
 
 
 def test_a_robot_refuses_states_in_another_world_frame(processes, install, probe, tmp_path):

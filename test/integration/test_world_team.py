@@ -12,7 +12,9 @@ taking body-frame Twist, flying bodies in 3D) start about 0.1 m from their place
 settle in a few simulated seconds; the run is stopped once every hand point (the position, for
 points) of the world's ground truth is within 0.05 m of its vertex. Then the world counted no
 contact, took every command (none refused, none stale: the stamps were on its clock), and
-every command the world heard was within the law's bound.
+every command the world heard was within the law's bound; the report says so too: what each
+robot commanded (its stamped command read at the heading of the pose it answered, which the
+world heard) is within c M1, the held command at the body's true heading within sqrt(2) c M1.
 """
 
 import json
@@ -113,8 +115,16 @@ def test_the_team_forms_on_the_world_through_the_relay(processes, install, probe
     assert stats['stale_command_messages'] == {}, stats['stale_command_messages']
     metrics = json.loads((out / 'metrics.json').read_text())
     assert metrics['num_robots'] == 3
-
     bound = config.law().u_bound
+    if config.command.stamped:
+        samples = metrics['num_samples'] * metrics['num_robots']
+        assert metrics.get('unknown_commands', 0) < 0.1 * samples, metrics
+        assert 0.0 < metrics['max_abs_u_hat_component'] <= bound * (1 + 1e-9), metrics
+        assert metrics['bound_violations'] == 0
+    if config.body.is_unicycle:
+        assert metrics['max_abs_u_hat_held_component'] <= math.sqrt(2.0) * bound * (1 + 1e-9)
+        assert metrics['u_hat_held_above_bound'] == 0
+
     heard = np.array([c for commands in watched.commands for c in commands])
     if config.body.is_unicycle:
         v_bound = math.sqrt(2.0) * bound
