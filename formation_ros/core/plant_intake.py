@@ -92,6 +92,12 @@ class CommandIntake:
         commands = self.commands
         return bool(np.all(commands.present & (commands.stamp_ns == stamp_ns)))
 
+    def silent(self, stamp_ns: int) -> List[int]:
+        """Return the robots (1-based) whose latest command does not answer ``stamp_ns``."""
+        commands = self.commands
+        return (np.flatnonzero(~(commands.present & (commands.stamp_ns == stamp_ns)))
+                + 1).tolist()
+
     def missing(self) -> List[int]:
         """Return the robots (1-based) that have sent no command yet."""
         return (np.flatnonzero(~self.commands.present) + 1).tolist()

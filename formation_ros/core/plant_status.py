@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 from formation_ros.core.admission import Reason, Refusals
+from formation_ros.core.lockstep import WAITED, WAITING_FOR
 from formation_ros.core.params import FormationConfig
 from formation_ros.core.plant import CommandStatus, PlantModel, StepReport
 from formation_ros.core.plant_gate import Phase
@@ -62,14 +63,14 @@ def start_line(config: FormationConfig, dt: float) -> str:
 @dataclass
 class Heard:
     """
-    What the plant node read for its status: liveliness, publishers and other nodes.
+    What the plant node read for its status: commands' ages, publishers and other nodes.
 
-    command_states: each robot's 'alive', 'lost' or 'unknown'; team_publishers: live
+    command_states: each robot's 'alive', 'lost' or 'unknown'; team_publishers: matched
     publishers of /formation/commands; listened: (N,) robots whose pose and neighbors are
     published; announced: this node's team values and identity (``ros.team.announced``);
     disagreeing: one line per node with other team values; doubled: {robot node: its
     processes}; plants: the other plants running, described ('' for none); shared: {topic:
-    its other publishers}.
+    its other publishers}; waiting: a lockstep wait being named (``core.lockstep``).
     """
 
     command_states: List[str]
@@ -80,6 +81,7 @@ class Heard:
     doubled: Dict[str, str] = field(default_factory=dict)
     plants: str = ''
     shared: Dict[str, str] = field(default_factory=dict)
+    waiting: Dict[str, object] = field(default_factory=dict)
 
 
 class PlantStatus:
@@ -144,7 +146,7 @@ class PlantStatus:
             values['malformed team command messages'] = refusals.count(TEAM, Reason.MALFORMED)
             values['team command messages in another frame'] = refusals.count(
                 TEAM, Reason.FRAME)
-            values['team command publishers alive'] = heard.team_publishers
+            values['team command publishers'] = heard.team_publishers
             values['robots with pose and neighbors published'] = ', '.join(
                 str(i + 1) for i in np.flatnonzero(listened).tolist()) or 'none'
         for status in NAMED_STATUSES:
@@ -156,6 +158,7 @@ class PlantStatus:
         for state in ('alive', 'lost'):
             values[f'robots with {state} cmd_vel'] = ', '.join(
                 str(i + 1) for i, s in enumerate(states) if s == state) or 'none'
+        values.update(heard.waiting)
         values.update(heard.announced)
         if heard.disagreeing:
             values['nodes with other team values'] = ' | '.join(heard.disagreeing)
@@ -184,9 +187,12 @@ class PlantStatus:
             return 'ok', Phase.LOOKING.value
         if phase is Phase.WAITING:
             return 'ok', Phase.WAITING.value
+        if heard.waiting:
+            robots, waited = heard.waiting[WAITING_FOR], heard.waiting[WAITED]
+            return 'warn', f'lockstep: waiting for robots {robots} for {waited:.1f} s'
         lost = heard.command_states.count('lost')
         if lost:
-            return 'warn', f'{lost} robots gone (cmd_vel liveliness lost)'
+            return 'warn', f'{lost} robots gone (no recent cmd_vel)'
         if not self.lockstep and rate < 0.9 * self.target_rate:
             return 'warn', f'stepping at {rate:.1f} Hz of {self.target_rate:.1f} Hz'
         return 'ok', 'running'

@@ -15,7 +15,7 @@ store, timers act.
 """
 
 import time
-from typing import Dict, List, Optional
+from typing import List, Optional
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.admission import Reason
@@ -24,6 +24,7 @@ from formation_ros.core.declarations import CommandFrame, Exe
 from formation_ros.core.events import event_records, timeline_events
 from formation_ros.core.exits import REFUSED
 from formation_ros.core.frames import desired_positions
+from formation_ros.core.lockstep import AnswerWait
 from formation_ros.core.plant import PlantModel, StepReport
 from formation_ros.core.plant_gate import (CLOCK_MATCH_LINE, ClockMatch, GAVE_UP_LINE,
                                            leftover_line, Phase, refusal_line, StartGate,
@@ -39,7 +40,6 @@ from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import CdrError, read_twist, read_twist_stamped, TeamCommandReader
 from formation_ros.ros.changes import Changes
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
-from formation_ros.ros.liveliness import PeerLiveliness
 from formation_ros.ros.markers import formation_markers, Paths
 from formation_ros.ros.once import OnceLog, RefusalLog
 from formation_ros.ros.parameters import declare_parameters
@@ -97,6 +97,7 @@ class PlantNode(Node):
                                 headings=config.start_headings,
                                 imperfections=config.imperfections)
         self.lockstep, self.team_transport = config.lockstep, config.team_transport
+        self.answer_wait = AnswerWait()
         self.publish_every = 1 if self.lockstep else settings.steps_per_publish
         self.own_name = self.get_fully_qualified_name()
         self.gate = StartGate(time.monotonic(), settings.wait_for_robots or self.lockstep,
@@ -119,14 +120,12 @@ class PlantNode(Node):
             self, self.n, self.dim, config.world_frame, self.team_transport,
             self.team_transport and settings.wait_for_subscribers <= 1,
             self.unicycles or body_frame, self.steady)
-        self.command_liveliness: Dict[str, PeerLiveliness] = {}
+        self.command_topics: List[str] = []
         if self.team_transport:
             self.team_reader = TeamCommandReader(self.n)
-            self.team_liveliness = PeerLiveliness()
             self.team_sub = self.create_subscription(
                 MultiDOFJointTrajectory, topics.TEAM_COMMANDS, self.on_team_command,
-                qos.team_commands_input(self.n), raw=True,
-                event_callbacks=self.team_liveliness.callbacks())
+                qos.team_commands_input(self.n), raw=True)
         else:
             self._command_topics()
         self.clock_sub = self.create_subscription(ClockMsg, topics.CLOCK, self.on_clock,
@@ -134,7 +133,7 @@ class PlantNode(Node):
         self.domain = DomainWatch(
             self, self.team_check, self.once,
             {**dict.fromkeys(self.state_topics.published_topics(), self.own_name),
-             **dict.fromkeys(self.command_liveliness)}, self.command_liveliness,
+             **dict.fromkeys(self.command_topics)}, self.command_topics,
             [topics.robot_node_name(i) for i in range(1, self.n + 1)]
             if self.team_transport else [])
         self.diagnostics_pub = self.create_publisher(
@@ -154,15 +153,14 @@ class PlantNode(Node):
         self.get_logger().info(start_line(config, self.model.dt))
 
     def _command_topics(self) -> None:
-        """Robot transport: hear each robot's cmd_vel, with its DDS liveliness."""
+        """Robot transport: hear each robot's cmd_vel, from any publisher (``COMMAND_INPUT``)."""
         for i in range(self.n):
-            liveliness = PeerLiveliness()
             sub = self.create_subscription(
                 TwistStamped if self.intake.stamped else Twist,
                 topics.robot_topic(i + 1, topics.CMD_VEL),
                 lambda data, index=i: self.on_command(index, data), qos.COMMAND_INPUT,
-                raw=True, event_callbacks=liveliness.callbacks())
-            self.command_liveliness[sub.topic_name] = liveliness
+                raw=True)
+            self.command_topics.append(sub.topic_name)
 
     def on_command(self, index: int, data: bytes) -> None:
         """Store robot ``index``'s command (``core.plant_intake``); lockstep: wake the step."""
@@ -285,6 +283,13 @@ class PlantNode(Node):
         assert self.stats.started is not None
         ahead_s = self.model.t / self.settings.realtime_factor - (now - self.stats.started)
         answered = self.intake.answered(self.model.t_ns)
+        line = self.answer_wait.look([] if answered else self.intake.silent(self.model.t_ns),
+                                     now)
+        if line is not None:
+            if answered:
+                self.get_logger().info(line)
+            else:
+                self.get_logger().warning(line)
         if answered and ahead_s <= 0.0:
             self._step()
             self._publish()
@@ -330,6 +335,8 @@ class PlantNode(Node):
         self.intake.state_stamp_ns = stamp_ns
         self.stats.answers.published(stamp_ns, time.monotonic_ns())
         self.last_publish_wall = time.monotonic()
+        if self.lockstep and self.gate.phase is Phase.RUNNING:
+            self.answer_wait.published(stamp_ns, self.last_publish_wall)
 
     def _resend_if_due(self) -> None:
         if time.monotonic() - self.last_publish_wall > RESEND_AFTER:
@@ -354,8 +361,9 @@ class PlantNode(Node):
                                                      self.gate.phase is Phase.RUNNING)
             heard.doubled, heard.plants = (self.domain.doubled_robots(now),
                                            self.domain.other_plants(now))
+        heard.waiting = self.answer_wait.values(now)
         if self.team_transport:
-            heard.team_publishers = self.team_liveliness.alive
+            heard.team_publishers = self.team_sub.get_publisher_count()
             heard.listened = self.state_topics.listened
         level, message, values = self.status_report.report(
             now, self.model, self.gate.phase, self.changes.states.at(self.model.t_ns).mode.value,
@@ -366,11 +374,9 @@ class PlantNode(Node):
         """
         Return each robot's 'alive', 'lost' or 'unknown', as its commands show it.
 
-        Its cmd_vel's DDS liveliness; team transport: whether its latest command came within
-        the liveliness lease or two state periods, whichever is longer.
+        Whether its latest command came within the liveliness lease or two state periods,
+        whichever is longer: a robot answers every state, whoever publishes its commands.
         """
-        if not self.team_transport:
-            return [peer.state() for peer in self.command_liveliness.values()]
         state_period = self.publish_every * self.model.dt / self.settings.realtime_factor
         lease = max(qos.LIVELINESS_LEASE, 2.0 * state_period)
         return self.intake.arrival_states(time.monotonic_ns(), int(lease * NS_PER_S))

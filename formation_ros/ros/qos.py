@@ -15,25 +15,26 @@ from rclpy.qos import (DurabilityPolicy, HistoryPolicy, LivelinessPolicy, QoSPro
                        ReliabilityPolicy)
 
 LIVELINESS_LEASE = 1.0
-"""Liveliness lease of commands and states, s: a dead peer is noticed within it."""
+"""Liveliness lease offered with commands and states, s: a reader that asks for it (a user's
+monitor) notices a dead peer within it; the plant notices by the commands' age, as long."""
 
 
-def _profile(depth, reliability, durability, lease=None,
-             kept_by=LivelinessPolicy.MANUAL_BY_TOPIC):
-    """Return a keep-last profile, with a ``lease`` (s) to offer or ask for, ``kept_by``."""
+def _profile(depth, reliability, durability, lease=None):
+    """Return a keep-last profile; with a ``lease`` (s) offered, kept by the publisher."""
     if lease is None:
         return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=depth,
                           reliability=reliability, durability=durability)
     return QoSProfile(history=HistoryPolicy.KEEP_LAST, depth=depth, reliability=reliability,
-                      durability=durability, liveliness=kept_by,
+                      durability=durability, liveliness=LivelinessPolicy.MANUAL_BY_TOPIC,
                       liveliness_lease_duration=Duration(seconds=lease))
 
 
 COMMAND = _profile(10, ReliabilityPolicy.RELIABLE, DurabilityPolicy.VOLATILE, LIVELINESS_LEASE)
 """Commands offered (``cmd_vel``, ``/formation/commands``): reliable, the lease kept by them."""
-COMMAND_INPUT = _profile(COMMAND.depth, COMMAND.reliability, COMMAND.durability,
-                         LIVELINESS_LEASE, LivelinessPolicy.AUTOMATIC)
-"""Commands heard by the plant: the lease asked for, kept by DDS (matches both kinds)."""
+COMMAND_INPUT = _profile(COMMAND.depth, ReliabilityPolicy.BEST_EFFORT, COMMAND.durability)
+"""Commands heard by the plant and the world: best effort, no lease asked, so every publisher
+of commands matches (reliable or best effort, with a lease or none: ``ros2 topic pub``, a
+teleop, a user's node); a dead or silent commander shows in the commands' age instead."""
 TEAM_CMD_VEL = _profile(COMMAND.depth, COMMAND.reliability, COMMAND.durability)
 """A team robot's own ``cmd_vel`` (only for those who listen): as COMMAND, no lease."""
 REFERENCE = _profile(10, ReliabilityPolicy.RELIABLE, DurabilityPolicy.TRANSIENT_LOCAL)
@@ -68,8 +69,8 @@ def team_commands_input(robots: int) -> QoSProfile:
     a whole state's answers fit the one history they share (it is kept per topic, as the
     topic has no keys), however long the plant takes to read them.
     """
-    return _profile(max(COMMAND.depth, robots), COMMAND.reliability, COMMAND.durability,
-                    LIVELINESS_LEASE, LivelinessPolicy.AUTOMATIC)
+    return _profile(max(COMMAND.depth, robots), COMMAND_INPUT.reliability,
+                    COMMAND_INPUT.durability)
 
 
 RECORDING_DEPTH = 1000

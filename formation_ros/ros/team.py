@@ -18,14 +18,13 @@ from collections import deque
 import os
 import socket
 import time
-from typing import Callable, Dict, List, Mapping, Optional, Sequence, Set, Tuple
+from typing import Callable, Collection, Dict, List, Mapping, Optional, Sequence, Set, Tuple
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.params import FormationConfig
 from formation_ros.core.team import differences, duplicate_due, team_values
 from formation_ros.core.turns import Turns
 from formation_ros.ros import qos, topics
-from formation_ros.ros.liveliness import PeerLiveliness
 from formation_ros.ros.once import OnceLog
 import numpy as np
 from numpy.typing import NDArray
@@ -302,13 +301,13 @@ class DomainWatch:
     """
     The plant's topics, robot nodes and name, watched for a second of each.
 
-    expected: {topic: its one publisher (fully qualified), None for any one}; commands:
-    {cmd_vel topic: its subscription's liveliness} (robot transport); robot_nodes: the robot
-    nodes' names, watched for two processes (team transport; empty: not watched).
+    expected: {topic: its one publisher (fully qualified), None for any one}; commands: the
+    cmd_vel topics (robot transport); robot_nodes: the robot nodes' names, watched for two
+    processes (team transport; empty: not watched).
     """
 
     def __init__(self, node: Node, team_check: TeamCheck, once: OnceLog,
-                 expected: Mapping[str, Optional[str]], commands: Mapping[str, PeerLiveliness],
+                 expected: Mapping[str, Optional[str]], commands: Collection[str],
                  robot_nodes: Sequence[str]) -> None:
         """Watch the graph of ``node``, whose fully qualified name is the plant's."""
         self.own_name = node.get_fully_qualified_name()
@@ -316,7 +315,7 @@ class DomainWatch:
         self.once = once
         self.graph = PublisherWatch(node, team_check, GRAPH_LOOKS)
         self.expected = dict(expected)
-        self.commands = dict(commands)
+        self.commands = set(commands)
         self.robot_nodes = list(robot_nodes)
         self.shared_by: Set[str] = set()
         """The publishers (names without hosts) of each line on shared topics logged."""
@@ -371,12 +370,16 @@ class DomainWatch:
         return ''
 
     def _alive(self, topic: str, names: Sequence[str]) -> bool:
-        """Whether a same-named second publisher of ``topic`` is known to run."""
+        """
+        Whether a same-named second publisher of ``topic`` is known to run.
+
+        A second robot with one name: two processes announce it on /diagnostics (the graph
+        alone keeps a killed one's endpoints until DDS drops its participant, about 20 s).
+        """
         now = time.monotonic()
-        liveliness = self.commands.get(topic)
-        if liveliness is None:
+        if topic not in self.commands:
             return bool(self.team_check.running(self.own_name, now))
-        return liveliness.alive >= 2 or len(self.team_check.running(names[0], now)) >= 2
+        return len(self.team_check.running(names[0], now)) >= 2
 
 
 def _some(topics: List[str], shown: int = 3) -> str:

@@ -5,6 +5,7 @@
 
 from formation_ros.core.admission import Reason, Refusals
 from formation_ros.core.law import make_law
+from formation_ros.core.lockstep import WAITED, WAITING_FOR
 from formation_ros.core.plant import Commands, CommandStatus, PlantModel
 from formation_ros.core.plant_gate import Phase
 from formation_ros.core.plant_intake import TEAM
@@ -36,7 +37,7 @@ def test_the_level_follows_the_start_up_then_lost_robots_then_the_rate():
         'ok', 'waiting for the robots')
     level, message, values = report.report(3.0, plant, Phase.RUNNING, 'running', 0, Refusals(),
                                            Heard(['alive', 'lost', 'unknown']))
-    assert (level, message) == ('warn', '1 robots gone (cmd_vel liveliness lost)')
+    assert (level, message) == ('warn', '1 robots gone (no recent cmd_vel)')
     assert values['robots with alive cmd_vel'] == '1'
     assert values['robots with lost cmd_vel'] == '2'
     commands = Commands.empty(3, 2)
@@ -50,6 +51,12 @@ def test_the_level_follows_the_start_up_then_lost_robots_then_the_rate():
     report.restart(4.0, plant.counts.steps)
     assert status(lockstep=True).report(5.0, plant, Phase.RUNNING, 'running', 0, Refusals(),
                                         alive)[:2] == ('ok', 'running')
+    waiting = Heard(['alive', 'lost', 'alive'],
+                    waiting={WAITING_FOR: '2', WAITED: 2.31})
+    level, message, values = status(lockstep=True).report(6.0, plant, Phase.RUNNING, 'running',
+                                                          0, Refusals(), waiting)
+    assert (level, message) == ('warn', 'lockstep: waiting for robots 2 for 2.3 s')
+    assert values[WAITING_FOR] == '2' and values[WAITED] == 2.31
 
 
 def test_errors_come_first_and_name_what_was_heard():
@@ -80,7 +87,7 @@ def test_refusals_show_under_the_keys_of_before():
     assert values['refused shape messages'] == 1
     assert values['malformed team command messages'] == 1
     assert values['team command messages in another frame'] == 1
-    assert values['team command publishers alive'] == 2
+    assert values['team command publishers'] == 2
     assert values['robots with pose and neighbors published'] == '1, 3'
     assert values['team'] == 'stopped' and values['held steps'] == 7
     plain = status().report(1.0, model(), Phase.RUNNING, 'running', 0, Refusals(),

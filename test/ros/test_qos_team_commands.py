@@ -7,8 +7,8 @@ The plant's team-command history holds a whole state's answers, over real DDS.
 Every fleet answers a state at once on the one ``/formation/commands`` topic, whose history a
 reader keeps per topic (it has no keys), not per publisher: while the plant steps, the
 answers wait there. Here 30 publishers (30 fleets) each send one command while the reader's
-node is not spinning; once every sample is acknowledged (in the reader's history), the reader
-takes what it kept.
+node is not spinning; once every sample is acknowledged (a reliable reader) or sent (the
+plant's best-effort one), the reader takes what it kept until nothing more comes.
 """
 
 from typing import List
@@ -75,4 +75,5 @@ def test_the_team_history_is_never_shallower_than_a_command_history():
     deep = qos.team_commands_input(1000)
     assert deep.depth == 1000
     assert (deep.reliability, deep.durability, deep.liveliness_lease_duration) == (
-        qos.COMMAND.reliability, qos.COMMAND.durability, qos.COMMAND.liveliness_lease_duration)
+        qos.COMMAND_INPUT.reliability, qos.COMMAND_INPUT.durability,
+        qos.COMMAND_INPUT.liveliness_lease_duration)
