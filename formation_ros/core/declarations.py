@@ -457,7 +457,8 @@ DECLARATIONS = (
           low=above(0.0), high=at_least(1e6), users=PHYSICS),
     Param('world.floor_friction', Kind.DOUBLE, 1.0,
           'Sliding friction coefficient between the floor and the wheels (unicycles) or the '
-          'traction of a holonomic base (2D points).', low=above(0.0), high=at_least(10.0),
+          'traction of a holonomic base (2D points); below 0.01 (no real floor) MuJoCo loses '
+          'the bases.', low=at_least(0.01), high=at_least(10.0),
           users=PHYSICS),
     Param('world.cmd_timeout', Kind.DOUBLE, 0.5,
           "A robot's command older than this (by its stamp), or none for this long, stops its "

@@ -19,6 +19,13 @@ saying how much it holds, and ended. The launcher ends with the same code when a
 recording stopped early. 74 is ``EX_IOERR`` of sysexits.h.
 """
 
+ENGINE_FAILED = 70
+"""
+The physics engine blew up (a pose non-finite or absurd): the world stopped within the step,
+logged one line naming the robot and the simulated time, and wrote what it had. 70 is
+``EX_SOFTWARE`` of sysexits.h.
+"""
+
 REFUSED = 2
 """
 The node refused to run here, or was given bad parameters or usage: it logged one line saying

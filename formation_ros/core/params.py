@@ -245,8 +245,20 @@ WORLD_FIELDS = ('timestep', 'realtime_factor', 'pose_rate', 'pose_noise', 'mass'
                 'wheel_radius', 'wheel_track', 'wheel_torque', 'force_limit', 'torque_limit',
                 'floor_friction', 'cmd_timeout', 'output_dir')
 """The fields of :class:`WorldSettings` read from ``world.<field>``."""
+WORLD_MAX_ROBOTS = 1000
+"""The most robots the physics engine takes (the world node, ``formation_sim --engine
+mujoco``): MuJoCo's compile time grows with the square of the bodies (1000: 8 s, 4000: out of
+its memory); docs/physics.md ("What the world refuses")."""
 TIMESTEP_NS_TOLERANCE = 1e-6
 """A timestep is a whole number of ns when within this many ns of one."""
+
+
+def world_size_problem(num_robots: int) -> Optional[str]:
+    """Return why the physics engine cannot take ``num_robots`` bodies, or None if it can."""
+    if num_robots <= WORLD_MAX_ROBOTS:
+        return None
+    return (f'{num_robots} robots are more than the physics world takes ({WORLD_MAX_ROBOTS}: '
+            "MuJoCo's compile time grows with the square of the bodies)")
 
 
 def world_settings(values: Mapping[str, Any], problems: Problems) -> WorldSettings:
@@ -809,6 +821,9 @@ def validate(raw: Mapping[str, Any], executable: Union[Exe, str] = Exe.SIM) -> F
     values = check_values(raw, exe)
     problems: Problems = []
     n, dim = values['num_robots'], values['dim']
+    too_many = world_size_problem(n) if exe is Exe.WORLD else None
+    if too_many:
+        raise ParamError([('num_robots', too_many)])
     radii = np.full(n, values['sensing_radius'], dtype=float)
     if values.get('sensing_radii') is not None:
         if len(values['sensing_radii']) != n:

@@ -2,10 +2,11 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-When the plant may publish its first state and start its clock: its start gate, without ROS.
+When the plant (or the world) may publish its first state and start its clock, without ROS.
 
 The plant node reads the graph (the other ``/clock`` publishers, who announced them, the
-subscribers) and feeds it here; the gate decides. Another team on the domain is
+subscribers) and feeds it here (``ros.clock_look``); the gate decides. The world node looks
+through the same gate, without holding its clock for the robots. Another team on the domain is
 ``core.occupants``'s rule, which the launcher applies too (:func:`domain_verdict`); the
 start-up order is docs/ros_interface.md ("Behaviour of the nodes", Start-up) and docs/faults.md
 (another team's plant already on the domain). Times are steady clock seconds.
@@ -27,6 +28,8 @@ CLOCK_MATCH_WAIT = 5.0
 """Once every robot is up, how long the clock waits at most for each /clock subscriber the
 graph shows to be matched to its publisher, s (one that never matches cannot hold the team)."""
 CLOCK_MATCH_LINE = 'every robot is up: waiting for /clock to reach its subscribers'
+CLOCK_MAKERS = ('plant', 'world')
+"""The names of the nodes that make a team's simulated clock."""
 GAVE_UP_LINE = (f'a /clock subscriber is still not matched after {CLOCK_MATCH_WAIT:g} s (a QoS '
                 '/clock does not offer?): starting the clock all the same')
 
@@ -72,10 +75,11 @@ class ClockMatch(enum.Enum):
 
 class StartGate:
     """
-    The plant's start-up: look at the domain, then hold the clock for the robots, then run.
+    The start-up of a node that makes the clock: look at the domain, hold the clock, run.
 
     created: when the node was made, s; hold: whether the clock waits for every robot
-    (``plant.wait_for_robots`` or lockstep); own_name: the node's fully qualified name.
+    (``plant.wait_for_robots`` or lockstep; never for the world); own_name: the node's fully
+    qualified name.
     """
 
     def __init__(self, created: float, hold: bool, own_name: str) -> None:
@@ -170,21 +174,28 @@ def waiting_line(missing: Sequence[int], num_robots: int, wanted: int,
             f'{list(missing[:10])}{more}) and for {listeners}')
 
 
+def clock_maker(names: Sequence[str]) -> str:
+    """Return what the /clock publishers ``names`` are: 'plant', 'world' or '/clock publisher'."""
+    kinds = [name.rsplit('/', 1)[-1] for name in names]
+    return next((kind for kind in kinds if kind in CLOCK_MAKERS), '/clock publisher')
+
+
 def leftover_line(name: str, waited: float) -> str:
-    """Return the line of a silent /clock publisher ``name`` taken for a killed plant's."""
+    """Return the line of a silent /clock publisher ``name`` taken for a killed node's."""
+    maker = clock_maker([name])
+    killed = maker if maker in CLOCK_MAKERS else 'plant'
     return (f'{name} is listed as a /clock publisher but sent nothing for {waited:.1f} s: taken '
-            'for what is left of a plant that was killed (DDS forgets it within about 20 s); '
-            'starting')
+            f'for what is left of a {killed} that was killed (DDS forgets it within about 20 '
+            's); starting')
 
 
 def refusal_line(others: Sequence[str], domain_id: int, named: str) -> str:
     """
-    Return the line of a plant refusing to start beside the /clock publishers ``others``.
+    Return the line of a plant or world refusing to start beside the /clock publishers ``others``.
 
     domain_id: the ROS_DOMAIN_ID; named: ``others`` named with their hosts where known.
     """
-    plant = any(name.rsplit('/', 1)[-1] == 'plant' for name in others)
-    return (f"refusing to start: another {'plant' if plant else '/clock publisher'} is on "
+    return (f'refusing to start: another {clock_maker(others)} is on '
             f'ROS_DOMAIN_ID {domain_id}: {named} publishes /clock (another team? stop it, or '
             'run this team on a domain of its own: export ROS_DOMAIN_ID=N, or the launcher '
             'without ROS_DOMAIN_ID set)')

@@ -29,6 +29,7 @@ from formation_ros.core.admission import Reason
 from formation_ros.core.commanded import commanded_velocity, HeardOrientations, needs_orientation
 from formation_ros.core.declarations import CommandFrame, Exe
 from formation_ros.core.exits import ENGINE_FAILED, REFUSED
+from formation_ros.core.params import world_size_problem
 from formation_ros.core.plant_gate import leftover_line, Phase, StartGate, Verdict
 from formation_ros.core.trajectory import (CHUNKS_DIR, ChunkWriter, read_body_chunks,
                                            read_chunks, read_held_chunks, save_atomically,
@@ -519,4 +520,4 @@ class WorldNode(Node):
 
 def main(args: Optional[List[str]] = None) -> int:
     """Entry point of ``ros2 run formation_ros world``."""
-    return run(WorldNode, args, name='world')
+    return run(WorldNode, args, name='world', robots_rule=world_size_problem)

@@ -21,6 +21,11 @@ crazyswarm2's simulator backends share one. It builds the scene of a validated c
   every ``odometry.ODOMETRY_PERIOD``);
 * :attr:`Engine.contacts` counts contact events between robots from MuJoCo's contact list and
   :attr:`Engine.closest` keeps the closest approach of two robots' positions.
+
+A step that makes a body's pose non-finite or absurd (MuJoCo's own check of the state, which
+resets it, or a body faster than :data:`ABSURD_SPEED`) raises :class:`Unstable` naming the
+robot and the simulated time; the engine then refuses to step again, and its poses are those
+of the step before (docs/physics.md, "When the engine blows up").
 """
 
 from dataclasses import dataclass
@@ -42,6 +47,30 @@ from numpy.typing import ArrayLike, NDArray
 Float = NDArray[np.float64]
 WXYZ_TO_XYZW = (1, 2, 3, 0)
 """MuJoCo's quaternions are (w, x, y, z), the package's (x, y, z, w)."""
+ABSURD_SPEED = 100.0
+"""A pose body moving faster than this, m/s, is taken for an engine that blew up: a thousand
+times a TurtleBot3's 0.22 m/s; MuJoCo's own check misses the growth that comes before."""
+BAD_STATE = (int(mujoco.mjtWarning.mjWARN_BADQPOS), int(mujoco.mjtWarning.mjWARN_BADQVEL),
+             int(mujoco.mjtWarning.mjWARN_BADQACC))
+"""MuJoCo's warnings of a state it found non-finite or huge (it then resets the state)."""
+BAD_STATE_WORDS = ('its position', 'its velocity', 'its acceleration')
+
+
+class Unstable(Exception):
+    """
+    The engine blew up: robot ``robot`` (1-based) got an absurd pose at ``t`` s (simulated).
+
+    what: what was wrong, in a few words.
+    """
+
+    def __init__(self, robot: int, t: float, what: str) -> None:
+        """Keep the robot, the time and what was wrong."""
+        super().__init__(f'robot {robot}: {what} at t = {t:.3f} s')
+        self.robot, self.t, self.what = robot, t, what
+
+
+def _quiet(message: bytes) -> None:
+    """Keep MuJoCo's warnings off the terminal: the engine reads them from its data."""
 
 
 @dataclass(frozen=True)
@@ -83,6 +112,8 @@ class Engine:
     def __init__(self, config: FormationConfig, world: Optional[WorldSettings] = None):
         """Build the scene of ``config`` (validated with a start) with ``world`` (default its)."""
         self.world = world or config.world or WorldSettings()
+        mujoco.set_mju_user_warning(_quiet)
+        self.failure: Optional[Unstable] = None
         self.scene: Scene = build_scene(config, self.world)
         self.model = self.scene.model
         self.mj_model = mujoco.MjModel.from_xml_string(self.scene.xml)
@@ -100,12 +131,16 @@ class Engine:
         self._pose_bodies = np.array([self._id(mujoco.mjtObj.mjOBJ_BODY, name)
                                       for name in self.scene.names])
         self._geom_robot = self._robots_of_geoms()
+        self._body_robot = self._robots_of_bodies()
+        self._warnings = self.data.warning.number[list(BAD_STATE)].copy()
         self._noise = np.random.default_rng([self.world.seed, NOISE_SEED_OFFSET])
         mujoco.mj_forward(self.mj_model, self.data)
         start = self.poses()
         self.contacts = ContactLog(n, 2.0 * self.model.footprint + RELEASE_GAP)
         self.closest = ClosestApproach(start.positions[:, :self.dim],
                                        2.0 * self.model.footprint)
+        self._last_positions = start.positions[:, :self.dim].copy()
+        self._max_move = ABSURD_SPEED * self.world.timestep
         self._no_yaw = np.zeros(n)
         self._live = np.zeros(n, dtype=bool)
         self._changed = True
@@ -128,13 +163,17 @@ class Engine:
         """Return where hinge ``joint``'s angle is in qpos."""
         return int(self.mj_model.jnt_qposadr[self._id(mujoco.mjtObj.mjOBJ_JOINT, joint)])
 
-    def _robots_of_geoms(self) -> NDArray[np.intp]:
-        """Return the robot (0-based) each geom belongs to, -1 for the world's: (ngeom,)."""
+    def _robots_of_bodies(self) -> NDArray[np.intp]:
+        """Return the robot (0-based) each body belongs to, -1 for the world's: (nbody,)."""
         robot_of_root = np.full(self.mj_model.nbody, -1, dtype=np.intp)
         roots = self.mj_model.body_rootid[self._pose_bodies]
         robot_of_root[roots] = np.arange(self.num_robots)
-        result: NDArray[np.intp] = robot_of_root[
-            self.mj_model.body_rootid[self.mj_model.geom_bodyid]]
+        result: NDArray[np.intp] = robot_of_root[self.mj_model.body_rootid]
+        return result
+
+    def _robots_of_geoms(self) -> NDArray[np.intp]:
+        """Return the robot (0-based) each geom belongs to, -1 for the world's: (ngeom,)."""
+        result: NDArray[np.intp] = self._robots_of_bodies()[self.mj_model.geom_bodyid]
         return result
 
     @property
@@ -192,14 +231,56 @@ class Engine:
         self.data.ctrl[:] = self.model.controls(held, yaw).ravel()
 
     def step(self, n_steps: int = 1) -> None:
-        """Advance ``n_steps`` engine steps, each ``world.timestep``."""
+        """
+        Advance ``n_steps`` engine steps, each ``world.timestep``.
+
+        Raises :class:`Unstable` at the first step that leaves a pose non-finite or absurd
+        (then at every call: the engine does not step again).
+        """
+        if self.failure is not None:
+            raise self.failure
         begun = time.perf_counter()
-        for _ in range(int(n_steps)):
-            self._controls()
-            mujoco.mj_step(self.mj_model, self.data)
-            self.steps += 1
-            self._observe()
-        self.wall += time.perf_counter() - begun
+        try:
+            for _ in range(int(n_steps)):
+                self._controls()
+                mujoco.mj_step(self.mj_model, self.data)
+                self._check()
+                self.steps += 1
+                self._observe()
+        finally:
+            self.wall += time.perf_counter() - begun
+
+    def _check(self) -> None:
+        """After a step: raise :class:`Unstable` if the state is non-finite or absurd."""
+        warnings = self.data.warning.number[list(BAD_STATE)]
+        positions = self.data.xpos[self._pose_bodies, :self.dim]
+        moves = np.abs(positions - self._last_positions)
+        if np.array_equal(warnings, self._warnings) and np.all(moves <= self._max_move):
+            self._last_positions = positions.copy()
+            return
+        t = (self.steps + 1) * self.step_ns / NS_PER_S
+        changed = np.flatnonzero(warnings != self._warnings)
+        if len(changed):
+            kind = int(changed[0])
+            self.failure = Unstable(self._robot_of_warning(kind), t,
+                                    f'MuJoCo found {BAD_STATE_WORDS[kind]} non-finite or huge')
+        else:
+            worst = np.nan_to_num(moves, nan=np.inf).max(axis=1)
+            robot = int(np.argmax(worst))
+            self.failure = Unstable(robot + 1, t, 'its pose moved faster than '
+                                                  f'{ABSURD_SPEED:g} m/s (or not finite)')
+        raise self.failure
+
+    def _robot_of_warning(self, kind: int) -> int:
+        """Return the robot (1-based) of MuJoCo's last warning of bad state ``kind`` (0: none)."""
+        where = int(self.data.warning.lastinfo[BAD_STATE[kind]])
+        model = self.mj_model
+        if BAD_STATE[kind] == int(mujoco.mjtWarning.mjWARN_BADQPOS):
+            joint = max(int(np.searchsorted(model.jnt_qposadr, where, side='right')) - 1, 0)
+            body = int(model.jnt_bodyid[joint])
+        else:
+            body = int(model.dof_bodyid[min(where, model.nv - 1)])
+        return int(self._body_robot[body]) + 1
 
     def _observe(self) -> None:
         """After a step: odometry, contacts between robots, the closest approach."""

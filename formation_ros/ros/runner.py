@@ -114,9 +114,16 @@ def _params_files(args: List[str]) -> List[str]:
     return [args[k + 1] for k, arg in enumerate(args[:-1]) if arg == '--params-file']
 
 
-def params_file_problem(path: str) -> Optional[str]:
+RobotsRule = Callable[[int], Optional[str]]
+"""Why a process cannot take a team of that many robots (None: it can)."""
+
+
+def params_file_problem(path: str, robots_rule: Optional[RobotsRule] = None) -> Optional[str]:
     """
     Return, as one line naming ``path``, what keeps it from being a parameters file; or None.
+
+    robots_rule: the process's limit on ``num_robots``, applied to the file's before rcl
+    parses it (rcl's parser takes minutes over the arrays of 100,000 robots).
 
     The file is checked by :mod:`formation_ros.core.file_guard` (size, anchors, depth, array
     lengths, YAML syntax in this package's words), never parsed in full, and must hold a
@@ -132,13 +139,14 @@ def params_file_problem(path: str) -> Optional[str]:
     if shape.root != 'mapping':
         return (f'{path}: is not a ROS 2 parameters file (no mapping of node names to '
                 'ros__parameters)')
-    return None
+    too_many = robots_rule(shape.num_robots) if robots_rule and shape.num_robots else None
+    return f'{path}: num_robots: {too_many}' if too_many else None
 
 
-def _init(args: Optional[List[str]], name: str) -> bool:
+def _init(args: Optional[List[str]], name: str, robots_rule: Optional[RobotsRule]) -> bool:
     """Start rclpy; on a bad command line or parameters file say so in one line, False."""
     for path in _params_files(sys.argv if args is None else args):
-        problem = params_file_problem(path)
+        problem = params_file_problem(path, robots_rule)
         if problem:
             print(f'{name}: parameters file {problem}', file=sys.stderr)
             return False
@@ -200,7 +208,8 @@ NodeFactory = Callable[[], Union[Node, Sequence[Node]]]
 """Builds the process's node, or its nodes (a fleet of robots): a node class, for one."""
 
 
-def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = 'node') -> int:
+def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = 'node',
+        robots_rule: Optional[RobotsRule] = None) -> int:
     """
     Start rclpy, build the node(s), spin until SIGINT/SIGTERM, shut down without a traceback.
 
@@ -215,9 +224,10 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
     its domain (:data:`formation_ros.core.exits.REFUSED`); the node has said why, in its own
     line. Returns the exit code: 0; 1 if a node's ``finish()`` failed (the others still
     finish); 2 for invalid parameters (one line per bad parameter) or a command line rclpy
-    cannot start from; a node's ``exit_code``.
+    cannot start from; a node's ``exit_code``. robots_rule: the process's limit on a parameters
+    file's ``num_robots`` (the world's), checked before rcl parses the file.
     """
-    if not _init(args, name):
+    if not _init(args, name, robots_rule):
         return REFUSED
     signal.signal(signal.SIGINT, _StopRequest.handler)
     signal.signal(signal.SIGTERM, _StopRequest.handler)

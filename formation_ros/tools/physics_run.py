@@ -23,7 +23,7 @@ from formation_ros.core.bodies import make_bodies
 from formation_ros.core.declarations import CommandFrame
 from formation_ros.core.frames import FrameSample
 from formation_ros.core.law import team_command
-from formation_ros.core.params import FormationConfig, WorldSettings
+from formation_ros.core.params import FormationConfig, world_size_problem, WorldSettings
 from formation_ros.core.timeline import Shape, Timeline
 from formation_ros.core.trajectory import Trajectory
 from formation_ros.core.units import NS_PER_S
@@ -54,6 +54,9 @@ class EngineRun:
 def engine_problem(config: FormationConfig, control_dt: float) -> Optional[str]:
     """Say why ``config`` cannot run on the engine with ``control_dt`` s, or None."""
     world = config.world or WorldSettings()
+    too_many = world_size_problem(config.num_robots)
+    if too_many:
+        return f'num_robots: {too_many}'
     steps = control_dt / world.timestep
     if steps < 1.0 - STEP_TOLERANCE or abs(steps - round(steps)) > STEP_TOLERANCE * steps:
         return (f'--dt {control_dt:g} s must be a whole number of world.timestep = '
