@@ -56,8 +56,8 @@ def test_a_world_or_a_plant_refuses_beside_a_running_one(processes, install, pro
     world = processes.start(node(install, 'world', TEAM))
     assert probe.spin_until(lambda: clock.seconds > 0.2, START_UP), processes.log('world')
     processes.start(node(install, 'world', TEAM, process='world_2'))
-    processes.start(node(install, 'plant', TEAM, process='plant_2'))
     refused(probe, processes, 'world_2', 'world', world.pid)
+    processes.start(node(install, 'plant', TEAM, process='plant_2'))
     refused(probe, processes, 'plant_2', 'world', world.pid)
     assert probe.spin_until(lambda: probe.count_publishers('/clock') == 1, 30)
     assert [info.node_name for info in probe.get_publishers_info_by_topic('/clock')] == ['world']
@@ -88,7 +88,8 @@ def moving(heard):
 def world_pid(install):
     """Return the process id of the world the launcher started (from the process table)."""
     world = [line for line in project_processes(install)
-             if os.path.join('formation_ros', 'world') in line.split()[1]]
+             if any(arg.endswith(os.path.join('formation_ros', 'world'))
+                    for arg in line.split()[1:3])]
     assert len(world) == 1, project_processes(install)
     return int(world[0].split()[0])
 
@@ -123,7 +124,7 @@ def test_a_world_killed_by_hand_leaves_every_robot_still_saying_why(
                              process=f'robot_{i}'))
     assert probe.spin_until(lambda: moving(heard), START_UP), processes.log('world')
     processes.send_signal('world', signal.SIGKILL)
-    stale = 'no new pose, neighbors for 0.5 s: publishing zero'
+    stale = 'no new pose, neighbour for 0.5 s: publishing zero'
     for i in (1, 2):
         logged(probe, processes, f'robot_{i}', stale)
     counts = {i: len(commands) for i, commands in heard.items()}
