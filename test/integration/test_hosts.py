@@ -294,13 +294,13 @@ def test_formation_converges_with_20_percent_loss_on_every_robot_link(net, insta
             first, last = 2.0, min(heard[-1], published[-1], sent[-1], arrived[-1]) - 0.5
             poses.append(delivered(heard, sent, first, last))
             commands.append(delivered(arrived, published, first, last))
-    print(f'delivered across a 20 % loss link: pose (best effort) {min(poses):.3f} to '
-          f'{max(poses):.3f}, cmd_vel (reliable) {min(commands):.3f} to {max(commands):.3f}; '
+    print(f'delivered across a 20 % loss link: pose {min(poses):.3f} to {max(poses):.3f}, '
+          f'cmd_vel {min(commands):.3f} to {max(commands):.3f} (both best effort); '
           f"settle time {metrics['settle_time']} s")
     alarms = [values_of(status)['robots with lost cmd_vel']
               for _, m in topics['/diagnostics'] for status in m.status
               if status.name == 'formation_ros/plant']
-    print(f"plant statuses with a robot's liveliness lost at 20 % loss: "
+    print(f"plant statuses with a robot's commands lost at 20 % loss: "
           f"{sum(a != 'none' for a in alarms)} of {len(alarms)}")
     shares = []
     for host in run.robots:
@@ -308,9 +308,8 @@ def test_formation_converges_with_20_percent_loss_on_every_robot_link(net, insta
             assert seen > 1000 and 0.15 < dropped / seen < 0.25, (host, hook, seen, dropped)
             shares.append(dropped / seen)
     print(f'packets dropped by nftables: {min(shares):.3f} to {max(shares):.3f}')
-    # Delivered fractions are measured, not promised: a reliable keep-last-10 writer replaces a
-    # lost command whose repair takes longer than ten newer ones (0.5 s at 20 Hz), so cmd_vel
-    # may deliver fewer than the best-effort poses on a bad stretch (0.70 against 0.80 seen).
+    # Delivered fractions are measured, not promised: the plant hears cmd_vel best effort (it
+    # takes any publisher, qos.COMMAND_INPUT), so a lost command is replaced by the next one.
     # The floor only says that most samples still cross: 0.57 is the lowest share seen.
     assert all(0.3 < share for share in poses + commands), (poses, commands)
 

@@ -77,11 +77,15 @@ def lockstep_run(processes, probe, install, tmp_path, transport):
 
     launch(processes, install, params, name=transport, options=('--robots-per-process', '2'))
     leaders = ['/robot_1', '/robot_3']
-    assert probe.spin_until(lambda: every_robot_reports()
-                            and robot_subscribers(probe, '/formation/reference') == leaders,
-                            START_UP), (statuses, processes.log(transport))
-    assert robot_subscribers(probe, '/formation/shape') == leaders
-    assert robot_subscribers(probe, '/formation/status') == leaders
+    shared = ('/formation/reference', '/formation/shape', '/formation/status')
+
+    def leaders_subscribe():
+        # the graph shows each subscription when its announcement arrives, in any order
+        return all(robot_subscribers(probe, topic) == leaders for topic in shared)
+
+    assert probe.spin_until(lambda: every_robot_reports() and leaders_subscribe(), START_UP), (
+        statuses, {topic: robot_subscribers(probe, topic) for topic in shared},
+        processes.log(transport))
     assert robot_subscribers(probe, '/clock') == []
     try:
         info = stop_when(probe, processes,
