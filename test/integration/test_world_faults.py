@@ -105,7 +105,7 @@ def test_a_world_killed_under_the_launcher_stops_the_run_and_names_the_world(
     info = wait_exit(probe, processes, 'launcher', 60)
     log = processes.log('launcher')
     assert info is not None and info.returncode == 1, log
-    assert 'world ended on its own (killed by SIGKILL); stopped the others' in log, log
+    assert 'world ended on its own (signal SIGKILL); stopped the others' in log, log
     assert probe.spin_until(lambda: not project_processes(install), 30), \
         project_processes(install)
     assert all(commands[-1] == (0.0, 0.0) for commands in heard.values()), heard
