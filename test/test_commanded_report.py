@@ -16,9 +16,10 @@ import os
 
 from formation_ros.core.params import validate
 from formation_ros.core.params_file import load_params_file
-from formation_ros.core.unicycle import quaternions_from_headings, unicycle_commands
+from formation_ros.core.unicycle import unicycle_commands
 from formation_ros.ros.bag_writer import BagWriter, TYPESTORE
 from formation_ros.tools.report import main as report_main
+from bag_messages import header, pose_msg, unicycle_twist
 import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -32,28 +33,6 @@ WANTED = (0.15, 0.15)
 """Robot 1's hand-point velocity: both components at c M1, m/s."""
 TURNED = max(0.15 * (math.cos(k * TURN) + math.sin(k * TURN)) for k in range(4))
 """The largest component of WANTED turned by the heading robot 1 turned since, m/s."""
-
-
-def header(stamp_ns, frame):
-    return TYPES['std_msgs/msg/Header'](
-        stamp=TYPES['builtin_interfaces/msg/Time'](sec=stamp_ns // NS, nanosec=stamp_ns % NS),
-        frame_id=frame)
-
-
-def pose(stamp_ns, position, heading):
-    qx, qy, qz, qw = quaternions_from_headings(heading)
-    return TYPES['geometry_msgs/msg/PoseStamped'](
-        header=header(stamp_ns, 'world'),
-        pose=TYPES['geometry_msgs/msg/Pose'](
-            position=TYPES['geometry_msgs/msg/Point'](x=float(position[0]),
-                                                      y=float(position[1]), z=0.0),
-            orientation=TYPES['geometry_msgs/msg/Quaternion'](x=qx, y=qy, z=qz, w=qw)))
-
-
-def twist(v, w):
-    vector = TYPES['geometry_msgs/msg/Vector3']
-    return TYPES['geometry_msgs/msg/Twist'](linear=vector(x=float(v), y=0.0, z=0.0),
-                                            angular=vector(x=0.0, y=0.0, z=float(w)))
 
 
 def write_bag(folder, stamped, excess):
@@ -78,12 +57,12 @@ def write_bag(folder, stamped, excess):
             headings = [1.0 + TURN * k, -0.4, 0.3, 2.0]
             for i in range(4):
                 bag.write(f'/robot_{i + 1}/pose', stamp + 1, TYPESTORE.serialize_cdr(
-                    pose(stamp, config.start[i], headings[i]), 'geometry_msgs/msg/PoseStamped'))
+                    pose_msg(stamp, config.start[i], headings[i]), 'geometry_msgs/msg/PoseStamped'))
             commands = {2: unicycle_commands((excess, 0.0), headings[1], 0.08)}
             if k == 0:
                 commands[1] = unicycle_commands(WANTED, headings[0], 0.08)
             for i, (v, w) in commands.items():
-                message = twist(v, w)
+                message = unicycle_twist(v, w)
                 if stamped:
                     message = TYPES['geometry_msgs/msg/TwistStamped'](
                         header=header(stamp, f'robot_{i}/base_link'), twist=message)

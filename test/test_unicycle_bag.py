@@ -7,10 +7,10 @@ import json
 import os
 
 from formation_ros.core.params import load_config
-from formation_ros.core.unicycle import quaternions_from_headings
 from formation_ros.ros.bag_writer import BagWriter, TYPESTORE
 from formation_ros.tools.report import main as report_main
 from formation_ros.tools.sim import run_metrics, simulate
+from bag_messages import header, pose_msg, unicycle_twist
 import numpy as np
 import pytest
 
@@ -20,31 +20,10 @@ NS = 1_000_000_000
 TYPES = TYPESTORE.types
 
 
-def header(stamp_ns, frame):
-    return TYPES['std_msgs/msg/Header'](
-        stamp=TYPES['builtin_interfaces/msg/Time'](sec=stamp_ns // NS, nanosec=stamp_ns % NS),
-        frame_id=frame)
-
-
-def vector3(x, y, z):
-    return TYPES['geometry_msgs/msg/Vector3'](x=float(x), y=float(y), z=float(z))
-
-
-def pose_msg(stamp_ns, position, heading):
-    qx, qy, qz, qw = quaternions_from_headings(heading)
-    return TYPES['geometry_msgs/msg/PoseStamped'](
-        header=header(stamp_ns, 'world'),
-        pose=TYPES['geometry_msgs/msg/Pose'](
-            position=TYPES['geometry_msgs/msg/Point'](x=float(position[0]),
-                                                      y=float(position[1]), z=0.0),
-            orientation=TYPES['geometry_msgs/msg/Quaternion'](x=qx, y=qy, z=qz, w=qw)))
-
-
 def twist_msg(stamp_ns, robot, command):
     return TYPES['geometry_msgs/msg/TwistStamped'](
         header=header(stamp_ns, f'robot_{robot}/base_link'),
-        twist=TYPES['geometry_msgs/msg/Twist'](linear=vector3(command[0], 0, 0),
-                                               angular=vector3(0, 0, command[1])))
+        twist=unicycle_twist(command[0], command[1]))
 
 
 def test_report_of_a_unicycle_bag_equals_the_simulation(tmp_path):
