@@ -27,8 +27,8 @@ from formation_ros.core.frames import desired_positions
 from formation_ros.core.lockstep import AnswerWait
 from formation_ros.core.plant import PlantModel, StepReport
 from formation_ros.core.plant_gate import (CLOCK_MATCH_LINE, ClockMatch, GAVE_UP_LINE,
-                                           leftover_line, Phase, refusal_line, StartGate,
-                                           Verdict, waiting_line)
+                                           leftover_line, Phase, StartGate, Verdict,
+                                           waiting_line)
 from formation_ros.core.plant_intake import CommandIntake, Source, TEAM
 from formation_ros.core.plant_stats import RunOutput, RunStats
 from formation_ros.core.plant_status import (collision_lines, CommandWatch, Heard, Note,
@@ -39,6 +39,7 @@ from formation_ros.core.units import NS_PER_S
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import CdrError, read_twist, read_twist_stamped, TeamCommandReader
 from formation_ros.ros.changes import Changes
+from formation_ros.ros.clock_look import look_at_clock, refusal
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.markers import formation_markers, Paths
 from formation_ros.ros.once import OnceLog, RefusalLog
@@ -233,19 +234,15 @@ class PlantNode(Node):
         if not self.gate.look_due(now, at_once):
             return self.gate.looked
         looking = self.gate.phase is Phase.LOOKING
-        others = self.domain.graph.named_publishers(topics.CLOCK, now)
-        if others is not None and self.own_name in others:
-            others.remove(self.own_name)
-        running = [name for name in others or [] if self.team_check.running(name, now)]
-        verdict = self.gate.heard(others, running, self.clock_heard > 0, now)
+        verdict, others = look_at_clock(self.domain.graph, self.team_check, self.gate,
+                                        self.clock_heard > 0, now)
         if self.gate.phase is Phase.REFUSED:
-            refused = self.gate.refused
-            self.refusal = refusal_line(refused, self.context.get_domain_id(),
-                                        self.domain.graph.name_others(refused, None, now))
+            self.refusal = refusal(self.domain.graph, self.gate, self.context.get_domain_id(),
+                                   now)
             self.get_logger().error(self.refusal)
             self.exit_code = REFUSED
         elif looking and self.gate.looked:
-            if verdict is Verdict.LEFTOVER:
+            if verdict is Verdict.LEFTOVER and others:
                 self.once.start('leftover-clock', leftover_line(others[0],
                                                                 now - self.gate.created))
             self.destroy_subscription(self.clock_sub)
