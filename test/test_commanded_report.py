@@ -14,12 +14,12 @@ import json
 import math
 import os
 
+from bag_messages import header, pose_msg, unicycle_twist
 from formation_ros.core.params import validate
 from formation_ros.core.params_file import load_params_file
 from formation_ros.core.unicycle import unicycle_commands
 from formation_ros.ros.bag_writer import BagWriter, TYPESTORE
 from formation_ros.tools.report import main as report_main
-from bag_messages import header, pose_msg, unicycle_twist
 import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -57,7 +57,8 @@ def write_bag(folder, stamped, excess):
             headings = [1.0 + TURN * k, -0.4, 0.3, 2.0]
             for i in range(4):
                 bag.write(f'/robot_{i + 1}/pose', stamp + 1, TYPESTORE.serialize_cdr(
-                    pose_msg(stamp, config.start[i], headings[i]), 'geometry_msgs/msg/PoseStamped'))
+                    pose_msg(stamp, config.start[i], headings[i]),
+                    'geometry_msgs/msg/PoseStamped'))
             commands = {2: unicycle_commands((excess, 0.0), headings[1], 0.08)}
             if k == 0:
                 commands[1] = unicycle_commands(WANTED, headings[0], 0.08)

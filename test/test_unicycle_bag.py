@@ -6,11 +6,11 @@
 import json
 import os
 
+from bag_messages import header, pose_msg, unicycle_twist
 from formation_ros.core.params import load_config
 from formation_ros.ros.bag_writer import BagWriter, TYPESTORE
 from formation_ros.tools.report import main as report_main
 from formation_ros.tools.sim import run_metrics, simulate
-from bag_messages import header, pose_msg, unicycle_twist
 import numpy as np
 import pytest
 

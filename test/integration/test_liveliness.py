@@ -6,9 +6,9 @@ A dead peer is noticed and reported in ``/diagnostics``.
 
 The plant, the reference node and four robots run as real processes; kill -9 of a robot must
 show in the plant's status by its commands' age (``robots with lost cmd_vel``: none for the
-lease, 1 s), well before DDS would drop the dead participant (about 20 s); kill -9 of the plant in the robots' status
-through their watchdog (``publishing zero: inputs stale``). The probe hears ``/diagnostics``
-like any monitoring tool.
+lease, 1 s), well before DDS would drop the dead participant (about 20 s); kill -9 of the
+plant in the robots' status through their watchdog (``publishing zero: inputs stale``). The
+probe hears ``/diagnostics`` like any monitoring tool.
 """
 
 import signal
