@@ -52,6 +52,7 @@ from scipy.spatial import cKDTree
 
 NEVER = -1
 UNSTAMPED = 0
+"""A stamp that means none, on the wall clock; on a world's /clock 0 is its first moment."""
 MESSAGE_TYPES = {SourceType.POSE: PoseStamped, SourceType.ODOMETRY: Odometry}
 
 
@@ -189,7 +190,7 @@ class RelayNode(Node):
         """Return whether robot ``index``'s measurement stamped ``stamp_ns`` is a new one."""
         last, self.stamps_ns[index] = self.stamps_ns[index], stamp_ns
         source = self.sources[index]
-        if stamp_ns == UNSTAMPED:
+        if stamp_ns == UNSTAMPED and not self.sim_time:
             self.once.start(f'unstamped-{index}',
                             f'robot {index + 1}: measurements on {source} carry no stamp: '
                             'taken as they arrive (a repeating source would look fresh)')

@@ -106,6 +106,7 @@ def test_the_team_forms_on_the_world_through_the_relay(processes, install, probe
     assert info.returncode == 0, log[-4000:]
     assert '[world]' in log and '[relay]' in log and '[plant]' not in log, log[-4000:]
     assert 'Traceback' not in log, log[-4000:]
+    assert 'carry no stamp' not in log, 'the world stamps its first poses 0: its start'
     assert 'launch_formation.sh: world: 0 contacts between robots' in log, log[-3000:]
 
     stats = json.loads((out / 'world_stats.json').read_text())
