@@ -19,7 +19,9 @@ Options:
   --venv DIR    virtual environment to use (default: \$FORMATION_VENV or .venv)
   --workers N   test workers (default: \$FORMATION_TEST_WORKERS or 2, one per core of the
                 2-core machine; 0 runs everything in this process, one test at a time)
-  --            pass the remaining arguments to pytest (e.g. -- -k jump -x)
+  --            pass the remaining arguments to pytest (e.g. -- -k jump -x); test files or
+                folders among them are run instead of the whole of test/ (e.g. --
+                test/core/test_jump.py)
   -h, --help    show this help
 USAGE
 }
@@ -49,5 +51,12 @@ parallel=()
 if [[ "$WORKERS" -gt 0 ]]; then
   parallel=(-n "$WORKERS" --dist loadgroup)
 fi
-exec "$VENV/bin/python" -m pytest test -p no:cacheprovider --durations=15 \
-  ${parallel[@]+"${parallel[@]}"} ${pytest_args[@]+"${pytest_args[@]}"}
+targets=(test)
+for arg in ${pytest_args[@]+"${pytest_args[@]}"}; do
+  if [[ "$arg" != -* && -e "${arg%%::*}" ]]; then
+    targets=()
+    break
+  fi
+done
+exec "$VENV/bin/python" -m pytest ${targets[@]+"${targets[@]}"} -p no:cacheprovider \
+  --durations=15 ${parallel[@]+"${parallel[@]}"} ${pytest_args[@]+"${pytest_args[@]}"}

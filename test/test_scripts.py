@@ -351,3 +351,14 @@ def test_hosts_places_plant_and_robots():
     for robots, host in zip(spread(7, 3), host_names(3)[1:]):
         assert {host_of(f'robot_{i}', 3) for i in robots} == {host}
     assert host_of('fleet_3', 2) == 'robots_1'
+
+
+def test_run_tests_runs_the_files_it_is_given_instead_of_the_whole_suite():
+    one = run('run_tests.sh', '--workers', '0', '--', 'test/core/test_lockstep.py',
+              '--collect-only', '-q')
+    assert one.returncode == 0, one.stdout[-2000:] + one.stderr[-2000:]
+    assert '4 tests collected' in one.stdout, one.stdout[-2000:]
+    assert 'test_jump' not in one.stdout
+    chosen = run('run_tests.sh', '--workers', '0', '--', '-k', 'silent_robot_is_named',
+                 '--collect-only', '-q')
+    assert 'test/core/test_lockstep.py' in chosen.stdout, chosen.stdout[-2000:]
