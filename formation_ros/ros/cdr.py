@@ -40,7 +40,6 @@ COVARIANCE_DOUBLES = 36
 ENDIANS = {b'\x00\x01': '<', b'\x00\x00': '>'}
 LITTLE_DOUBLE = np.dtype('<f8')
 """A float64 as the writers write it, whatever the machine's byte order."""
-IDENTITY = (0.0, 0.0, 0.0, 1.0)
 FINAL_PADDING = 3
 """Bytes a writer may leave after a message's last field (its payload padded to 4)."""
 

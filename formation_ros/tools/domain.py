@@ -220,12 +220,6 @@ class TeamLook:
             self.child.communicate()
 
 
-def look_for_team(domain: int, env: Mapping[str, str],
-                  seconds: float = TEAM_LOOK) -> Optional[TeamSeen]:
-    """Look at ``domain`` for another team (:class:`TeamLook`); return what it found."""
-    return TeamLook(domain, env, seconds).result()
-
-
 def _full_name(namespace: str, name: str) -> str:
     return namespace.rstrip('/') + '/' + name
 
