@@ -15,7 +15,7 @@ plant node passes the times; the rule is here, tested without ROS (docs/faults.m
 from dataclasses import dataclass
 from typing import Dict, List, Optional, Sequence
 
-from formation_ros.core.transport import robot_name
+from formation_ros.core.names import robot_name
 
 NAME_AFTER = 2.0
 """Seconds a state waits for answers before the robots still silent are named."""

@@ -14,7 +14,7 @@ Two standard messages carry a whole team's state and a robot process's or fleet'
   :func:`state_rows`.
 * ``/formation/commands``, a trajectory_msgs/MultiDOFJointTrajectory: ``header.stamp`` is the
   stamp of the state the commands answer, ``header.frame_id`` the ``world_frame``;
-  ``joint_names`` the robots' names ``robot_<i>`` (:func:`robot_name`), in any order, each at
+  ``joint_names`` the robots' names ``robot_<i>`` (``core.names``), in any order, each at
   most once; one point whose ``velocities[k]`` is the command of robot ``joint_names[k]``, the
   twist its ``cmd_vel`` would carry, in its command frame (``world_frame``, or its
   ``robot_<i>/base_link`` for unicycles and ``command.frame: body``): linear = u for points,
@@ -35,11 +35,6 @@ from numpy.typing import ArrayLike, NDArray
 POSE_WIDTH = 7
 """Numbers per pose: position (3) and quaternion (4)."""
 NAME = re.compile(r'robot_([1-9][0-9]{0,8})')
-
-
-def robot_name(robot_id: int) -> str:
-    """Return the name of robot ``robot_id`` (1-based) in a team command: ``robot_<i>``."""
-    return f'robot_{robot_id}'
 
 
 def robot_indices(names: Sequence[str], num_robots: int) -> NDArray[np.intp]:

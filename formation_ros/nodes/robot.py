@@ -28,6 +28,7 @@ from formation_ros.core.control import Commands, Control, Sensed
 from formation_ros.core.declarations import CommandFrame, Exe, PoseType
 from formation_ros.core.frames import FrameSample
 from formation_ros.core.law import Command
+from formation_ros.core.names import robot_name
 from formation_ros.core.reference_track import reference_values, ReferenceTrack
 from formation_ros.core.robot_intake import Refused, StateIntake
 from formation_ros.core.robot_status import startup_line, status_level, status_values
@@ -442,7 +443,8 @@ class RobotNode(Node):
                 f'{topic}: {names}' for topic, names in sorted(shared.items()))
         level, message = status_level(shared, policy.waiting, bool(policy.stale), flooding,
                                       self.lockstep)
-        return make_status(f'formation_ros/robot_{self.index + 1}', level, message, values)
+        return make_status(f'formation_ros/{robot_name(self.index + 1)}', level, message,
+                           values)
 
 
 def make_robot() -> RobotNode:

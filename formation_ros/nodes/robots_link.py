@@ -18,9 +18,10 @@ from formation_ros.core.admission import Reason
 from formation_ros.core.bodies import make_bodies
 from formation_ros.core.control import Control, Sensed
 from formation_ros.core.declarations import ParamError
+from formation_ros.core.names import robot_name
 from formation_ros.core.robot_intake import Refused
 from formation_ros.core.sensing import sensed_pairs, sensor_radii
-from formation_ros.core.transport import command_vectors, robot_name
+from formation_ros.core.transport import command_vectors
 from formation_ros.ros import qos, topics
 from formation_ros.ros.cdr import (encode_names, encode_team_commands, PoseArrayData, PoseData,
                                    read_pose_array)

@@ -19,6 +19,7 @@ import os
 from typing import Optional, Tuple
 from xml.etree import ElementTree
 
+from formation_ros.core.names import robot_name
 from formation_ros.core.params import FormationConfig, WorldSettings
 from formation_ros.physics.contacts import closest_distance
 from formation_ros.physics.models import make_model, Model
@@ -53,9 +54,9 @@ class Scene:
         return path
 
 
-def robot_name(index: int) -> str:
-    """Return the body name of robot ``index`` (0-based): ``robot_<index + 1>``."""
-    return f'robot_{index + 1}'
+def body_name(index: int) -> str:
+    """Return the body name of robot ``index`` (0-based): its name, ``robot_<index + 1>``."""
+    return robot_name(index + 1)
 
 
 def _header(root: ElementTree.Element, world: WorldSettings, world_frame: str) -> None:
@@ -103,7 +104,7 @@ def build_scene(config: FormationConfig, world: Optional[WorldSettings] = None) 
     actuators = ElementTree.Element('actuator')
     names = []
     for index, (position, heading) in enumerate(zip(start, headings)):
-        name = robot_name(index)
+        name = body_name(index)
         names.append(model.add_body(worldbody, name, position, float(heading)))
         model.add_actuators(actuators, name)
     root.append(actuators)

@@ -12,6 +12,7 @@ import math
 
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+from formation_ros.core.names import robot_name
 from formation_ros.core.timeline import Mode, TeamState
 from formation_ros.core.units import NS_PER_S
 from geometry_msgs.msg import Pose, PoseArray
@@ -23,7 +24,7 @@ BODY_FRAME = 'base_link'
 
 def body_frame(robot_id):
     """Return robot ``robot_id``'s body frame, ``robot_<i>/base_link`` (unicycle commands)."""
-    return f'robot_{int(robot_id)}/{BODY_FRAME}'
+    return f'{robot_name(int(robot_id))}/{BODY_FRAME}'
 
 
 def ns_to_stamp(ns):

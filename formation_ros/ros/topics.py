@@ -14,6 +14,8 @@ from dataclasses import dataclass
 import enum
 from typing import Dict, List
 
+from formation_ros.core.names import robot_name
+
 
 POSE = 'pose'
 NEIGHBOURS = 'neighbors'
@@ -68,7 +70,7 @@ class Topic:
 
 def robot_namespace(robot_id: int) -> str:
     """Return the namespace of robot ``robot_id`` (1-based): ``/robot_<i>``."""
-    return f'/robot_{robot_id}'
+    return f'/{robot_name(robot_id)}'
 
 
 def robot_node_name(robot_id: int) -> str:

@@ -29,6 +29,7 @@ import re
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
 
 from formation_ros.core.exits import RECORDING_FAILED
+from formation_ros.core.names import robot_name
 from formation_ros.ros.topics import CMD_VEL, robot_namespace, robot_topic
 
 PACKAGE = 'formation_ros'
@@ -162,7 +163,7 @@ def plan(run: Run) -> List[NodePlan]:
     if per_process == 1:
         for i in range(1, run.num_robots + 1):
             remaps = (((CMD_VEL, run.cmd_topics[i - 1]),) if run.cmd_topics else ())
-            nodes.append(NodePlan(f'robot_{i}', 'robot', namespace=robot_namespace(i),
+            nodes.append(NodePlan(robot_name(i), 'robot', namespace=robot_namespace(i),
                                   parameters=(('robot_id', i),) + robot, remappings=remaps))
         return nodes
     if run.cmd_topics:

@@ -5,9 +5,10 @@
 
 from formation_ros.core.frames import frame_from_pose, STATIONARY
 from formation_ros.core.law import make_law, robot_command, robot_commands
+from formation_ros.core.names import robot_name
 from formation_ros.core.sensing import neighbour_lists, sensed_pairs, sensor_radii
 from formation_ros.core.transport import (command_of, command_vectors, commands_of,
-                                          robot_indices, robot_name, state_rows)
+                                          robot_indices, state_rows)
 from formation_ros.core.unicycle import quaternions_from_headings
 import numpy as np
 import pytest
