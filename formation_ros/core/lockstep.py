@@ -58,8 +58,6 @@ class AnswerWait:
         self.repeat_every = repeat_every
         self.wait: Optional[Wait] = None
         self.said_at: Optional[float] = None
-        self.waits_named = 0
-        """Waits that lasted long enough to be named, over the run."""
 
     def published(self, stamp_ns: int, now: float) -> None:
         """Note a state stamped ``stamp_ns`` sent at ``now`` (a resent one changes nothing)."""
@@ -87,8 +85,6 @@ class AnswerWait:
             return None
         if self.said_at is not None and now - self.said_at < self.repeat_every:
             return None
-        if self.said_at is None:
-            self.waits_named += 1
         self.said_at = now
         return (f'lockstep: waiting for {robots_and_names(silent)}, no answer for '
                 f'{waited:.1f} s at {self.wait.stamp_ns * 1e-9:.3f} s simulated (a stopped '
@@ -100,8 +96,3 @@ class AnswerWait:
             return {}
         return {WAITING_FOR: ', '.join(map(str, self.wait.silent)),
                 WAITED: now - self.wait.since}
-
-    @property
-    def named(self) -> bool:
-        """Whether a wait is being named now (the status is then WARN)."""
-        return self.said_at is not None

@@ -73,8 +73,8 @@ def duplicate_due(names: Sequence[str], own: Optional[str], lasted: float,
 
     own: the one node expected to publish (None: any single node); lasted: for how long, s, the
     topic has had more than one publisher; alive: whether there is evidence that a second
-    publisher with the expected node's name runs (it announced itself from another process, or
-    DDS liveliness counts two). A second publisher with another name is due at once; one with
+    publisher with the expected node's name runs (it announced itself from another process). A
+    second publisher with another name is due at once; one with
     the expected name (a restart's dead predecessor, or a second copy) when ``alive``, or once
     it has lasted :data:`DUPLICATE_GRACE` s.
     """

@@ -52,7 +52,8 @@ from scipy.spatial import cKDTree
 
 NEVER = -1
 UNSTAMPED = 0
-"""A stamp that means none, on the wall clock; on a world's /clock 0 is its first moment."""
+"""A stamp that means none, on the wall clock; on a world's /clock 0 is its first moment, and
+only a second 0 in a row means none."""
 MESSAGE_TYPES = {SourceType.POSE: PoseStamped, SourceType.ODOMETRY: Odometry}
 
 
@@ -190,7 +191,7 @@ class RelayNode(Node):
         """Return whether robot ``index``'s measurement stamped ``stamp_ns`` is a new one."""
         last, self.stamps_ns[index] = self.stamps_ns[index], stamp_ns
         source = self.sources[index]
-        if stamp_ns == UNSTAMPED and not self.sim_time:
+        if stamp_ns == UNSTAMPED and (not self.sim_time or last == UNSTAMPED):
             self.once.start(f'unstamped-{index}',
                             f'robot {index + 1}: measurements on {source} carry no stamp: '
                             'taken as they arrive (a repeating source would look fresh)')

@@ -36,7 +36,7 @@ from formation_ros.core.trajectory import (CHUNKS_DIR, ChunkWriter, read_body_ch
                                            Trajectory, TRAJECTORY_FILE)
 from formation_ros.core.unicycle import hand_points, hand_velocity, quaternions_from_headings
 from formation_ros.core.units import NS_PER_S
-from formation_ros.physics.engine import Engine, Unstable
+from formation_ros.physics.engine import Engine, Unstable, unstable_line
 from formation_ros.physics.intake import CommandInbox
 from formation_ros.physics.pacing import Pacer
 from formation_ros.physics.parts import rotated
@@ -78,11 +78,6 @@ ODOMETRY_HEIGHT = 0.0
 HEARD_KEPT = 256
 """States kept per robot to read a held command at the orientation it answered: 5 s at 50 Hz,
 more than a command is ever held (``world.cmd_timeout``)."""
-UNSTABLE_SETTINGS = {True: ('timestep', 'mass', 'wheel_torque', 'wheel_radius', 'floor_friction'),
-                     False: ('timestep', 'mass', 'force_limit', 'torque_limit', 'floor_friction')}
-"""The world.* settings named with their values when the engine blows up, for unicycles and
-for points: those the unstable cases combined (docs/physics.md, "When the engine blows
-up")."""
 REFUSAL_WORDS = {Reason.MALFORMED: 'bytes that are not a whole {kind}',
                  Reason.FRAME: 'a frame other than its command frame',
                  Reason.NON_FINITE: 'non-finite values',
@@ -263,11 +258,7 @@ class WorldNode(Node):
         """Stop at the step that made a pose absurd: say so in one line; exit ENGINE_FAILED."""
         self.timer.cancel()
         self.exit_code = ENGINE_FAILED
-        values = ', '.join(f'world.{name} {getattr(self.world, name):g}'
-                           for name in UNSTABLE_SETTINGS[self.unicycles])
-        self.get_logger().error(
-            f'world: the physics engine blew up: {exc}; stopped there, no pose published '
-            f'after it ({values}: a shorter timestep, or less extreme bodies)')
+        self.get_logger().error(f'world: {unstable_line(exc, self.world, self.unicycles)}')
 
     def _note_late(self, rows: NDArray[np.intp], stamps: NDArray[np.int64]) -> None:
         """Count commands already older than ``world.cmd_timeout`` when applied; log once each."""

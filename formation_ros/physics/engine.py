@@ -69,6 +69,21 @@ class Unstable(Exception):
         self.robot, self.t, self.what = robot, t, what
 
 
+UNSTABLE_SETTINGS = {True: ('timestep', 'mass', 'wheel_torque', 'wheel_radius', 'floor_friction'),
+                     False: ('timestep', 'mass', 'force_limit', 'torque_limit', 'floor_friction')}
+"""The world.* settings named with their values when the engine blows up, for wheeled bases
+(True) and for points: those the unstable cases combined (docs/physics.md, "When the engine
+blows up")."""
+
+
+def unstable_line(failure: Unstable, world: WorldSettings, wheeled: bool) -> str:
+    """Return the one line that says the engine blew up: robot, time and the settings in force."""
+    values = ', '.join(f'world.{name} {getattr(world, name):g}'
+                       for name in UNSTABLE_SETTINGS[wheeled])
+    return (f'the physics engine blew up: {failure}; stopped there, no pose after it ({values}: '
+            'a shorter timestep, or less extreme bodies)')
+
+
 def _quiet(message: bytes) -> None:
     """Keep MuJoCo's warnings off the terminal: the engine reads them from its data."""
 

@@ -18,7 +18,8 @@ when a call of it is queued already, and each such call, once run, makes it look
 that reset a timer at every state it heard could, on a starved core, fill that queue faster
 than it ran it, its diagnostics timer called back to back and its states no longer answered: a
 lockstep run hung (docs/faults.md, "a robot process or fleet that stops answering"). A call of
-the timer that comes before the moment armed (a queued copy) does nothing.
+the timer that comes before the moment armed (a queued copy, which rcl takes as a tick and so
+moves the timer a period on) sets the timer back to that moment and does nothing else.
 """
 
 from typing import Callable, Optional
@@ -55,33 +56,40 @@ class Wake:
         due_ns = self._clock.now().nanoseconds + delay_ns
         if self._due_ns is not None and self._due_ns <= due_ns:
             return
-        if delay_ns != self._delay_ns:
-            self._timer.timer_period_ns = delay_ns
-            self._delay_ns = delay_ns
         self._due_ns = due_ns
-        self._timer.reset()
+        self._restart(delay_ns)
 
     def _run_task(self) -> None:
-        """Run the action armed for now (and any armed for later with it)."""
+        """Run the action armed for now, and one armed for later that is due by now."""
         self._task_pending = False
-        self._disarm()
+        if self._due_ns is not None and self._due_ns <= self._clock.now().nanoseconds:
+            self._disarm()
         try:
             self._action()
         except Exception as exc:
             # An exception leaving a task of rclpy's EventsExecutor crashes the process at
             # exit (a segmentation fault instead of the traceback): the timer raises it.
             self._failure = exc
-            self._timer.timer_period_ns = 0
-            self._delay_ns = 0
-            self._timer.reset()
+            self._restart(0)
 
     def _fire(self) -> None:
         if self._failure is not None:
             raise self._failure
-        if self._due_ns is None or self._clock.now().nanoseconds < self._due_ns:
+        if self._due_ns is None:
+            return
+        early_ns = self._due_ns - self._clock.now().nanoseconds
+        if early_ns > 0:
+            # the early call moved the timer a period on: count what is left from now
+            self._restart(early_ns)
             return
         self._disarm()
         self._action()
+
+    def _restart(self, delay_ns: int) -> None:
+        if delay_ns != self._delay_ns:
+            self._timer.timer_period_ns = delay_ns
+            self._delay_ns = delay_ns
+        self._timer.reset()
 
     def _disarm(self) -> None:
         if self._due_ns is not None:

@@ -42,13 +42,15 @@ class EngineRun:
     A run on the engine: its samples, the engine's counts and its contact events.
 
     trajectory: the samples; stats: :class:`formation_ros.physics.engine.WorldStats` as a dict;
-    events: the contact events, each {i, j, t}; version: MuJoCo's.
+    events: the contact events, each {i, j, t}; version: MuJoCo's; failure: the one line of an
+    engine that blew up (``physics.engine.unstable_line``: the run stops there), None if none.
     """
 
     trajectory: Trajectory
     stats: Dict[str, Any]
     events: List[Dict[str, Any]]
     version: str
+    failure: Optional[str] = None
 
 
 def engine_problem(config: FormationConfig, control_dt: float) -> Optional[str]:
@@ -80,8 +82,9 @@ def run_on_engine(config: FormationConfig, duration: float, control_dt: float,
     shapes: the shape in force at each time (``tools.sim.shapes_of``); progress: a
     ``tools.sim.Progress``. The engine's ``world.output_dir`` is not used.
     """
-    from formation_ros.physics.engine import Engine
+    from formation_ros.physics.engine import Engine, Unstable, unstable_line
     engine = Engine(config)
+    failure: Optional[str] = None
     law, reference = config.law(), config.reference()
     bodies = make_bodies(config.body, body_frame=config.command.frame is CommandFrame.BODY
                          and not config.body.is_unicycle)
@@ -117,7 +120,11 @@ def run_on_engine(config: FormationConfig, duration: float, control_dt: float,
             break
         progress.update(t)
         engine.apply(command, np.full(n, engine.time_ns, dtype=np.int64))
-        engine.step(steps_per_control)
+        try:
+            engine.step(steps_per_control)
+        except Unstable as exc:
+            failure = unstable_line(exc, engine.world, config.body.is_unicycle)
+            break
     trajectory = Trajectory.from_frames(times, points_kept, applied, frames, vertices_kept)
     if bodies.has_heading:
         trajectory = replace(trajectory, heading=np.array(headings), q_body=np.array(q_body),
@@ -125,7 +132,7 @@ def run_on_engine(config: FormationConfig, duration: float, control_dt: float,
     stats = asdict(engine.stats())
     events = [{'i': event.i, 'j': event.j, 't': event.t_ns / NS_PER_S}
               for event in engine.contacts.events]
-    return EngineRun(trajectory, stats, events, engine.version)
+    return EngineRun(trajectory, stats, events, engine.version, failure)
 
 
 def _finite(stats: Dict[str, Any]) -> Dict[str, Any]:

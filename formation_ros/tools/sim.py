@@ -40,6 +40,7 @@ from formation_ros.core.bodies import make_bodies
 from formation_ros.core.declarations import (CommandFrame, DEFAULT_COLLISION_DISTANCE, Exe,
                                              ParamError)
 from formation_ros.core.events import Event, EventKind, timeline_events, with_shapes
+from formation_ros.core.exits import ENGINE_FAILED
 from formation_ros.core.file_guard import ParamsFileError
 from formation_ros.core.frames import desired_positions, FrameSample
 from formation_ros.core.law import team_command
@@ -757,9 +758,14 @@ def run_engine_command(args: argparse.Namespace, config: FormationConfig,
     if not args.no_plots:
         from formation_ros.tools import plots
         plots.write_figures(run.trajectory, config.law(), metrics, args.out)
-    print(f'formation_sim: {integrator}, {duration:g} s simulated in {progress.elapsed:.1f} s')
+    simulated = duration if run.failure is None else float(run.trajectory.t[-1])
+    print(f'formation_sim: {integrator}, {simulated:g} s simulated in {progress.elapsed:.1f} s')
     print(format_summary(metrics, args.out))
     print(engine_summary(metrics))
+    if run.failure is not None:
+        print(f'formation_sim: {run.failure}; wrote the run up to there to {args.out}',
+              file=sys.stderr)
+        return ENGINE_FAILED
     return 0
 
 

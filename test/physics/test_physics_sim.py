@@ -11,7 +11,8 @@ import pytest
 
 mujoco = pytest.importorskip('mujoco')
 
-from formation_ros.core.metrics import formation_errors  # noqa: E402, I100
+from formation_ros.core.exits import ENGINE_FAILED  # noqa: E402, I100
+from formation_ros.core.metrics import formation_errors  # noqa: E402
 from formation_ros.core.params_file import load_params_file, write_params_file  # noqa: E402
 from formation_ros.core.trajectory import Trajectory  # noqa: E402
 from formation_ros.tools.report import main as report_main  # noqa: E402
@@ -95,3 +96,21 @@ def test_the_ideal_engine_is_the_default_bit_for_bit(tmp_path):
         runs.append((out / 'trajectory.npz').read_bytes())
         assert sorted(os.listdir(out)) == ['metrics.json', 'params.yaml', 'trajectory.npz']
     assert runs[0] == runs[1]
+
+
+def test_an_engine_that_blows_up_stops_the_run_in_one_line_and_keeps_it(tmp_path, capsys):
+    # the world's unstable case (test_world_faults): a long step, a light body, strong motors
+    values = load_params_file('config/world_turtlebot3.yaml')
+    values.update({'world.timestep': 0.05, 'world.mass': 1.0, 'world.wheel_torque': 1e4,
+                   'world.wheel_radius': 1.0, 'world.floor_friction': 0.1,
+                   'world.pose_rate': 10.0})
+    write_params_file(str(tmp_path / 'p.yaml'), values)
+    out = tmp_path / 'run'
+    assert sim_main([str(tmp_path / 'p.yaml'), '--engine', 'mujoco', '--dt', '0.05', '--out',
+                     str(out), '--no-plots', '--quiet']) == ENGINE_FAILED
+    err = capsys.readouterr().err
+    lines = [line for line in err.splitlines() if 'blew up' in line]
+    assert len(lines) == 1 and 'Traceback' not in err, err
+    assert 'robot ' in lines[0] and 'at t = ' in lines[0] and 'world.timestep 0.05' in lines[0]
+    run = Trajectory.load(str(out / 'trajectory.npz'))
+    assert 0.0 < run.t[-1] < 30.0 and np.all(np.isfinite(run.q))

@@ -98,3 +98,29 @@ def test_an_action_that_raises_stops_the_spin_with_its_exception(spinning):
     wake.arm()
     with pytest.raises(ValueError, match='the action failed'):
         spin_until(executor, clock, lambda: False)
+
+
+def test_an_early_call_of_the_timer_leaves_the_moment_armed(spinning):
+    # a queued copy calls the timer before it is due; rcl then counts a whole period from it
+    node, executor, clock = spinning
+    runs = []
+    wake = Wake(node, lambda: runs.append(clock.now().nanoseconds), clock)
+    armed = clock.now().nanoseconds
+    wake.arm(0.5)
+    with wake._timer.handle:
+        wake._timer.handle.call_timer()
+    wake._fire()
+    assert runs == [] and wake._timer.time_until_next_call() <= 0.5e9
+    assert spin_until(executor, clock, lambda: runs)
+    assert 0.5e9 <= runs[0] - armed
+
+
+def test_work_due_now_leaves_a_later_arming_standing(spinning):
+    node, executor, clock = spinning
+    runs = []
+    wake = Wake(node, lambda: runs.append(clock.now().nanoseconds), clock)
+    wake.arm()
+    armed = clock.now().nanoseconds
+    wake.arm(0.3)
+    assert spin_until(executor, clock, lambda: len(runs) == 2)
+    assert runs[1] - armed >= 0.3e9
