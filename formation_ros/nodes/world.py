@@ -30,7 +30,8 @@ from formation_ros.core.commanded import commanded_velocity, HeardOrientations, 
 from formation_ros.core.declarations import CommandFrame, Exe
 from formation_ros.core.exits import ENGINE_FAILED, REFUSED
 from formation_ros.core.params import world_size_problem
-from formation_ros.core.plant_gate import leftover_line, Phase, StartGate, Verdict
+from formation_ros.core.plant_gate import (leftover_line, Phase, StartGate, Verdict,
+                                           WORLD_LOOK_TIME)
 from formation_ros.core.trajectory import (CHUNKS_DIR, ChunkWriter, read_body_chunks,
                                            read_chunks, read_held_chunks, save_atomically,
                                            Trajectory, TRAJECTORY_FILE)
@@ -116,7 +117,8 @@ class WorldNode(Node):
         self.output_dir = self.world.output_dir
         self.output_failure: Optional[str] = None
         self.chunks: Optional[ChunkWriter] = None
-        self.gate = StartGate(time.monotonic(), False, self.get_fully_qualified_name())
+        self.gate = StartGate(time.monotonic(), False, self.get_fully_qualified_name(),
+                              WORLD_LOOK_TIME)
         self.team_check = TeamCheck(self, WORLD_STATUS)
         self.graph = PublisherWatch(self, self.team_check)
         self.refusal: Optional[str] = None
@@ -124,7 +126,6 @@ class WorldNode(Node):
         self.clock_heard = 0
         self.clock_sub = self.create_subscription(ClockMsg, topics.CLOCK, self.on_clock,
                                                   qos.CLOCK, raw=True)
-        self._start_output()
 
         self.clock_pub = self.create_publisher(ClockMsg, topics.CLOCK, qos.CLOCK)
         self.pose_pubs = [self.create_publisher(
@@ -142,7 +143,7 @@ class WorldNode(Node):
         self.heard: Optional[HeardOrientations] = None
         """The orientations of the states the robots heard (``pose``), to read what each
         commanded (``_sample``); only when a command needs one, is stamped and is recorded."""
-        if (self.chunks is not None and self.stamped
+        if (self.output_dir and self.stamped
                 and needs_orientation(self.unicycles, self.body_frame)):
             self.heard = HeardOrientations(self.n, HEARD_KEPT)
             self.state_subs = [self.create_subscription(
@@ -153,17 +154,22 @@ class WorldNode(Node):
         self.timer = self.create_timer(tick, self.on_timer, clock=self.steady)
         self.diagnostics_timer = self.create_timer(PERIOD, self.on_diagnostics,
                                                    clock=self.steady)
-        if self.chunks is not None:
+        if self.output_dir:
             self.chunk_timer = self.create_timer(CHUNK_PERIOD, self.write_chunk,
                                                  clock=self.steady)
         self.get_logger().info(
             f'world: {self.n} {self.engine.model.kind.value} robots in {self.dim}D, timestep '
             f'{self.world.timestep:g} s, realtime factor {self.world.realtime_factor:g}, '
             f'poses at {self.world.pose_rate:g} Hz'
-            + (f', writing to {self.output_dir}' if self.chunks is not None else ''))
+            + (f', writing to {self.output_dir}' if self.output_dir else ''))
 
     def _start_output(self) -> None:
-        """With ``world.output_dir``: write world.xml now and start the trajectory's chunks."""
+        """
+        With ``world.output_dir``: write world.xml now and start the trajectory's chunks.
+
+        Once the domain is found free: a world that refuses writes nothing (another world may
+        be writing there).
+        """
         if not self.output_dir:
             return
         where = self.output_dir
@@ -205,6 +211,7 @@ class WorldNode(Node):
         if verdict is Verdict.LEFTOVER and others:
             self.once.start('leftover-clock', leftover_line(others[0], now - self.gate.created))
         self.destroy_subscription(self.clock_sub)
+        self._start_output()
         return True
 
     def on_command(self, index: int, data: bytes) -> None:

@@ -41,7 +41,7 @@ def refused(probe, processes, name, maker, pid):
     assert f'/{maker} on host {HOST} (process {pid}) publishes /clock' in lines[0], log
 
 
-def test_a_world_or_a_plant_refuses_beside_a_running_one(processes, install, probe):
+def test_a_world_or_a_plant_refuses_beside_a_running_one(processes, install, probe, tmp_path):
     plant_clock = SimClock(probe)
     plant = processes.start(node(install, 'plant', TEAM, '-p', 'plant.wait_for_robots:=false'))
     assert probe.spin_until(lambda: plant_clock.seconds > 0.2, START_UP), processes.log('plant')
@@ -53,10 +53,15 @@ def test_a_world_or_a_plant_refuses_beside_a_running_one(processes, install, pro
     assert probe.spin_until(lambda: probe.count_publishers('/clock') == 0, 30)
 
     clock = SimClock(probe)
-    world = processes.start(node(install, 'world', TEAM))
-    assert probe.spin_until(lambda: clock.seconds > 0.2, START_UP), processes.log('world')
-    processes.start(node(install, 'world', TEAM, process='world_2'))
+    out = f'world.output_dir:={tmp_path / "world"}'
+    world = processes.start(node(install, 'world', TEAM, '-p', out))
+    assert probe.spin_until(lambda: clock.seconds > 0.2 and (tmp_path / 'world' / 'world.xml')
+                            .exists(), START_UP), processes.log('world')
+    written = (tmp_path / 'world' / 'world.xml').stat().st_mtime_ns
+    processes.start(node(install, 'world', TEAM, '-p', out, process='world_2'))
     refused(probe, processes, 'world_2', 'world', world.pid)
+    assert (tmp_path / 'world' / 'world.xml').stat().st_mtime_ns == written, \
+        'the refused world wrote into the output of the running one'
     processes.start(node(install, 'plant', TEAM, process='plant_2'))
     refused(probe, processes, 'plant_2', 'world', world.pid)
     assert probe.spin_until(lambda: probe.count_publishers('/clock') == 1, 30)
