@@ -44,6 +44,12 @@ def spin_until(executor, clock, condition):
     return condition()
 
 
+def timed_wake(node, clock):
+    """Return a Wake whose action notes when it ran (steady ns), and that list."""
+    runs = []
+    return Wake(node, lambda: runs.append(clock.now().nanoseconds), clock), runs
+
+
 def test_many_armings_before_the_executor_runs_it_give_one_action_and_no_reset(spinning):
     node, executor, clock = spinning
     runs, marks = [], []
@@ -74,8 +80,7 @@ def test_many_armings_before_the_executor_runs_it_give_one_action_and_no_reset(s
 
 def test_a_later_arming_keeps_the_earlier_moment_and_an_earlier_one_moves_it(spinning):
     node, executor, clock = spinning
-    runs = []
-    wake = Wake(node, lambda: runs.append(clock.now().nanoseconds), clock)
+    wake, runs = timed_wake(node, clock)
     armed = clock.now().nanoseconds
     wake.arm(0.05)
     wake.arm(5.0)
@@ -103,8 +108,7 @@ def test_an_action_that_raises_stops_the_spin_with_its_exception(spinning):
 def test_an_early_call_of_the_timer_leaves_the_moment_armed(spinning):
     # a queued copy calls the timer before it is due; rcl then counts a whole period from it
     node, executor, clock = spinning
-    runs = []
-    wake = Wake(node, lambda: runs.append(clock.now().nanoseconds), clock)
+    wake, runs = timed_wake(node, clock)
     armed = clock.now().nanoseconds
     wake.arm(0.5)
     with wake._timer.handle:
@@ -117,8 +121,7 @@ def test_an_early_call_of_the_timer_leaves_the_moment_armed(spinning):
 
 def test_work_due_now_leaves_a_later_arming_standing(spinning):
     node, executor, clock = spinning
-    runs = []
-    wake = Wake(node, lambda: runs.append(clock.now().nanoseconds), clock)
+    wake, runs = timed_wake(node, clock)
     wake.arm()
     armed = clock.now().nanoseconds
     wake.arm(0.3)
