@@ -35,12 +35,11 @@ from formation_ros.core.plant_gate import (leftover_line, Phase, StartGate, Verd
 from formation_ros.core.trajectory import (CHUNKS_DIR, ChunkWriter, read_body_chunks,
                                            read_chunks, read_held_chunks, save_atomically,
                                            Trajectory, TRAJECTORY_FILE)
-from formation_ros.core.unicycle import hand_points, hand_velocity, quaternions_from_headings
+from formation_ros.core.unicycle import hand_points, quaternions_from_headings
 from formation_ros.core.units import NS_PER_S
 from formation_ros.physics.engine import Engine, Unstable, unstable_line
 from formation_ros.physics.intake import CommandInbox
 from formation_ros.physics.pacing import Pacer
-from formation_ros.physics.parts import rotated
 from formation_ros.physics.scene import WORLD_FILE
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import (CdrError, encode_clock, encode_odometry, encode_pose_stamped,
@@ -337,16 +336,15 @@ class WorldNode(Node):
             return
         answered = (self.heard.rows(self.engine.stamp_ns) if self.heard is not None
                     else np.full((self.n, 4), np.nan))
-        commanded = commanded_velocity(held, answered, self.unicycles,
-                                       self.config.body.hand_distance, self.body_frame)
+        distance = self.config.body.hand_distance
+        commanded, at_truth = (
+            commanded_velocity(held, orientations, self.unicycles, distance, self.body_frame)
+            for orientations in (answered, quaternions_from_headings(headings)))
         if self.unicycles:
-            distance = self.config.body.hand_distance
             self.chunks.append(t, hand_points(positions, headings, distance), commanded,
                                heading=headings, q_body=positions, body_command=held,
-                               u_held=hand_velocity(held, headings, distance))
+                               u_held=at_truth)
             return
-        at_truth = held.copy()
-        at_truth[:, :2] = rotated(held[:, :2], headings)
         self.chunks.append(t, positions, commanded, u_held=at_truth)
 
     def _log_contacts(self) -> None:
