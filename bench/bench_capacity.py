@@ -50,8 +50,8 @@ sys.path[:0] = [ROOT, BENCH]
 from bench_core import params_for  # noqa: E402
 from bench_soak import (find_run_processes, LAUNCHER, read_pss_kib,  # noqa: E402
                         read_rss_kib)
-from formation_ros.core.declarations import BY_NAME  # noqa: E402, I100
-from formation_ros.core.params_file import write_params_file  # noqa: E402
+from formation_ros.core.settings.declarations import BY_NAME  # noqa: E402, I100
+from formation_ros.core.settings.params_file import write_params_file  # noqa: E402
 from formation_ros.ros.watch import stat_fields  # noqa: E402
 
 PLANT_RATE = 100.0

@@ -18,9 +18,9 @@ import platform
 import statistics
 import time
 
-from formation_ros.core.law import team_command
-from formation_ros.core.params import validate
-from formation_ros.tools.sim import simulate
+from formation_ros.core.maths.law import team_command
+from formation_ros.core.settings.params import validate
+from formation_ros.simulation.simulate import simulate
 import numpy as np
 
 

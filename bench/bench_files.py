@@ -37,8 +37,8 @@ PROGRAMS = ('guard', 'sim', 'plant')
 PLANT = 'import sys; from formation_ros.nodes.plant import main; sys.exit(main())'
 GUARD = """
 import resource, sys, time
-from formation_ros.core.declarations import ParamError
-from formation_ros.core.params_file import load_params_file
+from formation_ros.core.settings.declarations import ParamError
+from formation_ros.core.settings.params_file import load_params_file
 start = time.perf_counter()
 try:
     load_params_file(sys.argv[1])
@@ -76,7 +76,7 @@ def big_team() -> str:
     """Return a valid 10,000-robot 3D file as write_params_file writes it."""
     sys.path.insert(0, ROOT)
     import numpy as np
-    from formation_ros.core.params_file import dump_params_text
+    from formation_ros.core.settings.params_file import dump_params_text
     rng = np.random.default_rng(1)
     n = 10_000
     lattice = 1.5 * np.indices((22, 22, 21)).reshape(3, -1).T[:n]

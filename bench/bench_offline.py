@@ -34,34 +34,33 @@ ROOT = os.path.dirname(BENCH)
 sys.path[:0] = [ROOT, BENCH]
 
 from bench_core import params_for  # noqa: E402
-from formation_ros.core.params_file import write_params_file  # noqa: E402, I100
+from formation_ros.core.settings.params_file import write_params_file  # noqa: E402, I100
 
 SPLIT_CHILD = """
 import json, os, resource, shutil, sys, time
 begun, cpu_begun = time.perf_counter(), time.process_time()
-from formation_ros.tools import sim
+from formation_ros.core.runs.trajectory import TRAJECTORY_FILE
+from formation_ros.core.settings.params import load_config
+from formation_ros.simulation import simulate
 imported, cpu_imported = time.perf_counter(), time.process_time()
 params, out, dt, sample_dt = sys.argv[1], sys.argv[2], float(sys.argv[3]), sys.argv[4]
-config = sim.load_config(params)
+config = load_config(params)
 duration = config.duration
 given = None if sample_dt == 'default' else float(sample_dt)
-if hasattr(sim, 'sampling_metadata'):
-    sampling = sim.sampling_metadata(config.num_robots, duration, dt, given)
-else:  # a formation_sim from before the sampling rule, for before-and-after numbers
-    sampling = {'sample_dt': sim.DEFAULT_SAMPLE_DT if given is None else given}
-events = sim.schedule_events(config)
-progress = sim.Progress(duration, quiet=True)
+sampling = simulate.sampling_metadata(config.num_robots, duration, dt, given)
+events = simulate.schedule_events(config)
+progress = simulate.Progress(duration, quiet=True)
 started, cpu_started = time.perf_counter(), time.process_time()
-run = sim.run_fixed_step(config, duration, dt, sampling['sample_dt'], progress)
+run = simulate.run_fixed_step(config, duration, dt, sampling['sample_dt'], progress)
 integrated, cpu_integrated = time.perf_counter(), time.process_time()
-metrics = sim.run_metrics(run.trajectory, config, f'zero-order hold, dt = {dt:g} s', events)
-metrics.update(sim.plant_metrics(run, config))
+metrics = simulate.run_metrics(run.trajectory, config, f'zero-order hold, dt = {dt:g} s', events)
+metrics.update(simulate.plant_metrics(run, config))
 metrics.update(sampling)
 measured, cpu_measured = time.perf_counter(), time.process_time()
 os.makedirs(out, exist_ok=True)
-run.trajectory.save(os.path.join(out, sim.TRAJECTORY_FILE))
-shutil.copyfile(params, os.path.join(out, sim.PARAMS_COPY))
-with open(os.path.join(out, sim.METRICS_FILE), 'w', encoding='utf-8') as stream:
+run.trajectory.save(os.path.join(out, TRAJECTORY_FILE))
+shutil.copyfile(params, os.path.join(out, simulate.PARAMS_COPY))
+with open(os.path.join(out, simulate.METRICS_FILE), 'w', encoding='utf-8') as stream:
     json.dump(metrics, stream, indent=2)
 written, cpu_written = time.perf_counter(), time.process_time()
 print(json.dumps({'imports_s': imported - begun, 'start_up_s': started - imported,

@@ -46,7 +46,7 @@ ROOT = os.path.dirname(BENCH)
 sys.path[:0] = [ROOT, BENCH]
 
 from bench_soak import find_run_processes, sort_key, write_json  # noqa: E402
-from formation_ros.core.params_file import load_params_file  # noqa: E402, I100
+from formation_ros.core.settings.params_file import load_params_file  # noqa: E402, I100
 from formation_ros.ros.watch import LAUNCHER_PID_ENV, LAUNCHER_START_ENV  # noqa: E402
 from formation_ros.ros.watch import process_start  # noqa: E402
 

@@ -30,7 +30,7 @@ BENCH = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(BENCH)
 sys.path[:0] = [ROOT]
 
-from formation_ros.core.params import validate  # noqa: E402
+from formation_ros.core.settings.params import validate  # noqa: E402
 import numpy as np  # noqa: E402
 
 CONTROL_PERIOD = 0.05

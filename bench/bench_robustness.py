@@ -8,16 +8,16 @@ Usage: python bench/bench_robustness.py [--quick] [--seeds 3] [--jobs 1] [--out 
        python bench/bench_robustness.py --physics [--only PART ...] [--teams TEAM ...] [...]
 
 It sweeps each non-ideality of the plant model (plant.actuator_lag, plant.state_delay,
-plant.pose_noise, plant.max_acceleration; core/dynamics.py), the step (plant.rate), a grid of
+plant.pose_noise, plant.max_acceleration; core/model/dynamics.py), the step (plant.rate), a grid of
 delay x lag and the gain c at fixed delays, on the paper's Section 5 team
 (config/paper_section5.yaml) and on config/unicycle_2d.yaml, from several random starts
 (start.seed, which also seeds the noise). Every run is formation_sim --dt 1/plant.rate
-(formation_ros.tools.sim.run_fixed_step, in-process), sampled every step, and gives: the
+(formation_ros.simulation.simulate.run_fixed_step, in-process), sampled every step, and gives: the
 closest approach of the control points and of the bodies, the collisions (approaches closer
 than the bodies' size: 2 x body.radius = 0.22 m between the unicycles' axle centres; for the
 Section 5 points, which have no radius and whose potential guarantees nothing from these
 starts, the starts' own start.min_separation = 0.1 m), the settle time (every robot within
-0.05 m of its place from then on, core/metrics.py), the largest |u_hat| component against
+0.05 m of its place from then on, core/runs/metrics.py), the largest |u_hat| component against
 c M1, the largest body velocity and whether the run converged (settled). Prints a Markdown
 table per sweep and progress lines on stderr, writes OUT/bench/robustness.json and one figure
 per sweep, OUT/robustness_<sweep>.png (OUT defaults to the repository's docs/).
@@ -45,13 +45,13 @@ BENCH = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(BENCH)
 sys.path[:0] = [ROOT, BENCH]
 
-from formation_ros.core.declarations import BY_NAME, ParamError  # noqa: E402
-from formation_ros.core.metrics import SETTLE_TOLERANCE  # noqa: E402
-from formation_ros.core.params import FormationConfig, validate  # noqa: E402
-from formation_ros.core.params_file import load_params_file  # noqa: E402
-from formation_ros.core.safety import guaranteed_min_distance  # noqa: E402
-from formation_ros.core.unicycle import hand_points  # noqa: E402
-from formation_ros.tools.sim import Progress, run_fixed_step, run_metrics  # noqa: E402
+from formation_ros.core.maths.safety import guaranteed_min_distance  # noqa: E402
+from formation_ros.core.maths.unicycle import hand_points  # noqa: E402
+from formation_ros.core.runs.metrics import SETTLE_TOLERANCE  # noqa: E402
+from formation_ros.core.settings.declarations import BY_NAME, ParamError  # noqa: E402
+from formation_ros.core.settings.params import FormationConfig, validate  # noqa: E402
+from formation_ros.core.settings.params_file import load_params_file  # noqa: E402
+from formation_ros.simulation.simulate import Progress, run_fixed_step, run_metrics  # noqa: E402
 import physics_robustness  # noqa: E402
 
 CONFIGS = {'section5': 'config/paper_section5.yaml', 'unicycle': 'config/unicycle_2d.yaml'}

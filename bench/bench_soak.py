@@ -35,7 +35,7 @@ ROOT = os.path.dirname(BENCH)
 sys.path[:0] = [ROOT, BENCH]
 
 from bench_core import params_for  # noqa: E402
-from formation_ros.core.params_file import write_params_file  # noqa: E402, I100
+from formation_ros.core.settings.params_file import write_params_file  # noqa: E402, I100
 from formation_ros.ros.watch import stat_fields  # noqa: E402
 
 NODES = ('plant', 'reference', 'robot', 'record', 'fleet')

@@ -44,10 +44,11 @@ ROOT = os.path.dirname(BENCH)
 sys.path[:0] = [ROOT, BENCH]
 
 from bench_robustness import machine  # noqa: E402
-from formation_ros.core.frames import desired_positions  # noqa: E402, I100
-from formation_ros.core.metrics import SETTLE_TOLERANCE  # noqa: E402
-from formation_ros.core.params import FormationConfig, validate  # noqa: E402
-from formation_ros.core.params_file import load_params_file, write_params_file  # noqa: E402
+from formation_ros.core.maths.frames import desired_positions  # noqa: E402, I100
+from formation_ros.core.runs.metrics import SETTLE_TOLERANCE  # noqa: E402
+from formation_ros.core.settings.params import FormationConfig, validate  # noqa: E402
+from formation_ros.core.settings.params_file import (load_params_file,  # noqa: E402
+                                                     write_params_file)
 import numpy as np  # noqa: E402, I100
 from numpy.typing import NDArray  # noqa: E402
 
@@ -386,8 +387,8 @@ def ros_free_running(prefix: str, folder: str) -> Dict[str, Any]:
 
 def ros_lockstep(prefix: str, folder: str, switch_at: float, duration: float) -> Dict[str, Any]:
     """Section 5 over ROS in lockstep with the switch in the schedule; compared to --dt."""
-    from formation_ros.core.trajectory import Trajectory, TRAJECTORY_FILE
-    from formation_ros.tools.sim import simulate
+    from formation_ros.core.runs.trajectory import Trajectory, TRAJECTORY_FILE
+    from formation_ros.simulation.simulate import simulate
     os.makedirs(folder)
     raw = section5(switch_at, duration, lockstep=True)
     params = write(folder, 'params', raw)

@@ -38,7 +38,8 @@ BENCH = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(BENCH)
 sys.path[:0] = [ROOT]
 
-from formation_ros.core.params_file import load_params_file, write_params_file  # noqa: E402
+from formation_ros.core.settings.params_file import (load_params_file,  # noqa: E402
+                                                     write_params_file)
 import numpy as np  # noqa: E402
 
 LAUNCHER = os.path.join(ROOT, 'scripts', 'launch_formation.sh')

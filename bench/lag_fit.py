@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-The package's lag model (core/dynamics.py, D1) fitted to a step response: tau, a, RMS error.
+The package's lag model (core/model/dynamics.py, D1) fitted to a step response: tau, a, RMS error.
 
 A body that starts at rest and is commanded a step u follows, in the plant model,
 ``v(t) = lagged_velocity(0, u, t, tau, a)`` (a ramp at a while ``|u - v| > a tau``, then a
@@ -53,7 +53,7 @@ class LagFit:
 
 def model_response(t: ArrayLike, step: float, lag: float, max_acceleration: float) -> Float:
     """Return (D1)'s velocity at times t (s) after a step ``step`` from rest."""
-    from formation_ros.core.dynamics import lagged_velocity
+    from formation_ros.core.model.dynamics import lagged_velocity
     times = np.asarray(t, dtype=float)
     if lag <= 0.0 and max_acceleration <= 0.0:
         return np.full_like(times, step)

@@ -7,7 +7,7 @@ Robustness on the physics engine: ``bench_robustness.py --physics`` (issue 30, i
 Two parts, each selectable with ``--only``:
 
 * the sweeps: the law on the MuJoCo engine (formation_sim --engine mujoco, in-process:
-  ``tools.physics_run.run_on_engine``), one world knob at a time from the defaults: the motors'
+  ``simulation.engine_run.run_on_engine``), one world knob at a time from the defaults: the motors'
   limit (``world.wheel_torque`` for the differential-drive bases, ``world.force_limit`` for
   the holonomic ones), the payload (``world.mass``), the floor (``world.floor_friction``:
   the wheels slip), the control period (the law's dt, held while the engine steps) and the
@@ -42,9 +42,10 @@ BENCH = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(BENCH)
 sys.path[:0] = [ROOT, BENCH]
 
-from formation_ros.core.metrics import SETTLE_TOLERANCE  # noqa: E402
-from formation_ros.core.params import FormationConfig, validate, WorldSettings  # noqa: E402
-from formation_ros.core.params_file import load_params_file  # noqa: E402
+from formation_ros.core.runs.metrics import SETTLE_TOLERANCE  # noqa: E402
+from formation_ros.core.settings.params import (FormationConfig, validate,  # noqa: E402
+                                                WorldSettings)
+from formation_ros.core.settings.params_file import load_params_file  # noqa: E402
 from lag_fit import fit_lag, model_response  # noqa: E402
 import numpy as np  # noqa: E402
 
@@ -141,8 +142,8 @@ def footprint_size(config: FormationConfig) -> float:
 
 def engine_job(job: Tuple[str, Settings, int, float]) -> Dict[str, Any]:
     """Run one team on the engine with one setting from one start; return its measures."""
-    from formation_ros.tools.physics_run import engine_problem, run_on_engine
-    from formation_ros.tools.sim import Progress, run_metrics, shapes_of
+    from formation_ros.simulation.engine_run import engine_problem, run_on_engine
+    from formation_ros.simulation.simulate import Progress, run_metrics, shapes_of
     team, settings, seed_offset, duration = job
     started = time.monotonic()
     config, control_dt = team_config(team, settings, seed_offset)
@@ -174,7 +175,7 @@ def engine_job(job: Tuple[str, Settings, int, float]) -> Dict[str, Any]:
 
 def ideal_job(job: Tuple[str, float, float, float, float]) -> Dict[str, Any]:
     """Run one team on the plant model with a lag tau and a limit a; return its measures."""
-    from formation_ros.tools.sim import Progress, run_fixed_step, run_metrics
+    from formation_ros.simulation.simulate import Progress, run_fixed_step, run_metrics
     team, lag, acceleration, duration, control_dt = job
     started = time.monotonic()
     config, _ = team_config(team, (), 0, {'plant.actuator_lag': lag,

@@ -3,7 +3,7 @@
 
 """rosbags messages the bag tests write: headers, planar poses with a heading, twists."""
 
-from formation_ros.core.unicycle import quaternions_from_headings
+from formation_ros.core.maths.unicycle import quaternions_from_headings
 from formation_ros.ros.bag_writer import TYPESTORE
 
 NS = 1_000_000_000

@@ -1,22 +1,22 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""formation_report --animate (tools/animate.py, tools/scene.py) and segments in the report."""
+"""formation_report --animate (figures/animate.py, figures/scene.py) and segments in the report."""
 
 import json
 import math
 import os
 import shutil
 
-from formation_ros.core.events import Event, EventKind
-from formation_ros.core.frames import stationary_frame
-from formation_ros.core.params import load_config
-from formation_ros.tools.animate import (AnimationError, GIF, MAX_FRAMES, MP4, plan_frames,
-                                         write_animation)
+from formation_ros.core.maths.frames import stationary_frame
+from formation_ros.core.runs.events import Event, EventKind
+from formation_ros.core.settings.params import load_config
+from formation_ros.figures.animate import (AnimationError, GIF, MAX_FRAMES, MP4, plan_frames,
+                                           write_animation)
+from formation_ros.figures.scene import Scene
+from formation_ros.simulation.simulate import format_summary, run_metrics, shaped, simulate
 from formation_ros.tools.report import main as report_main, write_report
-from formation_ros.tools.scene import Scene
-from formation_ros.tools.sim import (format_summary, main as sim_main, run_metrics, shaped,
-                                     simulate)
+from formation_ros.tools.sim import main as sim_main
 import numpy as np
 from PIL import Image
 import pytest

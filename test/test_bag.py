@@ -9,14 +9,15 @@ import shutil
 import subprocess
 import sys
 
-from formation_ros.core.frames import frame_to_pose
-from formation_ros.core.params import load_config, validate
-from formation_ros.core.params_file import dump_params_text, load_params_file, parse_params_text
+from formation_ros.core.maths.frames import frame_to_pose
+from formation_ros.core.settings.params import load_config, validate
+from formation_ros.core.settings.params_file import (dump_params_text, load_params_file,
+                                                     parse_params_text)
 from formation_ros.ros.bag_writer import BagError, BagWriter, TYPESTORE
 from formation_ros.ros.topics import PARAMS as PARAMS_TOPIC
+from formation_ros.simulation.simulate import run_metrics, simulate
 from formation_ros.tools.bag import read_messages, read_or_recover, recover_bag, repair_bag
 from formation_ros.tools.report import main as report_main
-from formation_ros.tools.sim import run_metrics, simulate
 import numpy as np
 import pytest
 import yaml

@@ -15,9 +15,9 @@ import math
 import os
 
 from bag_messages import header, pose_msg, unicycle_twist
-from formation_ros.core.params import validate
-from formation_ros.core.params_file import load_params_file
-from formation_ros.core.unicycle import unicycle_commands
+from formation_ros.core.maths.unicycle import unicycle_commands
+from formation_ros.core.settings.params import validate
+from formation_ros.core.settings.params_file import load_params_file
 from formation_ros.ros.bag_writer import BagWriter, TYPESTORE
 from formation_ros.tools.report import main as report_main
 import pytest

@@ -11,7 +11,7 @@ import re
 import subprocess
 import sys
 
-from formation_ros.core import declarations
+from formation_ros.core.settings import declarations
 import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))

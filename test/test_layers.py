@@ -15,15 +15,32 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PACKAGE = os.path.join(ROOT, 'formation_ros')
 ROS_MODULES = ('rclpy', 'rcl_interfaces', 'builtin_interfaces', 'geometry_msgs', 'nav_msgs',
                'std_msgs', 'rosgraph_msgs', 'diagnostic_msgs', 'visualization_msgs', 'rosbags')
+OUTSIDE_CORE = ('formation_ros.ros', 'formation_ros.nodes', 'formation_ros.tools',
+                'formation_ros.physics', 'formation_ros.simulation', 'formation_ros.figures')
 FORBIDDEN = {
-    'core': ROS_MODULES + ('formation_ros.ros', 'formation_ros.nodes', 'formation_ros.tools',
-                           'formation_ros.physics', 'mujoco', 'matplotlib'),
+    'core': ROS_MODULES + OUTSIDE_CORE + ('mujoco', 'matplotlib'),
     'physics': ROS_MODULES + ('formation_ros.ros', 'formation_ros.nodes', 'formation_ros.tools',
+                              'formation_ros.simulation', 'formation_ros.figures',
                               'matplotlib'),
-    'ros': ('formation_ros.nodes', 'formation_ros.tools', 'matplotlib'),
-    'nodes': ('formation_ros.tools', 'matplotlib'),
+    'ros': ('formation_ros.nodes', 'formation_ros.tools', 'formation_ros.simulation',
+            'formation_ros.figures', 'matplotlib', 'mujoco'),
+    'nodes': ('formation_ros.tools', 'formation_ros.simulation', 'formation_ros.figures',
+              'matplotlib'),
+    'simulation': ROS_MODULES + ('formation_ros.ros', 'formation_ros.nodes', 'formation_ros.tools',
+                                 'formation_ros.figures', 'matplotlib'),
+    'figures': ROS_MODULES + ('formation_ros.ros', 'formation_ros.nodes', 'formation_ros.tools',
+                              'formation_ros.physics', 'mujoco'),
     'tools': ('formation_ros.nodes',),
 }
+"""Each layer and what it must not import: the arrows point down only."""
+CORE_ROOMS = {
+    'maths': (),
+    'model': ('maths',),
+    'runs': ('maths',),
+    'settings': ('maths', 'model'),
+    'rules': ('maths', 'model', 'runs', 'settings'),
+}
+"""The rooms of the core and the rooms each may import (``formation_ros/core/__init__.py``)."""
 NODES = ('robot', 'fleet', 'plant', 'reference', 'recorder', 'relay', 'world')
 NEVER_IN_A_NODE = ('matplotlib', 'scipy.integrate', 'formation_ros.tools')
 NOT_IN_A_ROBOT = ('scipy',)
@@ -46,9 +63,10 @@ def imported_modules(path):
 
 
 def layer_files(layer):
+    """Every module of a layer, its rooms included."""
     folder = os.path.join(PACKAGE, layer)
-    return sorted(os.path.join(folder, name) for name in os.listdir(folder)
-                  if name.endswith('.py'))
+    return sorted(os.path.join(root, name) for root, _, names in os.walk(folder)
+                  for name in names if name.endswith('.py'))
 
 
 @pytest.mark.parametrize('layer', sorted(FORBIDDEN))
@@ -65,6 +83,42 @@ def test_every_module_is_in_a_layer():
     loose = [name for name in os.listdir(PACKAGE)
              if name.endswith('.py') and name != '__init__.py']
     assert not loose, loose
+    layers = {name for name in os.listdir(PACKAGE)
+              if os.path.isfile(os.path.join(PACKAGE, name, '__init__.py'))}
+    assert layers == set(FORBIDDEN), layers
+
+
+def test_every_core_module_is_in_a_room():
+    core = os.path.join(PACKAGE, 'core')
+    loose = [name for name in os.listdir(core) if name.endswith('.py') and name != '__init__.py']
+    assert not loose, loose
+    rooms = {name for name in os.listdir(core)
+             if os.path.isfile(os.path.join(core, name, '__init__.py'))}
+    assert rooms == set(CORE_ROOMS), rooms
+
+
+@pytest.mark.parametrize('room', sorted(CORE_ROOMS))
+def test_core_rooms_import_only_the_rooms_below(room):
+    allowed = {room, *CORE_ROOMS[room]}
+    files = layer_files(os.path.join('core', room))
+    assert len(files) > 1
+    wrong = [(os.path.relpath(path, ROOT), module) for path in files
+             for module in sorted(imported_modules(path))
+             if module.startswith('formation_ros.core.')
+             and module.split('.')[2] not in allowed]
+    assert not wrong, wrong
+
+
+def test_tools_hold_command_line_tools_and_what_only_they_use():
+    """A module of tools/ is a command or is imported by tools only (no bench, no other layer)."""
+    tools = {os.path.basename(path)[:-3] for path in layer_files('tools')} - {'__init__'}
+    users = {}
+    for layer in sorted(set(FORBIDDEN) - {'tools'}):
+        for path in layer_files(layer):
+            for module in imported_modules(path):
+                if module.startswith('formation_ros.tools.'):
+                    users.setdefault(module.split('.')[2], []).append(path)
+    assert tools and not users, users
 
 
 @pytest.mark.parametrize('node', NODES)

@@ -255,7 +255,7 @@ def test_launch_file_spreads_robots_over_fleet_processes(launch_file):
 
 @pytest.mark.parametrize('record', ['', '/tmp/formation_bag'])
 def test_launch_file_starts_the_system_of_the_shell_launcher(launch_file, setup_data, record):
-    from formation_ros.core.declarations import BY_NAME as schema, Exe
+    from formation_ros.core.settings.declarations import BY_NAME as schema, Exe
     scripts = {entry.split('=')[0].strip()
                for entry in setup_data['entry_points']['console_scripts']}
     params = os.path.join(ROOT, 'config', 'square_4.yaml')

@@ -4,12 +4,12 @@
 """
 Property-based tests (hypothesis): the parameter loader and the control law on hostile input.
 
-Loader (``core.params_file.parse_params_text`` + ``core.params.validate`` for every ``Exe``):
-random YAML documents and text, wrong types, NaN, inf, 1e300, subnormal numbers, huge lists,
-unicode and missing sections raise nothing but ``ParamError``, and valid files, over the whole
-range the parameters allow, give a config. Law (``core.law.robot_command``, ``team_command``): for
-finite positions, even extreme or coincident ones and many neighbours, u_hat is finite with
-every component within c M1 (inclusive) and u is finite.
+Loader (``core.settings.params_file.parse_params_text`` + ``core.settings.params.validate`` for
+every ``Exe``): random YAML documents and text, wrong types, NaN, inf, 1e300, subnormal numbers,
+huge lists, unicode and missing sections raise nothing but ``ParamError``, and valid files, over
+the whole range the parameters allow, give a config. Law (``core.maths.law.robot_command``,
+``team_command``): for finite positions, even extreme or coincident ones and many neighbours, u_hat
+is finite with every component within c M1 (inclusive) and u is finite.
 
 The contract for non-finite input: the robot node drops poses, neighbours and references with
 non-finite values before the law (``nodes/robot.py``), so the law does not promise a finite
@@ -26,14 +26,14 @@ error. The plant model's properties are in ``test/core/test_plant_properties.py`
 import math
 import os
 
-from formation_ros.core.declarations import BY_NAME, Exe, Kind, ParamError
-from formation_ros.core.frames import STATIONARY
-from formation_ros.core.law import (GAIN_MAX, KAPPA_MAX, make_law, REPULSION_RANGE,
-                                    robot_command, team_command)
-from formation_ros.core.params import FormationConfig, validate
-from formation_ros.core.params_file import (dump_params_text, load_params_file, nest,
-                                            parse_params_text)
-from formation_ros.core.reference import Reference
+from formation_ros.core.maths.frames import STATIONARY
+from formation_ros.core.maths.law import (GAIN_MAX, KAPPA_MAX, make_law, REPULSION_RANGE,
+                                          robot_command, team_command)
+from formation_ros.core.maths.reference import Reference
+from formation_ros.core.settings.declarations import BY_NAME, Exe, Kind, ParamError
+from formation_ros.core.settings.params import FormationConfig, validate
+from formation_ros.core.settings.params_file import (dump_params_text, load_params_file, nest,
+                                                     parse_params_text)
 from hypothesis import assume, given, HealthCheck, settings, strategies as st
 import numpy as np
 import pytest
@@ -274,7 +274,7 @@ kappas = st.one_of(st.floats(min_value=5e-324, max_value=KAPPA_MAX),
 @st.composite
 def laws(draw):
     """
-    Draw law constants over the whole range the law takes (``core.law``).
+    Draw law constants over the whole range the law takes (``core.maths.law``).
 
     Gain and kappa up to 1e6, b from 1 mm to 10 km for either jump function, R_i up to 1000 b.
     """

@@ -7,9 +7,9 @@ import os
 import re
 import shlex
 
-from formation_ros.core.declarations import Exe, is_known, ParamError
-from formation_ros.core.params import validate
-from formation_ros.core.params_file import load_params_file
+from formation_ros.core.settings.declarations import Exe, is_known, ParamError
+from formation_ros.core.settings.params import validate
+from formation_ros.core.settings.params_file import load_params_file
 import pytest
 import yaml
 

@@ -12,9 +12,9 @@ import pytest
 
 mujoco = pytest.importorskip('mujoco')
 
-from formation_ros.core.params import load_config, validate  # noqa: E402, I100
-from formation_ros.core.params_file import parse_params_text  # noqa: E402
-from formation_ros.core.trajectory import Trajectory, TRAJECTORY_FILE  # noqa: E402
+from formation_ros.core.runs.trajectory import Trajectory, TRAJECTORY_FILE  # noqa: E402, I100
+from formation_ros.core.settings.params import load_config, validate  # noqa: E402
+from formation_ros.core.settings.params_file import parse_params_text  # noqa: E402
 from formation_ros.physics.scene import build_scene  # noqa: E402
 from formation_ros.tools import render, sim  # noqa: E402
 from PIL import Image  # noqa: E402

@@ -8,13 +8,13 @@ import os
 import subprocess
 import sys
 
-from formation_ros.core.law import log_potential
-from formation_ros.core.metrics import formation_errors
-from formation_ros.core.params import load_config, validate
-from formation_ros.core.params_file import load_params_file
-from formation_ros.core.trajectory import Trajectory
-from formation_ros.tools.plots import FIGURES
-from formation_ros.tools.sim import run_metrics, simulate
+from formation_ros.core.maths.law import log_potential
+from formation_ros.core.runs.metrics import formation_errors
+from formation_ros.core.runs.trajectory import Trajectory
+from formation_ros.core.settings.params import load_config, validate
+from formation_ros.core.settings.params_file import load_params_file
+from formation_ros.figures.plots import FIGURES
+from formation_ros.simulation.simulate import run_metrics, simulate
 import numpy as np
 import pytest
 
@@ -231,7 +231,7 @@ def test_cli_accepts_a_step_equal_to_the_duration(tmp_path):
 
 
 def test_body_frame_commands_move_the_bodies_as_world_ones_do():
-    from formation_ros.tools.sim import Progress, simulate_fixed_step
+    from formation_ros.simulation.simulate import Progress, simulate_fixed_step
     raw = load_params_file(os.path.join(ROOT, 'config', 'square_4.yaml'))
     world = validate(raw)
     body = validate({**raw, 'command.frame': 'body', 'start.headings': [0.5, 2.0, -1.0, 3.0]})

@@ -8,10 +8,10 @@ import os
 import subprocess
 import sys
 
-from formation_ros.core.declarations import Exe, ParamError
-from formation_ros.core.params import load_config, validate
-from formation_ros.core.params_file import dump_params_text, load_params_file
-from formation_ros.tools.sim import simulate
+from formation_ros.core.settings.declarations import Exe, ParamError
+from formation_ros.core.settings.params import load_config, validate
+from formation_ros.core.settings.params_file import dump_params_text, load_params_file
+from formation_ros.simulation.simulate import simulate
 import pytest
 
 ROOT = os.path.join(os.path.dirname(__file__), '..')

@@ -4,8 +4,8 @@
 """
 formation_sim at scale: the default-sampling rule, lazy imports, and the exact fast paths.
 
-The rule (``tools.sim.default_sample_dt``) is checked against a brute-force search over the
-multiples of the default spacing; a thinned run must keep exactly the samples of the full run
+The rule (``simulation.simulate.default_sample_dt``) is checked against a brute-force search over
+the multiples of the default spacing; a thinned run must keep exactly the samples of the full run
 at its own times; the fast paths of the law and of the admission must give the very numbers of
 the general formulas, written out here once more.
 """
@@ -16,11 +16,12 @@ import os
 import subprocess
 import sys
 
-from formation_ros.core.law import make_law, team_command
-from formation_ros.core.params import load_config
-from formation_ros.core.plant import Commands, PlantModel
-from formation_ros.core.reference import Reference
-from formation_ros.core.trajectory import Trajectory
+from formation_ros.core.maths.law import make_law, team_command
+from formation_ros.core.maths.reference import Reference
+from formation_ros.core.model.plant import Commands, PlantModel
+from formation_ros.core.runs.trajectory import Trajectory, TRAJECTORY_FILE
+from formation_ros.core.settings.params import load_config
+from formation_ros.simulation import simulate
 from formation_ros.tools import sim
 import numpy as np
 import pytest
@@ -33,7 +34,7 @@ SECTION5 = os.path.join(ROOT, 'config', 'paper_section5.yaml')
 def samples_of(duration, dt, sample_dt):
     """How many samples a run keeps, counted one by one as run_fixed_step / RK45 keep them."""
     if dt is None:
-        return len(sim.sample_times(duration, sample_dt))
+        return len(simulate.sample_times(duration, sample_dt))
     steps = int(round(duration / dt))
     stride = max(1, int(round(sample_dt / dt)))
     return sum(1 for k in range(steps) if k % stride == 0) + 1
@@ -44,38 +45,39 @@ def samples_of(duration, dt, sample_dt):
     (10000, 20.0, 0.01), (10000, 20.0, None), (10000, 20.0, 0.025), (10000, 20.0, 0.05),
     (3000, 7.3, 0.003), (10 ** 7, 20.0, 0.01)])
 def test_default_spacing_is_the_smallest_multiple_within_the_cap(robots, duration, dt):
-    spacing = sim.default_sample_dt(robots, duration, dt)
+    spacing = simulate.default_sample_dt(robots, duration, dt)
     multiples = [m for m in range(1, 3000)
-                 if m * sim.DEFAULT_SAMPLE_DT >= duration
-                 or robots * samples_of(duration, dt, m * sim.DEFAULT_SAMPLE_DT)
-                 <= sim.MAX_ROBOT_SAMPLES]
-    wanted = min(multiples[0] * sim.DEFAULT_SAMPLE_DT, duration)
+                 if m * simulate.DEFAULT_SAMPLE_DT >= duration
+                 or robots * samples_of(duration, dt, m * simulate.DEFAULT_SAMPLE_DT)
+                 <= simulate.MAX_ROBOT_SAMPLES]
+    wanted = min(multiples[0] * simulate.DEFAULT_SAMPLE_DT, duration)
     assert spacing == pytest.approx(wanted, rel=1e-12)
-    assert sim.sample_count(duration, dt, spacing) == samples_of(duration, dt, spacing)
+    assert simulate.sample_count(duration, dt, spacing) == samples_of(duration, dt, spacing)
     if spacing < duration:
-        assert robots * samples_of(duration, dt, spacing) <= sim.MAX_ROBOT_SAMPLES
+        assert robots * samples_of(duration, dt, spacing) <= simulate.MAX_ROBOT_SAMPLES
 
 
 def test_ten_thousand_robots_over_20_s_are_sampled_every_50_ms():
-    assert sim.default_sample_dt(10000, 20.0, 0.01) == 0.05
-    assert sim.default_sample_dt(1000, 20.0, 0.01) == sim.DEFAULT_SAMPLE_DT
-    meta = sim.sampling_metadata(10000, 20.0, 0.01, None)
+    assert simulate.default_sample_dt(10000, 20.0, 0.01) == 0.05
+    assert simulate.default_sample_dt(1000, 20.0, 0.01) == simulate.DEFAULT_SAMPLE_DT
+    meta = simulate.sampling_metadata(10000, 20.0, 0.01, None)
     assert meta == {'sample_dt': 0.05, 'sampling': 'default, thinned',
-                    'max_robot_samples': sim.MAX_ROBOT_SAMPLES}
-    assert sim.sampling_metadata(10000, 20.0, 0.01, 0.01)['sampling'] == 'given'
-    assert sim.sampling_metadata(10, 20.0, None, None)['sampling'] == 'default'
+                    'max_robot_samples': simulate.MAX_ROBOT_SAMPLES}
+    assert simulate.sampling_metadata(10000, 20.0, 0.01, 0.01)['sampling'] == 'given'
+    assert simulate.sampling_metadata(10, 20.0, None, None)['sampling'] == 'default'
 
 
 def test_help_states_the_rule():
     text = sim.build_parser().format_help()
-    assert f'{sim.MAX_ROBOT_SAMPLES:,}' in text and 'robots x samples' in ' '.join(text.split())
+    assert f'{simulate.MAX_ROBOT_SAMPLES:,}' in text
+    assert 'robots x samples' in ' '.join(text.split())
 
 
 def run_main(tmp_path, name, *options):
     out = tmp_path / name
     assert sim.main([SECTION5, '--out', str(out), '--no-plots', '--quiet', *options]) == 0
-    return (Trajectory.load(str(out / sim.TRAJECTORY_FILE)),
-            json.loads((out / sim.METRICS_FILE).read_text()))
+    return (Trajectory.load(str(out / TRAJECTORY_FILE)),
+            json.loads((out / simulate.METRICS_FILE).read_text()))
 
 
 @pytest.mark.parametrize('step', [('--dt', '0.01'), ()])
@@ -84,7 +86,7 @@ def test_a_thinned_run_keeps_the_full_runs_samples_at_its_times(tmp_path, monkey
     full, full_metrics = run_main(tmp_path, 'full', *options)
     assert full_metrics['sampling'] == 'default' and full_metrics['sample_dt'] == 0.01
     assert len(full.t) == 201
-    monkeypatch.setattr(sim, 'MAX_ROBOT_SAMPLES', 10 * 60)
+    monkeypatch.setattr(simulate, 'MAX_ROBOT_SAMPLES', 10 * 60)
     thin, thin_metrics = run_main(tmp_path, 'thin', *options)
     assert thin_metrics['sampling'] == 'default, thinned'
     assert thin_metrics['sample_dt'] == 0.04 and thin_metrics['max_robot_samples'] == 600
@@ -124,13 +126,13 @@ def test_importing_formation_sim_or_asking_for_help_loads_no_scipy_or_matplotlib
 
 
 def test_a_fixed_step_run_without_figures_loads_no_scipy_or_matplotlib(tmp_path):
-    """The grid of core.pairs searches every pair a --dt run needs: scipy stays unloaded."""
+    """The grid of core.maths.pairs searches every pair a --dt run needs: scipy stays unloaded."""
     out = str(tmp_path / 'run')
     code = ('from formation_ros.tools.sim import main\n'
             f"assert main([{SECTION5!r}, '--out', {out!r}, '--duration', '1', '--dt', '0.01', "
             "'--no-plots', '--quiet']) == 0")
     assert loaded_by(code) == '[]'
-    assert Trajectory.load(os.path.join(out, sim.TRAJECTORY_FILE)).q.shape == (101, 10, 2)
+    assert Trajectory.load(os.path.join(out, TRAJECTORY_FILE)).q.shape == (101, 10, 2)
 
 
 def test_the_command_gives_the_numbers_of_the_library_call(tmp_path):
@@ -141,8 +143,8 @@ def test_the_command_gives_the_numbers_of_the_library_call(tmp_path):
                              '--quiet'], capture_output=True, text=True, cwd=ROOT, timeout=300)
     assert result.returncode == 0, result.stderr
     config = load_config(SECTION5)
-    run = sim.run_fixed_step(config, 2.0, 0.01, 0.01, sim.Progress(2.0, quiet=True))
-    written = Trajectory.load(str(out / sim.TRAJECTORY_FILE))
+    run = simulate.run_fixed_step(config, 2.0, 0.01, 0.01, simulate.Progress(2.0, quiet=True))
+    written = Trajectory.load(str(out / TRAJECTORY_FILE))
     for name in ('t', 'q', 'u', 'u_hat', 'q_desired', 'q_od'):
         assert np.array_equal(getattr(written, name), getattr(run.trajectory, name)), name
 

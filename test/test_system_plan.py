@@ -9,7 +9,7 @@ from pathlib import Path
 import subprocess
 import sys
 
-from formation_ros.core.params_file import load_params_file, write_params_file
+from formation_ros.core.settings.params_file import load_params_file, write_params_file
 import pytest
 from test_package import launched_nodes, node_parameters, Shutdown
 from test_scripts import launch_fake, make_fake_install, run
@@ -174,7 +174,7 @@ def test_lab_launch_file_starts_what_the_launcher_starts(lab_launch_file, named,
 
 
 def test_a_lab_runs_relay_reference_and_robots_on_wall_clock_time(named):
-    from formation_ros.core.declarations import BY_NAME as schema, Exe
+    from formation_ros.core.settings.declarations import BY_NAME as schema, Exe
     views = launcher_views(named, ['--no-plant', '--cmd-topic', '/{name}/cmd_vel',
                                    '--source-topic', '/vrpn_mocap/{name}/pose', '--record',
                                    '/tmp/lab_bag'])
@@ -230,7 +230,7 @@ def test_lab_launch_file_refuses_what_the_launcher_refuses(lab_launch_file, argu
 
 
 def test_lab_launch_file_refuses_bad_parameters(lab_launch_file, tmp_path):
-    from formation_ros.core.declarations import ParamError
+    from formation_ros.core.settings.declarations import ParamError
     values = dict(load_params_file(SQUARE), **{'relay.source_names': ['a', 'a', 'b', 'c']})
     path = str(tmp_path / 'twice.yaml')
     write_params_file(path, values)
@@ -288,7 +288,7 @@ class Exited:
 
 @pytest.mark.parametrize('policy', ['continue', 'stop', ''])
 def test_a_failed_recording_ends_a_launch_file_run_only_when_asked(launch_file, policy):
-    from formation_ros.core.exits import RECORDING_FAILED
+    from formation_ros.core.settings.exits import RECORDING_FAILED
     nodes = launched_nodes(launch_file, params_file=SQUARE, record='/tmp/bag',
                            on_record_failure=policy)
     (recorder,) = [node for node in nodes if node.kwargs['executable'] == 'record']

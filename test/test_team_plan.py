@@ -5,9 +5,9 @@
 
 import os
 
-from formation_ros.core.declarations import Exe
-from formation_ros.core.params import load_config
-from formation_ros.core.params_file import load_params_file, write_params_file
+from formation_ros.core.settings.declarations import Exe
+from formation_ros.core.settings.params import load_config
+from formation_ros.core.settings.params_file import load_params_file, write_params_file
 from formation_ros.tools.system import PlanError, read_formation
 import pytest
 

@@ -7,10 +7,10 @@ import json
 import os
 
 from bag_messages import header, pose_msg, unicycle_twist
-from formation_ros.core.params import load_config
+from formation_ros.core.settings.params import load_config
 from formation_ros.ros.bag_writer import BagWriter, TYPESTORE
+from formation_ros.simulation.simulate import run_metrics, simulate
 from formation_ros.tools.report import main as report_main
-from formation_ros.tools.sim import run_metrics, simulate
 import numpy as np
 import pytest
 

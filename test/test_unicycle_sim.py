@@ -9,16 +9,16 @@ import os
 import subprocess
 import sys
 
-from formation_ros.core.declarations import Exe
-from formation_ros.core.law import log_potential, team_command
-from formation_ros.core.metrics import dis_min_series, formation_errors
-from formation_ros.core.params import load_config, validate, validate_for_every_executable
-from formation_ros.core.params_file import load_params_file
-from formation_ros.core.safety import guaranteed_min_distance
-from formation_ros.core.trajectory import ARRAYS, BODY_ARRAYS, Trajectory
-from formation_ros.core.unicycle import command_bounds, hand_points
-from formation_ros.tools.plots import FIGURES
-from formation_ros.tools.sim import run_metrics, simulate
+from formation_ros.core.maths.law import log_potential, team_command
+from formation_ros.core.maths.safety import guaranteed_min_distance
+from formation_ros.core.maths.unicycle import command_bounds, hand_points
+from formation_ros.core.runs.metrics import dis_min_series, formation_errors
+from formation_ros.core.runs.trajectory import ARRAYS, BODY_ARRAYS, Trajectory
+from formation_ros.core.settings.declarations import Exe
+from formation_ros.core.settings.params import load_config, validate, validate_for_every_executable
+from formation_ros.core.settings.params_file import load_params_file
+from formation_ros.figures.plots import FIGURES
+from formation_ros.simulation.simulate import run_metrics, simulate
 import numpy as np
 import pytest
 from scipy.spatial.distance import pdist

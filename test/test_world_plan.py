@@ -5,7 +5,7 @@
 
 import os
 
-from formation_ros.core.params_file import load_params_file, write_params_file
+from formation_ros.core.settings.params_file import load_params_file, write_params_file
 import pytest
 from test_package import launched_nodes
 from test_scripts import make_fake_install, run
@@ -31,7 +31,7 @@ def world_install(tmp_path):
 
 
 def test_the_world_relay_reference_and_robots_run_on_the_worlds_clock():
-    from formation_ros.core.declarations import BY_NAME as schema, Exe
+    from formation_ros.core.settings.declarations import BY_NAME as schema, Exe
     views = launcher_views(WORLD, ['--world', '--out', '/nonexistent/w', '--record',
                                    '/nonexistent/w_bag'])
     assert [view['executable'] for view in views] == ['record', 'world', 'relay',

@@ -9,7 +9,7 @@ messages, serialized by rclpy, are what a motion-capture driver, a base driver o
 and so an independent reference for the package's readers and writers.
 """
 
-from formation_ros.core.frames import frame_to_pose
+from formation_ros.core.maths.frames import frame_to_pose
 from formation_ros.ros.messages import FORMATION_FRAME, stamped, WORLD_FRAME, xyz
 from geometry_msgs.msg import PoseStamped, TwistStamped
 from nav_msgs.msg import Odometry
@@ -47,7 +47,7 @@ def velocity_of(msg, dim):
 
 
 def reference_odometry(frame, stamp_ns, dim):
-    """Build the nav_msgs/Odometry of a reference sample (``core.frames.frame_to_pose``)."""
+    """Build the nav_msgs/Odometry of a reference sample (``core.maths.frames.frame_to_pose``)."""
     position, quat, linear, angular = frame_to_pose(frame, dim)
     msg = stamped(Odometry(), stamp_ns)
     msg.child_frame_id = FORMATION_FRAME

@@ -6,7 +6,8 @@ Sphinx extension: the reference parts of the docs, generated from the package's 
 
 Directives (each writes MyST Markdown that the page then parses):
 
-* ``formation-parameters [NAMES]``: the parameters of ``core/declarations.py`` (name, type,
+* ``formation-parameters [NAMES]``: the parameters of ``core/settings/declarations.py`` (name,
+type,
   default, range, who reads it, meaning): those NAMES gives (``plant.`` a prefix, ``dim`` one
   name), or all of them. A parameter without a description, or one that no table of the docs
   lists, is a build warning (an error with ``-W``).
@@ -84,7 +85,7 @@ def code(text: object) -> str:
 
 def default_text(param: Any) -> str:
     """Say a parameter's default as a user writes it in a file."""
-    from formation_ros.core.declarations import REQUIRED
+    from formation_ros.core.settings.declarations import REQUIRED
     value = param.default
     if value is REQUIRED:
         return 'required'
@@ -99,7 +100,7 @@ def default_text(param: Any) -> str:
 
 def readers_text(param: Any) -> str:
     """Say which executables read a parameter (``fleet`` runs the robot's nodes)."""
-    from formation_ros.core.declarations import ALL, Exe
+    from formation_ros.core.settings.declarations import ALL, Exe
     if param.users == ALL:
         return 'all'
     names = [exe.value for exe in Exe if exe in param.users]
@@ -110,7 +111,7 @@ def readers_text(param: Any) -> str:
 
 def parameter_problems(declarations: Sequence[Any]) -> List[str]:
     """Return what keeps the reference from being complete: names without a description."""
-    return [f"parameter '{p.name}' has no description in core/declarations.py"
+    return [f"parameter '{p.name}' has no description in core/settings/declarations.py"
             for p in declarations if not str(p.description or '').strip()]
 
 
@@ -137,7 +138,7 @@ def unlisted_parameters(declarations: Sequence[Any], listed: Iterable[str]) -> L
 
 
 def parameter_markdown(declarations: Sequence[Any]) -> List[str]:
-    """Return the parameter reference table of ``declarations`` (core.declarations.Param)."""
+    """Return the parameter reference table of ``declarations`` (``settings.declarations.Param``)."""
     rows = [(code(p.name), p.kind.value.replace('_', ' '), default_text(p),
              p.range_text(), readers_text(p), p.description) for p in declarations]
     return table(('name', 'type', 'default', 'allowed', 'read by', 'meaning'), rows)
@@ -440,12 +441,12 @@ class Parameters(Generated):
 
     has_content = False
     final_argument_whitespace = True
-    reads = ('formation_ros/core/declarations.py',)
+    reads = ('formation_ros/core/settings/declarations.py',)
     kind = 'parameters'
 
     def markdown(self) -> Tuple[List[str], List[str]]:
         """Return the table of the parameters named (all without a name)."""
-        from formation_ros.core.declarations import DECLARATIONS
+        from formation_ros.core.settings.declarations import DECLARATIONS
         chosen = select_parameters(DECLARATIONS, self.arguments[0].split() if self.arguments
                                    else [])
         env = self.state.document.settings.env
@@ -469,7 +470,7 @@ def merge_parameters(app: Any, env: Any, docnames: Any, other: Any) -> None:
 
 def check_parameters(app: Any, env: Any) -> None:
     """Warn about parameters that no table lists, once some page has parameter tables."""
-    from formation_ros.core.declarations import DECLARATIONS
+    from formation_ros.core.settings.declarations import DECLARATIONS
     listed = getattr(env, 'formation_parameters', {})
     if listed:
         for problem in unlisted_parameters(DECLARATIONS, set().union(*listed.values())):

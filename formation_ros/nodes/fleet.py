@@ -20,7 +20,7 @@ import re
 import sys
 from typing import List, Optional, Sequence
 
-from formation_ros.core.declarations import ParamError
+from formation_ros.core.settings.declarations import ParamError
 from formation_ros.nodes.robot import RobotNode
 from formation_ros.nodes.robots_link import RobotsLink
 from formation_ros.ros.runner import run

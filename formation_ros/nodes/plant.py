@@ -4,38 +4,38 @@
 """
 Plant node (executable ``plant``): the robots' bodies and range sensors on the ROS graph.
 
-It steps :class:`formation_ros.core.plant.PlantModel` (the model ``formation_sim --dt`` steps)
-with the commands it hears and publishes ``/clock``, what each robot senses, ``/diagnostics``
-and ``/formation/markers``; with ``plant.output_dir`` it writes ``trajectory.npz`` and
-``plant_stats.json``. Topics, transports, start-up and lockstep: docs/ros_interface.md; faults
+It steps :class:`formation_ros.core.model.plant.PlantModel` (the model ``formation_sim --dt``
+steps) with the commands it hears and publishes ``/clock``, what each robot senses,
+``/diagnostics`` and ``/formation/markers``; with ``plant.output_dir`` it writes ``trajectory.npz``
+and ``plant_stats.json``. Topics, transports, start-up and lockstep: docs/ros_interface.md; faults
 and another team on the domain: docs/faults.md. Its rules are core objects it feeds with what
-it read: the start gate (``core.plant_gate``), the intake of commands (``core.plant_intake``),
-the run statistics (``core.plant_stats``) and the status (``core.plant_status``). Callbacks
-store, timers act.
+it read: the start gate (``core.rules.plant_gate``), the intake of commands
+(``core.rules.plant_intake``), the run statistics (``core.rules.plant_stats``) and the status
+(``core.rules.plant_status``). Callbacks store, timers act.
 """
 
 import time
 from typing import List, Optional
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros.core.admission import Reason
-from formation_ros.core.bodies import make_bodies
-from formation_ros.core.declarations import CommandFrame, Exe
-from formation_ros.core.events import event_records, timeline_events
-from formation_ros.core.exits import REFUSED
-from formation_ros.core.frames import desired_positions
-from formation_ros.core.lockstep import AnswerWait
-from formation_ros.core.plant import PlantModel, StepReport
-from formation_ros.core.plant_gate import (CLOCK_MATCH_LINE, ClockMatch, GAVE_UP_LINE,
-                                           leftover_line, Phase, StartGate, Verdict,
-                                           waiting_line)
-from formation_ros.core.plant_intake import CommandIntake, Source, TEAM
-from formation_ros.core.plant_stats import RunOutput, RunStats
-from formation_ros.core.plant_status import (collision_lines, CommandWatch, Heard, Note,
-                                             PlantStatus, start_line, violation_lines)
-from formation_ros.core.team import team_values
-from formation_ros.core.timeline import Mode
-from formation_ros.core.units import NS_PER_S
+from formation_ros.core.maths.frames import desired_positions
+from formation_ros.core.maths.units import NS_PER_S
+from formation_ros.core.model.bodies import make_bodies
+from formation_ros.core.model.plant import PlantModel, StepReport
+from formation_ros.core.rules.admission import Reason
+from formation_ros.core.rules.lockstep import AnswerWait
+from formation_ros.core.rules.plant_gate import (CLOCK_MATCH_LINE, ClockMatch, GAVE_UP_LINE,
+                                                 leftover_line, Phase, StartGate, Verdict,
+                                                 waiting_line)
+from formation_ros.core.rules.plant_intake import CommandIntake, Source, TEAM
+from formation_ros.core.rules.plant_stats import RunOutput, RunStats
+from formation_ros.core.rules.plant_status import (collision_lines, CommandWatch, Heard, Note,
+                                                   PlantStatus, start_line, violation_lines)
+from formation_ros.core.runs.events import event_records, timeline_events
+from formation_ros.core.runs.timeline import Mode
+from formation_ros.core.settings.declarations import CommandFrame, Exe
+from formation_ros.core.settings.exits import REFUSED
+from formation_ros.core.settings.team import team_values
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import CdrError, read_twist, read_twist_stamped, TeamCommandReader
 from formation_ros.ros.changes import Changes
@@ -164,7 +164,7 @@ class PlantNode(Node):
             self.command_topics.append(sub.topic_name)
 
     def on_command(self, index: int, data: bytes) -> None:
-        """Store robot ``index``'s command (``core.plant_intake``); lockstep: wake the step."""
+        """Store robot ``index``'s command (``rules.plant_intake``); lockstep: wake the step."""
         try:
             command = read_twist_stamped(data) if self.intake.stamped else read_twist(data)
         except CdrError as exc:
@@ -229,7 +229,7 @@ class PlantNode(Node):
         """
         Look up the other /clock publishers when the gate asks; return whether the domain is ours.
 
-        The gate (``core.plant_gate``) decides: refuse (exit REFUSED), end the look or go on.
+        The gate (``core.rules.plant_gate``) decides: refuse (exit REFUSED), end the look or go on.
         """
         if not self.gate.look_due(now, at_once):
             return self.gate.looked
@@ -317,7 +317,7 @@ class PlantNode(Node):
             self.get_logger().error(line)
 
     def _say(self, note: Note) -> None:
-        """Log a condition's start or end once (``core.plant_status.Note``)."""
+        """Log a condition's start or end once (``core.rules.plant_status.Note``)."""
         if note.starts:
             self.once.start_group(list(note.keys), note.line, note.level)
         elif note.line is not None:
@@ -341,7 +341,7 @@ class PlantNode(Node):
 
     def on_diagnostics(self) -> None:
         """
-        Publish the plant's status (``core.plant_status``).
+        Publish the plant's status (``core.rules.plant_status``).
 
         While the clock waits for the robots the domain is looked at first: another team is
         the gate's to refuse, in one line.

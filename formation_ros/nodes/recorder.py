@@ -18,8 +18,8 @@ import os
 from typing import Any, Dict, List, Optional, Tuple
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros.core.declarations import Exe, ParamError, RECORDER_ONLY
-from formation_ros.core.exits import RECORDING_FAILED
+from formation_ros.core.settings.declarations import Exe, ParamError, RECORDER_ONLY
+from formation_ros.core.settings.exits import RECORDING_FAILED
 from formation_ros.ros import qos, topics
 from formation_ros.ros.bag_writer import (BagError, BagWriteError, BagWriter, FLUSHES_PER_FILE,
                                           qos_of)

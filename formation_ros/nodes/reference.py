@@ -9,7 +9,7 @@ velocity at ``reference.rate``), ``/formation/shape`` and ``/formation/status`` 
 holding from its stamp on), and serves ``/formation/stop`` and ``/formation/start``. The
 messages: docs/ros_interface.md, "Topics"; when samples go out (plant time, lockstep, a held
 clock): docs/ros_interface.md, "Behaviour of the nodes"; changes at run time and the rules a new
-shape or reference must keep: docs/changes.md. The frame itself is ``core.reference``'s.
+shape or reference must keep: docs/changes.md. The frame itself is ``core.maths.reference``'s.
 Start it beside a plant with ``use_sim_time:=true``::
 
     ros2 run formation_ros reference --ros-args --params-file config/square_4.yaml \\
@@ -20,13 +20,14 @@ import math
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros.core.declarations import Exe, ParamError, ReferenceKind
-from formation_ros.core.frames import frame_to_pose
-from formation_ros.core.params import check_shape, tracking_problem
-from formation_ros.core.reference import PERIODIC
-from formation_ros.core.team import team_values
-from formation_ros.core.timeline import Mode, ReferenceTimeline, Shape, TeamState, Timeline
-from formation_ros.core.units import NS_PER_S
+from formation_ros.core.maths.frames import frame_to_pose
+from formation_ros.core.maths.reference import PERIODIC
+from formation_ros.core.maths.reference import ReferenceKind
+from formation_ros.core.maths.units import NS_PER_S
+from formation_ros.core.runs.timeline import Mode, ReferenceTimeline, Shape, TeamState, Timeline
+from formation_ros.core.settings.declarations import Exe, ParamError
+from formation_ros.core.settings.params import check_shape, tracking_problem
+from formation_ros.core.settings.team import team_values
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import encode_odometry
 from formation_ros.ros.diagnostics import diagnostics, PERIOD

@@ -7,11 +7,11 @@ Relay node (executable ``relay``): the range sensor of the plant, without the bo
 In a lab the bodies are real and a motion-capture system measures them: :class:`RelayNode`
 reads each robot's measured pose (``relay.source_topic``, a PoseStamped or an Odometry) and
 publishes what the plant would, every robot's ``pose`` and ``neighbors`` with the one sensing
-rule of ``core.sensing``, all with one wall-clock stamp per cycle at ``relay.rate``. Beside a
+rule of ``core.maths.sensing``, all with one wall-clock stamp per cycle at ``relay.rate``. Beside a
 simulated lab (the ``world`` node) it runs on the world's ``/clock`` (``use_sim_time:=true``):
 a cycle is due every ``1 / relay.rate`` s of simulated time, stamped with it, and a
 measurement's age is simulated time since it arrived (:meth:`RelayNode.now_ns`). A
-measurement is admitted by ``core.admission`` (frame, finite values, a unit quaternion, whole
+measurement is admitted by ``core.rules.admission`` (frame, finite values, a unit quaternion, whole
 bytes; every refusal counted and logged once through ``ros.once.RefusalLog``) and by its stamp
 (:meth:`RelayNode._advances`: later than the last one taken). The rules and the stale robots:
 docs/lab.md and docs/faults.md ("the motion capture repeats a lost body's last pose")::
@@ -25,14 +25,14 @@ import time
 from typing import Callable, Dict, List, Optional, Tuple
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros.core.admission import Reason, refusal
-from formation_ros.core.bodies import make_bodies
-from formation_ros.core.declarations import Exe, ParamError, SourceType
-from formation_ros.core.frames import valid_quaternions
-from formation_ros.core.sensing import sensed_pairs, sensor_radii
-from formation_ros.core.team import team_values
-from formation_ros.core.unicycle import headings_from_quaternions
-from formation_ros.core.units import NS_PER_S
+from formation_ros.core.maths.frames import valid_quaternions
+from formation_ros.core.maths.sensing import sensed_pairs, sensor_radii
+from formation_ros.core.maths.unicycle import headings_from_quaternions
+from formation_ros.core.maths.units import NS_PER_S
+from formation_ros.core.model.bodies import make_bodies
+from formation_ros.core.rules.admission import Reason, refusal
+from formation_ros.core.settings.declarations import Exe, ParamError, SourceType
+from formation_ros.core.settings.team import team_values
 from formation_ros.ros import qos, topics
 from formation_ros.ros.cdr import (CdrError, PoseData, read_odometry, read_pose_stamped,
                                    StateEncoder)

@@ -5,9 +5,9 @@ r"""
 Robot node (executable ``robot``): one robot's bounded formation controller.
 
 :class:`RobotNode` adapts messages and timers to the robot's rules, which hold no ROS: what it
-takes of its states and their clock (``core.robot_intake``), the reference it follows
-(``core.reference_track``), which states it answers and when its watchdog looks
-(``core.answers``), and its commands (``core.control``). Callbacks read the bytes
+takes of its states and their clock (``core.rules.robot_intake``), the reference it follows
+(``core.rules.reference_track``), which states it answers and when its watchdog looks
+(``core.rules.answers``), and its commands (``core.rules.control``). Callbacks read the bytes
 (``ros.cdr``), store and arm a one-shot timer (``ros.wake``) that answers; the command goes out
 through one output: the robot's ``cmd_vel`` (:class:`CmdVelOutput`), or with ``transport:
 team`` its process's link (``nodes.robots_link``). Topics, parameters and behaviour:
@@ -22,19 +22,19 @@ import time
 from typing import Any, Callable, Dict, List, Optional, Tuple
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros.core.admission import Reason
-from formation_ros.core.answers import Act, AnswerPolicy
-from formation_ros.core.control import Commands, Control, Sensed
-from formation_ros.core.declarations import CommandFrame, Exe, PoseType
-from formation_ros.core.frames import FrameSample
-from formation_ros.core.law import Command
-from formation_ros.core.names import robot_name
-from formation_ros.core.reference_track import reference_values, ReferenceTrack
-from formation_ros.core.robot_intake import Refused, StateIntake
-from formation_ros.core.robot_status import startup_line, status_level, status_values
-from formation_ros.core.team import team_values
-from formation_ros.core.timeline import Mode, Shape, TeamState
-from formation_ros.core.units import NS_PER_S
+from formation_ros.core.maths.frames import FrameSample
+from formation_ros.core.maths.law import Command
+from formation_ros.core.maths.units import NS_PER_S
+from formation_ros.core.rules.admission import Reason
+from formation_ros.core.rules.answers import Act, AnswerPolicy
+from formation_ros.core.rules.control import Commands, Control, Sensed
+from formation_ros.core.rules.reference_track import reference_values, ReferenceTrack
+from formation_ros.core.rules.robot_intake import Refused, StateIntake
+from formation_ros.core.rules.robot_status import startup_line, status_level, status_values
+from formation_ros.core.runs.timeline import Mode, Shape, TeamState
+from formation_ros.core.settings.declarations import CommandFrame, Exe, PoseType
+from formation_ros.core.settings.names import robot_name
+from formation_ros.core.settings.team import team_values
 from formation_ros.nodes.robots_link import RobotsLink
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import (PoseArrayData, PoseData, read_odometry, read_pose_array,
@@ -72,8 +72,8 @@ class RobotNode(Node):
 
         ``leader``: the first robot of this process (a fleet's other robots); this robot then
         hears the reference and the changes through it, with ``transport: team`` always, else
-        if it has the leader's ``core.reference_track.reference_values``. ``reports``: whether
-        it publishes on /diagnostics itself (a fleet's first robot publishes the others'
+        if it has the leader's ``core.rules.reference_track.reference_values``. ``reports``:
+        whether it publishes on /diagnostics itself (a fleet's first robot publishes the others'
         statuses, :attr:`reported`).
         """
         given = list(kwargs.pop('parameter_overrides', None) or [])
@@ -415,7 +415,7 @@ class RobotNode(Node):
         return None if self.latest is None else self.latest.row(k)
 
     def diagnostic_status(self) -> StatusData:
-        """Return this robot's status (``core.robot_status``) with its team values."""
+        """Return this robot's status (``core.rules.robot_status``) with its team values."""
         if self.link is not None:
             self.link.report_to(self)
         else:

@@ -6,22 +6,22 @@ A robot process's link to its robots with ``transport: team``: states in, comman
 
 :class:`RobotsLink` reads ``/formation/states`` once for every robot of a process (or fleet),
 admits it through its first robot (the leader, ``RobotNode.admit_state``), senses each robot's
-neighbours with the plant's sensing rule (``core.sensing``) and is the leader's command output:
-every robot's command from one call of ``core.control.Control``, in one
+neighbours with the plant's sensing rule (``core.maths.sensing``) and is the leader's command
+output: every robot's command from one call of ``core.rules.control.Control``, in one
 ``/formation/commands`` message, and on a robot's own ``cmd_vel`` while someone subscribes to
 it (``ros.on_demand``). The message layouts and rules: docs/ros_interface.md ("Transports").
 """
 
 from typing import List, Optional, Sequence, Tuple, TYPE_CHECKING
 
-from formation_ros.core.admission import Reason
-from formation_ros.core.bodies import make_bodies
-from formation_ros.core.control import Control, Sensed
-from formation_ros.core.declarations import ParamError
-from formation_ros.core.names import robot_name
-from formation_ros.core.robot_intake import Refused
-from formation_ros.core.sensing import sensed_pairs, sensor_radii
-from formation_ros.core.transport import command_vectors
+from formation_ros.core.maths.sensing import sensed_pairs, sensor_radii
+from formation_ros.core.model.bodies import make_bodies
+from formation_ros.core.rules.admission import Reason
+from formation_ros.core.rules.control import Control, Sensed
+from formation_ros.core.rules.robot_intake import Refused
+from formation_ros.core.rules.transport import command_vectors
+from formation_ros.core.settings.declarations import ParamError
+from formation_ros.core.settings.names import robot_name
 from formation_ros.ros import qos, topics
 from formation_ros.ros.cdr import (encode_names, encode_team_commands, PoseArrayData, PoseData,
                                    read_pose_array)
@@ -121,7 +121,7 @@ class RobotsLink:
         Read and admit the team state heard (if any), sense, and give the leader its part.
 
         A copy of the state taken last (the plant sends one again while it waits for answers)
-        is not read again: it is heard anew and answered as a copy (``core.answers``).
+        is not read again: it is heard anew and answered as a copy (``core.rules.answers``).
         """
         data, self.heard = self.heard, None
         if data is None or (data != self.taken and not self._sense(data)):
@@ -154,7 +154,7 @@ class RobotsLink:
         return True
 
     def sensed(self) -> Sensed:
-        """Return what the robots know of the state taken last (``core.control.Sensed``)."""
+        """Return what the robots know of the state taken last (``core.rules.control.Sensed``)."""
         assert self.sensed_now is not None
         return self.sensed_now
 

@@ -12,7 +12,7 @@ odometry on ``/robot_<i>/odom``; it drives the bodies from ``/robot_<i>/cmd_vel`
 callbacks only store (``physics.intake``). It counts contacts between robots and, with
 ``world.output_dir``, writes ``world.xml``, ``trajectory.npz`` and ``world_stats.json``.
 Before its first step it looks at the domain through the plant's start gate
-(``core.plant_gate``, ``ros.clock_look``): beside another plant or world it refuses (exit 2).
+(``core.rules.plant_gate``, ``ros.clock_look``): beside another plant or world it refuses (exit 2).
 How to start it, what it refuses and writes: docs/physics.md ("The world node"); its topics:
 docs/ros_interface.md.
 """
@@ -25,18 +25,19 @@ import time
 from typing import Any, Dict, List, Optional
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros.core.admission import Reason
-from formation_ros.core.commanded import commanded_velocity, HeardOrientations, needs_orientation
-from formation_ros.core.declarations import CommandFrame, Exe
-from formation_ros.core.exits import ENGINE_FAILED, REFUSED
-from formation_ros.core.params import world_size_problem
-from formation_ros.core.plant_gate import (leftover_line, Phase, StartGate, Verdict,
-                                           WORLD_LOOK_TIME)
-from formation_ros.core.trajectory import (CHUNKS_DIR, ChunkWriter, read_body_chunks,
-                                           read_chunks, read_held_chunks, save_atomically,
-                                           Trajectory, TRAJECTORY_FILE)
-from formation_ros.core.unicycle import hand_points, quaternions_from_headings
-from formation_ros.core.units import NS_PER_S
+from formation_ros.core.maths.unicycle import hand_points, quaternions_from_headings
+from formation_ros.core.maths.units import NS_PER_S
+from formation_ros.core.model.commanded import (commanded_velocity, HeardOrientations,
+                                                needs_orientation)
+from formation_ros.core.rules.admission import Reason
+from formation_ros.core.rules.plant_gate import (leftover_line, Phase, StartGate, Verdict,
+                                                 WORLD_LOOK_TIME)
+from formation_ros.core.runs.trajectory import (CHUNKS_DIR, ChunkWriter, read_body_chunks,
+                                                read_chunks, read_held_chunks, save_atomically,
+                                                Trajectory, TRAJECTORY_FILE)
+from formation_ros.core.settings.declarations import CommandFrame, Exe
+from formation_ros.core.settings.exits import ENGINE_FAILED, REFUSED
+from formation_ros.core.settings.params import world_size_problem
 from formation_ros.physics.engine import Engine, Unstable, unstable_line
 from formation_ros.physics.intake import CommandInbox
 from formation_ros.physics.pacing import Pacer
@@ -193,7 +194,7 @@ class WorldNode(Node):
         """
         Look up the other /clock publishers when the gate asks; return whether the domain is ours.
 
-        The plant's gate decides (``core.plant_gate``): refuse (exit REFUSED) beside another
+        The plant's gate decides (``core.rules.plant_gate``): refuse (exit REFUSED) beside another
         plant or world, take a silent one of this name for a killed world's, or go on looking.
         """
         if not self.gate.look_due(now):
@@ -323,7 +324,7 @@ class WorldNode(Node):
         Keep one trajectory sample as the plant writes it (hand points for unicycles).
 
         u: what each robot commanded, its held command read at the orientation of the state it
-        answered (``core.commanded``; NaN where the world did not hear that state, or for
+        answered (``core.model.commanded``; NaN where the world did not hear that state, or for
         unstamped commands, which do not say which state); u_held, for commands that need a
         heading: the held command read at the body's true heading now.
         """

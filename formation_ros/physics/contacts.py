@@ -16,8 +16,8 @@ of the robots' positions over a run.
 from dataclasses import dataclass
 from typing import List, Tuple
 
-from formation_ros.core.pairs import closest_pair, pairs_within, squared_norms
-from formation_ros.core.units import NS_PER_S
+from formation_ros.core.maths.pairs import closest_pair, pairs_within, squared_norms
+from formation_ros.core.maths.units import NS_PER_S
 import numpy as np
 from numpy.typing import NDArray
 

@@ -32,10 +32,10 @@ from dataclasses import dataclass
 import time
 from typing import Optional, Sequence, Tuple
 
-from formation_ros.core.dynamics import NOISE_SEED_OFFSET
-from formation_ros.core.params import FormationConfig, WorldSettings
-from formation_ros.core.unicycle import headings_from_quaternions
-from formation_ros.core.units import NS_PER_S
+from formation_ros.core.maths.unicycle import headings_from_quaternions
+from formation_ros.core.maths.units import NS_PER_S
+from formation_ros.core.model.dynamics import NOISE_SEED_OFFSET
+from formation_ros.core.settings.params import FormationConfig, WorldSettings
 from formation_ros.physics.contacts import ClosestApproach, ContactLog, RELEASE_GAP
 from formation_ros.physics.diff_drive import DiffDrive
 from formation_ros.physics.odometry import ODOMETRY_PERIOD, WheelOdometry

@@ -6,7 +6,7 @@ What a world takes of the commands it hears, before the engine applies them (no 
 
 A world node reads each robot's ``cmd_vel`` bytes (``ros.cdr``) and hands the message's frame,
 velocities and stamp to :meth:`CommandInbox.take`, which refuses it by the one rule of
-``core.admission`` (the robot's command frame, then finite values: those the body uses) or as
+``core.rules.admission`` (the robot's command frame, then finite values: those the body uses) or as
 stamped on another clock (more than ``world.cmd_timeout`` after the world's time: a wall-clock
 stamp, or a sender on another ``/clock``), and otherwise keeps it as the robot's latest until
 the node's step timer drains the inbox into :meth:`formation_ros.physics.engine.Engine.apply`.
@@ -19,8 +19,8 @@ engine's motors limit it. What is refused is counted by the node (``ros.once.Ref
 import math
 from typing import Optional, Sequence, Tuple
 
-from formation_ros.core.admission import Reason, refusal
-from formation_ros.core.transport import command_of
+from formation_ros.core.rules.admission import Reason, refusal
+from formation_ros.core.rules.transport import command_of
 import numpy as np
 from numpy.typing import NDArray
 

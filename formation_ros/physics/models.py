@@ -26,9 +26,9 @@ and rad/s, forces in N, torques in N m.
 import math
 from typing import Optional, Union
 
-from formation_ros.core.bodies import BodySettings
-from formation_ros.core.declarations import BodyKind, CommandFrame
-from formation_ros.core.params import WorldSettings
+from formation_ros.core.model.bodies import BodyKind, BodySettings
+from formation_ros.core.settings.declarations import CommandFrame
+from formation_ros.core.settings.params import WorldSettings
 from formation_ros.physics.diff_drive import DiffDrive, WHEEL_HALF_WIDTH
 from formation_ros.physics.parts import GRAVITY
 from formation_ros.physics.points import Flyer, Holonomic

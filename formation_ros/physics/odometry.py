@@ -8,14 +8,14 @@ Every odometry period (:data:`ODOMETRY_PERIOD`, a whole number of engine steps) 
 encoder angles (left, right, rad) are read; their increments since the last reading, over the
 time between, are the wheels' mean speeds, which the model's rolling-without-slip relation
 (:meth:`DiffDrive.body_rates`) turns into (v, w), integrated exactly along the arc
-(:func:`formation_ros.core.unicycle.zoh_step`), as ``diff_drive_controller`` does from its
+(:func:`formation_ros.core.maths.unicycle.zoh_step`), as ``diff_drive_controller`` does from its
 wheels' positions. The estimate starts at the true start pose and drifts from the truth
 wherever a wheel slips or the base is pushed: what real odometry does.
 """
 
 from typing import Tuple
 
-from formation_ros.core.unicycle import zoh_step
+from formation_ros.core.maths.unicycle import zoh_step
 from formation_ros.physics.diff_drive import DiffDrive
 import numpy as np
 from numpy.typing import NDArray

@@ -15,7 +15,7 @@ wall-clock times come from a monotonic clock.
 
 from typing import Optional
 
-from formation_ros.core.units import NS_PER_S
+from formation_ros.core.maths.units import NS_PER_S
 
 
 class Pacer:

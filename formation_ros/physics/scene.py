@@ -4,12 +4,12 @@
 """
 The MJCF world of a formation: a floor and one body per robot at its start, with its heading.
 
-:func:`build_scene` takes a validated :class:`~formation_ros.core.params.FormationConfig` (its
-``num_robots``, ``dim``, ``start`` positions and ``start_headings``, ``body.*``, ``command.frame``
-and ``world_frame``) and the world's settings (``world.*``) and returns a :class:`Scene`: the
-MJCF text, which ``mujoco.MjModel.from_xml_string`` (or, written as ``world.xml``,
-``from_xml_path`` and ``python -m mujoco.viewer --mjcf world.xml``) loads as it is, and the
-body model of :mod:`formation_ros.physics.models`. Robot i (1-based) is the body
+:func:`build_scene` takes a validated :class:`~formation_ros.core.settings.params.FormationConfig`
+(its ``num_robots``, ``dim``, ``start`` positions and ``start_headings``, ``body.*``,
+``command.frame`` and ``world_frame``) and the world's settings (``world.*``) and returns a
+:class:`Scene`: the MJCF text, which ``mujoco.MjModel.from_xml_string`` (or, written as
+``world.xml``, ``from_xml_path`` and ``python -m mujoco.viewer --mjcf world.xml``) loads as it is,
+and the body model of :mod:`formation_ros.physics.models`. Robot i (1-based) is the body
 ``robot_<i>``, MuJoCo's world frame is ``world_frame`` (kept in the model as the custom text
 ``world_frame``), z up.
 """
@@ -19,8 +19,8 @@ import os
 from typing import Optional, Tuple
 from xml.etree import ElementTree
 
-from formation_ros.core.names import robot_name
-from formation_ros.core.params import FormationConfig, WorldSettings
+from formation_ros.core.settings.names import robot_name
+from formation_ros.core.settings.params import FormationConfig, WorldSettings
 from formation_ros.physics.contacts import closest_distance
 from formation_ros.physics.models import make_model, Model
 from formation_ros.physics.parts import FLOOR_GROUP, GRAVITY, number, numbers

@@ -33,7 +33,7 @@ from pathlib import Path
 import shutil
 from typing import Any, BinaryIO, Callable, Dict, List, Optional, Tuple, Union
 
-from formation_ros.core.params_file import dump_params_text
+from formation_ros.core.settings.params_file import dump_params_text
 from formation_ros.ros import topics
 from formation_ros.ros.cdr import CdrError, read_clock
 from formation_ros.ros.fields import NS_PER_S

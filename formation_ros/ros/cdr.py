@@ -26,10 +26,10 @@ import math
 import struct
 from typing import Dict, List, Optional, Sequence, Tuple
 
-from formation_ros.core.frames import frame_from_pose, FrameSample
-from formation_ros.core.transport import robot_indices, state_rows
-from formation_ros.core.unicycle import quaternions_from_headings
-from formation_ros.core.units import NS_PER_S
+from formation_ros.core.maths.frames import frame_from_pose, FrameSample
+from formation_ros.core.maths.unicycle import quaternions_from_headings
+from formation_ros.core.maths.units import NS_PER_S
+from formation_ros.core.rules.transport import robot_indices, state_rows
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -121,7 +121,7 @@ class OdometryData:
         return PoseData(self.stamp_ns, self.frame_id, self.position, self.orientation)
 
     def frame(self, dim: int) -> FrameSample:
-        """Return the formation frame this sample carries (``core.frames.frame_from_pose``)."""
+        """Return the formation frame this sample carries (``maths.frames.frame_from_pose``)."""
         return frame_from_pose(self.stamp_ns / NS_PER_S, self.position, self.orientation,
                                self.linear, self.angular, dim)
 
@@ -354,7 +354,7 @@ class StateEncoder:
         Return (poses, arrays): robot i's serialized PoseStamped and PoseArray at ``stamp_ns``.
 
         q: (N, dim) positions, m; (observer, seen): every sensed pair, sorted by observer
-        (``core.sensing.sensed_pairs``): robot ``observer[k]`` sees robot ``seen[k]``;
+        (``core.maths.sensing.sensed_pairs``): robot ``observer[k]`` sees robot ``seen[k]``;
         headings: (N,) rad about +z, written as the orientations; else orientations: (N, 4)
         unit quaternions (x, y, z, w) written as they are (neither: the previous call's, at
         first identity).
@@ -382,14 +382,15 @@ class StateEncoder:
         """
         Take the poses of every robot (as :meth:`encode` takes them) without encoding.
 
-        The rows are those of a team state (``core.transport.state_rows``): robot i's at i - 1.
+        The rows are those of a team state (``core.rules.transport.state_rows``): robot i's at i -
+        1.
         """
         if headings is not None:
             orientations = quaternions_from_headings(headings)
         self.rows[:] = state_rows(q, self.rows[:, 3:] if orientations is None else orientations)
 
     def team(self, stamp_ns: int) -> bytes:
-        """Return the team state (``core.transport``) of the poses last taken, at ``stamp_ns``."""
+        """Return the team state (``rules.transport``) of the poses last taken, at ``stamp_ns``."""
         return encode_team_states(stamp_ns, self.frame_id, self.rows)
 
 
@@ -402,7 +403,7 @@ TRANSFORM_DOUBLES = 7
 @dataclass(frozen=True)
 class TeamCommandsData:
     """
-    A team command message (``core.transport``), as read.
+    A team command message (``core.rules.transport``), as read.
 
     stamp_ns: the stamp of the state it answers; frame_id: its header's frame; per robot
     listed: its 0-based index (K,), linear (K, 3) m/s and angular (K, 3) rad/s.
@@ -508,7 +509,7 @@ def encode_names(names: Sequence[str]) -> bytes:
 def encode_team_commands(stamp_ns: int, frame_id: str, names: bytes,
                          linear: ArrayLike, angular: ArrayLike) -> bytes:
     """
-    Return a serialized team command (``core.transport``): a MultiDOFJointTrajectory.
+    Return a serialized team command (``core.rules.transport``): a MultiDOFJointTrajectory.
 
     names: :func:`encode_names` of the robots' names; linear, angular: (K, 3) twists, row k
     robot k's.
@@ -528,7 +529,7 @@ def encode_team_commands(stamp_ns: int, frame_id: str, names: bytes,
 
 
 def encode_team_states(stamp_ns: int, frame_id: str, rows: ArrayLike) -> bytes:
-    """Return a serialized team state (``core.transport``): a PoseArray of (N, 7) rows."""
+    """Return a serialized team state (``core.rules.transport``): a PoseArray of (N, 7) rows."""
     header = encode_header(stamp_ns, frame_id)
     head = header + _pad(len(header), 4)
     values = np.ascontiguousarray(rows, dtype=LITTLE_DOUBLE)

@@ -6,7 +6,7 @@ Follow the formation's changes: ``/formation/shape`` and ``/formation/status`` i
 
 Robots and the plant hear the reference node's shapes and team states (``nodes/reference.py``),
 check each as the parameters file's values are checked, and keep it in a
-:class:`formation_ros.core.timeline.Timeline` from its stamp on. Subscription callbacks only
+:class:`formation_ros.core.runs.timeline.Timeline` from its stamp on. Subscription callbacks only
 store the message and arm a one-shot timer (:class:`formation_ros.ros.wake.Wake`), which calls
 :meth:`Changes.take`.
 """
@@ -15,10 +15,11 @@ from collections import deque
 from typing import Any, Callable, List
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros.core.declarations import ParamError, ReferenceKind
-from formation_ros.core.params import check_shape, FormationConfig
-from formation_ros.core.timeline import (Mode, named_shape, ReferenceTimeline, Shape, TeamState,
-                                         Timeline)
+from formation_ros.core.maths.reference import ReferenceKind
+from formation_ros.core.runs.timeline import (Mode, named_shape, ReferenceTimeline, Shape,
+                                              TeamState, Timeline)
+from formation_ros.core.settings.declarations import ParamError
+from formation_ros.core.settings.params import check_shape, FormationConfig
 from formation_ros.ros import fields, qos, topics
 from formation_ros.ros.messages import team_state_of
 from formation_ros.ros.wake import Wake

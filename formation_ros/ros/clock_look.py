@@ -5,14 +5,14 @@
 The look at the domain of a node that makes the clock (the plant, the world) before it starts.
 
 What the graph shows (the other ``/clock`` publishers, named, and which of them another process
-announces on ``/diagnostics``) goes to the node's start gate, ``core.plant_gate.StartGate``,
-whose rule (``core.occupants``, the launcher's too) decides: refuse, go on looking, or start.
+announces on ``/diagnostics``) goes to the node's start gate, ``core.rules.plant_gate.StartGate``,
+whose rule (``core.rules.occupants``, the launcher's too) decides: refuse, go on looking, or start.
 This module only reads the graph for it, for both nodes; the rule is not repeated here.
 """
 
 from typing import List, Optional, Tuple
 
-from formation_ros.core.plant_gate import refusal_line, StartGate, Verdict
+from formation_ros.core.rules.plant_gate import refusal_line, StartGate, Verdict
 from formation_ros.ros import topics
 from formation_ros.ros.team import PublisherWatch, TeamCheck
 

@@ -12,8 +12,8 @@ robot: ``ros.on_demand``); :class:`Output` is what a robot node publishes its an
 
 from typing import Optional, Protocol
 
-from formation_ros.core.control import Control
-from formation_ros.core.transport import command_vectors
+from formation_ros.core.rules.control import Control
+from formation_ros.core.rules.transport import command_vectors
 from formation_ros.ros import qos, topics
 from formation_ros.ros.cdr import encode_twist, encode_twist_stamped
 from geometry_msgs.msg import Twist, TwistStamped

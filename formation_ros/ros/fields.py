@@ -9,8 +9,8 @@ so they serve rclpy's messages in the nodes and the messages that ``rosbags`` de
 a bag alike.
 """
 
-from formation_ros.core.frames import frame_from_pose
-from formation_ros.core.units import NS_PER_S
+from formation_ros.core.maths.frames import frame_from_pose
+from formation_ros.core.maths.units import NS_PER_S
 import numpy as np
 
 

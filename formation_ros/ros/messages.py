@@ -12,9 +12,9 @@ import math
 
 from builtin_interfaces.msg import Time
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
-from formation_ros.core.names import robot_name
-from formation_ros.core.timeline import Mode, TeamState
-from formation_ros.core.units import NS_PER_S
+from formation_ros.core.maths.units import NS_PER_S
+from formation_ros.core.runs.timeline import Mode, TeamState
+from formation_ros.core.settings.names import robot_name
 from geometry_msgs.msg import Pose, PoseArray
 
 WORLD_FRAME = 'world'
@@ -78,7 +78,7 @@ def team_status(mode, since_ns, values):
 
 def team_state_of(msg, dim):
     """
-    Read a ``/formation/status`` message (:func:`team_status`) into a ``core.timeline.TeamState``.
+    Read a ``/formation/status`` message (:func:`team_status`) into a ``runs.timeline.TeamState``.
 
     Raises ValueError when it is not one: no team status, an unknown mode, missing or
     non-finite values, an origin that is not dim values.

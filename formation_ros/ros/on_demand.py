@@ -7,12 +7,12 @@ Publishers made on demand: a topic's publisher once a subscriber to it shows in 
 With the team transport the plant publishes a robot's ``pose`` and ``neighbors``, and a team
 robot its ``cmd_vel``, only for a subscriber (docs/ros_interface.md, "Transports"): a thousand
 publishers nobody hears are a thousand endpoints for discovery. :class:`OnDemand` looks up a
-few items a look, in turn (``core.turns``), and makes an item's publishers when one shows.
+few items a look, in turn (``core.rules.turns``), and makes an item's publishers when one shows.
 """
 
 from typing import Callable, List
 
-from formation_ros.core.turns import Turns
+from formation_ros.core.rules.turns import Turns
 import numpy as np
 from numpy.typing import NDArray
 

@@ -5,8 +5,8 @@
 
 from typing import Any, Callable, Generic, Iterable, List, Mapping, Sequence, Set
 
-from formation_ros.core.admission import Reason, Refusals, Source
-from formation_ros.core.plant_status import robots_named  # noqa: F401 (its name here too)
+from formation_ros.core.rules.admission import Reason, Refusals, Source
+from formation_ros.core.rules.plant_status import robots_named  # noqa: F401 (its name here too)
 
 
 class OnceLog:
@@ -85,7 +85,7 @@ class RefusalLog(Generic[Source]):
     """
     Count every refused message; log each (source, reason) once while it lasts.
 
-    The counts (:attr:`refusals`, ``core.admission.Refusals``) are what a node reports and
+    The counts (:attr:`refusals`, ``core.rules.admission.Refusals``) are what a node reports and
     decides by; the log only keeps a line from repeating.
     """
 

@@ -17,10 +17,11 @@ import re
 import sys
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
-from formation_ros.core.declarations import (ARRAYS, Bound, BY_NAME, did_you_mean, Exe,
-                                             is_known, Kind, Param, ParamError, SHAPE_NAME,
-                                             SHAPE_VERTICES, shape_vertices_name, used_by)
-from formation_ros.core.params import FormationConfig, validate
+from formation_ros.core.settings.declarations import (ARRAYS, Bound, BY_NAME, did_you_mean, Exe,
+                                                      is_known, Kind, Param, ParamError,
+                                                      SHAPE_NAME, SHAPE_VERTICES,
+                                                      shape_vertices_name, used_by)
+from formation_ros.core.settings.params import FormationConfig, validate
 from formation_ros.ros.topics import robot_namespace
 from rcl_interfaces.msg import FloatingPointRange, IntegerRange, ParameterDescriptor
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException

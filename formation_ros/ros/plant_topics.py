@@ -12,7 +12,7 @@ The topics and their QoS: docs/ros_interface.md ("Topics", "Transports"); the by
 
 from typing import List, Optional
 
-from formation_ros.core.plant import PlantModel
+from formation_ros.core.model.plant import PlantModel
 from formation_ros.ros import qos, topics
 from formation_ros.ros.cdr import encode_clock, StateEncoder
 from formation_ros.ros.on_demand import LISTENERS_PERIOD, OnDemand

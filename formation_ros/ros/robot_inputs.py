@@ -5,17 +5,17 @@
 A robot node's gate for what it hears: read the bytes, admit them, count and say refusals.
 
 :class:`InputGate` reads a message's bytes (``ros.cdr``), admits a state by
-``core.robot_intake.StateIntake`` and lets it set the robot's clock (``ros.sim_clock``), counts
-every refusal and logs it once while it lasts (``ros.once.RefusalLog``), for stamps from another
-clock with the advice the graph gives (``ros.sim_clock.clock_advice``), and looks who publishes
-``/clock`` and the reference. What a robot refuses and why: docs/faults.md.
+``core.rules.robot_intake.StateIntake`` and lets it set the robot's clock (``ros.sim_clock``),
+counts every refusal and logs it once while it lasts (``ros.once.RefusalLog``), for stamps from
+another clock with the advice the graph gives (``ros.sim_clock.clock_advice``), and looks who
+publishes ``/clock`` and the reference. What a robot refuses and why: docs/faults.md.
 """
 
 import time
 from typing import Callable, Dict, Optional, TypeVar
 
-from formation_ros.core.admission import Reason, Refusals
-from formation_ros.core.robot_intake import Refused, StateIntake
+from formation_ros.core.rules.admission import Reason, Refusals
+from formation_ros.core.rules.robot_intake import Refused, StateIntake
 from formation_ros.ros.cdr import CdrError, PoseArrayData, TooManyPoses
 from formation_ros.ros.once import OnceLog, RefusalLog
 from formation_ros.ros.sim_clock import clock_advice, StateClock

@@ -30,10 +30,10 @@ import threading
 import time
 from typing import Any, Callable, List, Mapping, Optional, Sequence, Union
 
-from formation_ros.core.declarations import ParamError
-from formation_ros.core.exits import REFUSED
-from formation_ros.core.file_guard import (check_params_text, ParamsFileError,
-                                           read_params_file_text)
+from formation_ros.core.settings.declarations import ParamError
+from formation_ros.core.settings.exits import REFUSED
+from formation_ros.core.settings.file_guard import (check_params_text, ParamsFileError,
+                                                    read_params_file_text)
 from formation_ros.ros.watch import LAUNCHER_PID_ENV, LAUNCHER_START_ENV, process_start
 import rclpy
 from rclpy.exceptions import InvalidParameterTypeException, InvalidParameterValueException
@@ -125,8 +125,8 @@ def params_file_problem(path: str, robots_rule: Optional[RobotsRule] = None) -> 
     robots_rule: the process's limit on ``num_robots``, applied to the file's before rcl
     parses it (rcl's parser takes minutes over the arrays of 100,000 robots).
 
-    The file is checked by :mod:`formation_ros.core.file_guard` (size, anchors, depth, array
-    lengths, YAML syntax in this package's words), never parsed in full, and must hold a
+    The file is checked by :mod:`formation_ros.core.settings.file_guard` (size, anchors, depth,
+    array lengths, YAML syntax in this package's words), never parsed in full, and must hold a
     mapping: rcl parses it only after this, so that none of rcl's or libyaml's own messages
     reach the user for a file the guard refuses.
     """
@@ -220,9 +220,9 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
     spin also ends when the launcher named in the environment is gone (see
     :class:`LauncherWatch`), and when a node sets its ``exit_code`` attribute (checked every
     SIGNAL_LATENCY s): the recorder whose disk is full
-    (:data:`formation_ros.core.exits.RECORDING_FAILED`), a plant that finds another team on
-    its domain (:data:`formation_ros.core.exits.REFUSED`); the node has said why, in its own
-    line. Returns the exit code: 0; 1 if a node's ``finish()`` failed (the others still
+    (:data:`formation_ros.core.settings.exits.RECORDING_FAILED`), a plant that finds another team
+    on its domain (:data:`formation_ros.core.settings.exits.REFUSED`); the node has said why, in
+    its own line. Returns the exit code: 0; 1 if a node's ``finish()`` failed (the others still
     finish); 2 for invalid parameters (one line per bad parameter) or a command line rclpy
     cannot start from; a node's ``exit_code``. robots_rule: the process's limit on a parameters
     file's ``num_robots`` (the world's), checked before rcl parses the file.

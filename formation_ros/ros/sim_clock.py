@@ -7,14 +7,14 @@ Simulated time for robot nodes without a ``/clock`` subscription.
 A robot node is made on the wall clock (:func:`wall_clock_overrides`, so rclpy's time source
 makes no ``/clock`` subscription) and then put on the time asked for
 (:func:`sim_time_without_clock`); on simulated time :class:`StateClock` sets its clock to the
-time its states set (the rule: ``core.robot_intake.StateIntake``), and :func:`keep_sim_time`
+time its states set (the rule: ``core.rules.robot_intake.StateIntake``), and :func:`keep_sim_time`
 refuses a change of ``use_sim_time`` while it runs. Why: docs/ros_interface.md ("Time").
 """
 
 import time
 from typing import Any, List, Mapping, Optional, Sequence
 
-from formation_ros.core.declarations import ParamError
+from formation_ros.core.settings.declarations import ParamError
 from formation_ros.ros.team import PublisherWatch
 from rcl_interfaces.msg import SetParametersResult
 from rclpy.clock import ROSClock

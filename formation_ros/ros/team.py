@@ -4,12 +4,12 @@
 """
 One team per domain: the values every node must agree on, and the second publishers of a topic.
 
-Every formation node announces ``core.team.team_values`` and who it is (host, process, node) in
-its ``/diagnostics`` status (:func:`announced`); the plant and the reference hear them all and
-name each node whose values differ (:class:`TeamCheck`; a shape just switched counts as the
+Every formation node announces ``core.settings.team.team_values`` and who it is (host, process,
+node) in its ``/diagnostics`` status (:func:`announced`); the plant and the reference hear them all
+and name each node whose values differ (:class:`TeamCheck`; a shape just switched counts as the
 same for :data:`RECENT` checks). :class:`PublisherWatch` looks up the graph for a second
-publisher of a topic (``core.team.duplicate_due`` decides when one is reported) and names it
-with its host; :class:`DomainWatch` is what the plant watches with them while it runs. The
+publisher of a topic (``core.settings.team.duplicate_due`` decides when one is reported) and names
+it with its host; :class:`DomainWatch` is what the plant watches with them while it runs. The
 rules: docs/faults.md (two publishers on one cmd_vel; a second plant or publisher; nodes that
 disagree).
 """
@@ -21,9 +21,9 @@ import time
 from typing import Callable, Collection, Dict, List, Mapping, Optional, Sequence, Set, Tuple
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros.core.params import FormationConfig
-from formation_ros.core.team import differences, duplicate_due, team_values
-from formation_ros.core.turns import Turns
+from formation_ros.core.rules.turns import Turns
+from formation_ros.core.settings.params import FormationConfig
+from formation_ros.core.settings.team import differences, duplicate_due, team_values
 from formation_ros.ros import qos, topics
 from formation_ros.ros.once import OnceLog
 import numpy as np
@@ -204,7 +204,7 @@ class PublisherWatch:
     A second publisher with another node name is reported at once; one with the expected
     node's own name may be what is left of a process killed a moment ago (DDS forgets it about
     20 s later), so it is reported at once only with evidence that it runs (``alive``), else
-    after ``core.team.DUPLICATE_GRACE`` s.
+    after ``core.settings.team.DUPLICATE_GRACE`` s.
     """
 
     def __init__(self, node: Node, team: Optional[TeamCheck] = None,

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import enum
 from typing import Dict, List
 
-from formation_ros.core.names import robot_name
+from formation_ros.core.settings.names import robot_name
 
 
 POSE = 'pose'
@@ -30,7 +30,7 @@ STATUS = '/formation/status'
 STOP = '/formation/stop'
 START = '/formation/start'
 STATES = '/formation/states'
-"""Team transport: every robot's pose in one PoseArray per state (``core.transport``)."""
+"""Team transport: every robot's pose in one PoseArray per state (``core.rules.transport``)."""
 TEAM_COMMANDS = '/formation/commands'
 """Team transport: one MultiDOFJointTrajectory per robot process or fleet per state."""
 MEASURED_POSE = 'measured_pose'
@@ -43,7 +43,7 @@ MEASUREMENT_TYPES: Dict[str, str] = {
     'odometry': 'nav_msgs/msg/Odometry',
 }
 """ROS type of the relay's measured poses by ``relay.source_type`` value (topics: the template
-``relay.source_topic``, ``core.params.RelaySettings.source``)."""
+``relay.source_topic``, ``core.settings.params.RelaySettings.source``)."""
 
 
 class QosKind(enum.Enum):

@@ -24,7 +24,7 @@ moves the timer a period on) sets the timer back to that moment and does nothing
 
 from typing import Callable, Optional
 
-from formation_ros.core.units import NS_PER_S
+from formation_ros.core.maths.units import NS_PER_S
 from rclpy.clock import Clock
 from rclpy.node import Node
 

@@ -5,7 +5,7 @@
 Read rosbag2 directories of formation runs (``rosbags``) back into a trajectory; recover cut bags.
 
 Bags are written by the recorder (:mod:`formation_ros.ros.bag_writer`). Reading rebuilds a
-:class:`formation_ros.core.trajectory.Trajectory` from the recorded poses, commands and
+:class:`formation_ros.core.runs.trajectory.Trajectory` from the recorded poses, commands and
 reference samples (header stamps, i.e. simulated time).
 
 A bag whose recorder was killed (SIGKILL, power cut) has no metadata.yaml and an MCAP without
@@ -25,17 +25,17 @@ import struct
 import tempfile
 from typing import Any, Dict, List, Optional, Tuple
 
-from formation_ros.core.commanded import (commanded_velocity, needs_orientation,
-                                          UNKNOWN_ORIENTATION)
-from formation_ros.core.declarations import CommandFrame
-from formation_ros.core.events import timeline_events
-from formation_ros.core.file_guard import read_params_file_text
-from formation_ros.core.frames import advance, FrameSample
-from formation_ros.core.params import check_shape, FormationConfig, ParamError
-from formation_ros.core.timeline import Mode, named_shape, Shape, TeamState, Timeline
-from formation_ros.core.trajectory import Trajectory
-from formation_ros.core.unicycle import hand_points, headings_from_quaternions
-from formation_ros.core.units import NS_PER_S
+from formation_ros.core.maths.frames import advance, FrameSample
+from formation_ros.core.maths.unicycle import hand_points, headings_from_quaternions
+from formation_ros.core.maths.units import NS_PER_S
+from formation_ros.core.model.commanded import (commanded_velocity, needs_orientation,
+                                                UNKNOWN_ORIENTATION)
+from formation_ros.core.runs.events import timeline_events
+from formation_ros.core.runs.timeline import Mode, named_shape, Shape, TeamState, Timeline
+from formation_ros.core.runs.trajectory import Trajectory
+from formation_ros.core.settings.declarations import CommandFrame
+from formation_ros.core.settings.file_guard import read_params_file_text
+from formation_ros.core.settings.params import check_shape, FormationConfig, ParamError
 from formation_ros.ros import topics as names
 from formation_ros.ros.bag_writer import BagError, BagWriter, PARAMS_FILE, TYPESTORE
 from formation_ros.ros.fields import frame_of, points_of, position_of, stamp_to_ns
@@ -51,7 +51,7 @@ from rosbags.rosbag2.metadata import parse_qos
 
 Recorded = Dict[str, List[Tuple[int, Any]]]
 EVENTS = 'events'
-"""The key of the run's events (``core.events``) in the info of :func:`trajectory_from_topics`."""
+"""The key of the run's events (``runs.events``) in the info of :func:`trajectory_from_topics`."""
 MCAP_MAGIC = b'\x89MCAP0\r\n'
 METADATA = 'metadata.yaml'
 DAMAGED = '.damaged'
@@ -424,7 +424,7 @@ def bag_params_text(path: str, recorded: Recorded) -> Optional[str]:
     """
     Return the parameters YAML stored with a bag (topic, else params.yaml), or None.
 
-    params.yaml is read within the limits of :mod:`formation_ros.core.file_guard` (raises
+    params.yaml is read within the limits of :mod:`formation_ros.core.settings.file_guard` (raises
     its ParamsFileError).
     """
     if recorded.get(names.PARAMS):
@@ -479,7 +479,7 @@ def trajectory_from_topics(recorded: Recorded,
     its body arrays). Poses in a frame other than ``world_frame`` are left out (counted in the
     info). Where a command needs an orientation (unicycles, body-frame commands of points), u
     is what the robot commanded, read at the orientation of the pose it answered
-    (``core.commanded``: the robot's own /robot_<i>/pose at the command's stamp), NaN where
+    (``core.model.commanded``: the robot's own /robot_<i>/pose at the command's stamp), NaN where
     that pose was not recorded or the command has no stamp to name it; u_held reads it at the
     pose of each sample instead (``Trajectory.with_held``).
     """

@@ -26,7 +26,7 @@ that two users tend to start apart and one user's second run takes the next free
 most :data:`TRIES` port-free candidates are looked at.
 
 A domain the user chose is looked at for another team before anything starts
-(:class:`TeamLook`; the rule is ``core.occupants``): with discovery on this host only, a
+(:class:`TeamLook`; the rule is ``core.rules.occupants``): with discovery on this host only, a
 domain with no participant port bound here holds none; else a child (``--team S``) reads the
 ROS graph, and only the graph, for up to :data:`TEAM_LOOK` s.
 """
@@ -40,7 +40,7 @@ import sys
 import time
 from typing import List, Mapping, Optional, Sequence, Set, Tuple
 
-from formation_ros.core.occupants import occupants
+from formation_ros.core.rules.occupants import occupants
 
 FIRST, LAST = 1, 101
 PORT_BASE, DOMAIN_GAIN, UNICAST_OFFSET, PARTICIPANT_GAIN = 7400, 250, 10, 2
@@ -155,8 +155,8 @@ class TeamSeen:
     """
     What a look at a domain for another team found.
 
-    found: the nodes that show one (``core.occupants``; empty: none); clock: those of them that
-    publish /clock; seconds: how long the look's participant looked (0: no participant was
+    found: the nodes that show one (``core.rules.occupants``; empty: none); clock: those of them
+    that publish /clock; seconds: how long the look's participant looked (0: no participant was
     needed); complete: whether it ended because it had seen every participant of this host.
     """
 
@@ -235,7 +235,7 @@ def team_in_graph(seconds: float, local: bool) -> TeamSeen:
     Join ROS_DOMAIN_ID and read its graph for up to ``seconds`` s: what shows another team.
 
     The node makes no publisher or subscriber of a team's topics (no /rosout, no parameter
-    services), and sends nothing there. The look ends as soon as ``core.occupants`` finds a
+    services), and sends nothing there. The look ends as soon as ``core.rules.occupants`` finds a
     node; with ``local`` (discovery on this host only) also once every participant bound here
     is seen (its writer on ros_discovery_info) with its nodes named (their /parameter_events
     writers) and the graph has not changed for SETTLE s. A /clock publisher still unnamed at

@@ -34,16 +34,15 @@ import sys
 import time
 from typing import Callable, Mapping, Optional, Sequence, TextIO
 
-from formation_ros.core.exits import RECORDING_FAILED, REFUSED
+from formation_ros.core.settings.exits import RECORDING_FAILED, REFUSED
 from formation_ros.ros.watch import watch_environment
 from formation_ros.tools.domain import choose_domain, TeamLook, TeamSeen
 from formation_ros.tools.supervise import describe_returncode, ExitInfo, ProcessSpec, Supervisor
-from formation_ros.tools.system import (DISCOVERY, DISCOVERY_ENV, discovery_problem,
-                                        DOMAIN_ENV, domain_problem, ESSENTIAL, FLEET_REMAP,
-                                        Formation, network_variables, NodePlan,
-                                        ON_RECORD_FAILURE, plan, PlanError, read_formation,
-                                        RECORDER, recorder_plan, ros_arguments, Run,
-                                        stop_stages, with_variables)
+from formation_ros.tools.system import (DISCOVERY, DISCOVERY_ENV, discovery_problem, DOMAIN_ENV,
+                                        domain_problem, ESSENTIAL, FLEET_REMAP, Formation,
+                                        network_variables, NodePlan, ON_RECORD_FAILURE, plan,
+                                        PlanError, read_formation, RECORDER, recorder_plan,
+                                        ros_arguments, Run, stop_stages, with_variables)
 
 PROG = 'launch_formation.sh'
 PACKAGE = 'formation_ros'
@@ -177,8 +176,8 @@ def read_parameters(options: 'Options') -> Formation:
     listing every problem, or naming the option at fault.
     """
     # Imported here so that --help and usage errors need nothing but the standard library.
-    from formation_ros.core.declarations import ParamError
-    from formation_ros.core.file_guard import ParamsFileError
+    from formation_ros.core.settings.declarations import ParamError
+    from formation_ros.core.settings.file_guard import ParamsFileError
     try:
         return read_formation(options.params, plant=not (options.no_plant or options.world),
                               cmd_topic=options.cmd_topic, source_topic=options.source_topic,
@@ -612,12 +611,12 @@ class Launch:
 
     def report(self) -> int:
         """Run formation_report on the bag or the run directory, if any; return the exit code."""
-        from formation_ros.core.trajectory import TRAJECTORY_FILE  # numpy: not for --help
+        from formation_ros.core.runs.trajectory import TRAJECTORY_FILE  # numpy: not for --help
         options = self.options
         if options.record is not None:
             source, target = options.record, options.out or options.record
         elif options.out is not None:
-            from formation_ros.core.trajectory import CHUNKS_DIR
+            from formation_ros.core.runs.trajectory import CHUNKS_DIR
             if not any(os.path.exists(os.path.join(options.out, name))
                        for name in (TRAJECTORY_FILE, CHUNKS_DIR)):
                 maker = 'world' if options.world else 'plant'

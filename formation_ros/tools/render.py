@@ -34,8 +34,8 @@ import sys
 import time
 from typing import Any, Callable, List, Mapping, Optional, Sequence, TextIO, Tuple
 
-from formation_ros.core.params import FormationConfig
-from formation_ros.core.trajectory import Trajectory, TRAJECTORY_FILE
+from formation_ros.core.runs.trajectory import Trajectory, TRAJECTORY_FILE
+from formation_ros.core.settings.params import FormationConfig
 import numpy as np
 from numpy.typing import NDArray
 
@@ -103,7 +103,7 @@ class RenderOptions:
     How to render a run.
 
     width, height: the frame in pixels; fps: frames per second of the GIF; speed: simulated
-    seconds per second of GIF (None: as ``tools.animate.plan_frames`` chooses); max_frames:
+    seconds per second of GIF (None: as ``figures.animate.plan_frames`` chooses); max_frames:
     at most this many frames; camera: one of :data:`CAMERAS`; sensing: draw the sensing
     circles; shadows: draw shadows (with OSMesa, about 1.5 times the CPU of a frame).
     """
@@ -552,8 +552,8 @@ def render_run(trajectory: Trajectory, config: FormationConfig, path: str,
     ``stream`` at most every 10 % once the render takes over 2 s. RenderError (one line) when
     the run cannot be rendered or the file written; no partial file is left.
     """
-    from formation_ros.tools.animate import AnimationError, plan_frames
-    from formation_ros.tools.sim import Progress
+    from formation_ros.figures.animate import AnimationError, plan_frames
+    from formation_ros.simulation.simulate import Progress
     from PIL import Image
     started = time.monotonic()
     if not (np.all(np.isfinite(trajectory.q)) and np.all(np.isfinite(trajectory.q_desired))):

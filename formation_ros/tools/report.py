@@ -18,7 +18,7 @@ They are computed by the same code as ``formation_sim``. Input:
   or ``launch_formation.sh --out``; a ``plant_stats.json`` there is merged into the metrics).
 
 ``--animate`` writes ``animation.mp4`` (ffmpeg on PATH) or ``animation.gif`` of the run
-(``tools.animate``) beside metrics.json, with or without the figures.
+(``figures.animate``) beside metrics.json, with or without the figures.
 
 Unreadable input, or an ``--out`` that cannot be written, ends with exit code 2 and one line
 that says what is wrong.
@@ -33,24 +33,23 @@ import sys
 import time
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
-from formation_ros.core.declarations import ParamError
-from formation_ros.core.events import Event, events_from_records
-from formation_ros.core.file_guard import ParamsFileError
-from formation_ros.core.frames import FrameSample
-from formation_ros.core.params import FormationConfig, load_config, validate
-from formation_ros.core.params_file import parse_params_text
-from formation_ros.core.plant import PLANT_STATS_FILE
-from formation_ros.core.trajectory import (CHUNKS_DIR, read_body_chunks, read_chunks,
-                                           read_held_chunks, Trajectory, TRAJECTORY_FILE)
+from formation_ros.core.maths.frames import FrameSample
+from formation_ros.core.model.plant import PLANT_STATS_FILE
+from formation_ros.core.runs.events import Event, events_from_records
+from formation_ros.core.runs.trajectory import (CHUNKS_DIR, read_body_chunks, read_chunks,
+                                                read_held_chunks, Trajectory, TRAJECTORY_FILE)
+from formation_ros.core.settings.declarations import ParamError
+from formation_ros.core.settings.file_guard import ParamsFileError
+from formation_ros.core.settings.params import FormationConfig, load_config, validate
+from formation_ros.core.settings.params_file import parse_params_text
+from formation_ros.figures.animate import (AnimationError, DEFAULT_DPI, DEFAULT_FPS, describe,
+                                           FIGURE_WIDTH, GIF, MAX_FRAMES, MP4, plan_frames,
+                                           write_animation)
 from formation_ros.ros import topics as names
 from formation_ros.ros.bag_writer import BagError, PARAMS_FILE
-from formation_ros.tools.animate import (AnimationError, DEFAULT_DPI, DEFAULT_FPS, describe,
-                                         FIGURE_WIDTH, GIF, MAX_FRAMES, MP4, plan_frames,
-                                         write_animation)
-from formation_ros.tools.bag import (bag_params_text, EVENTS, mcap_files, METADATA,
-                                     plant_status, read_or_recover, repair_bag,
-                                     trajectory_from_topics)
-from formation_ros.tools.sim import format_summary, run_metrics, shaped
+from formation_ros.simulation.simulate import format_summary, run_metrics, shaped
+from formation_ros.tools.bag import (bag_params_text, EVENTS, mcap_files, METADATA, plant_status,
+                                     read_or_recover, repair_bag, trajectory_from_topics)
 
 Loaded = Tuple[Trajectory, FormationConfig, Dict[str, Any]]
 
@@ -234,7 +233,7 @@ def write_report(trajectory: Trajectory, config: FormationConfig, out_dir: str,
     """
     Write metrics.json (and the figures) to ``out_dir``; return the metrics.
 
-    events (``core.events``): metrics.json gets the per-segment metrics under ``segments``.
+    events (``core.runs.events``): metrics.json gets the per-segment metrics under ``segments``.
     The trajectory's desired positions are those of the shape in force already (every loader
     builds them so); with ``frames`` (the reference at each sample) they are rebuilt from the
     events' shapes. ValueError when a shape does not fit.
@@ -250,7 +249,7 @@ def write_report(trajectory: Trajectory, config: FormationConfig, out_dir: str,
         json.dump(metrics, stream, indent=2)
         stream.write('\n')
     if plots:
-        from formation_ros.tools import plots as figures
+        from formation_ros.figures import plots as figures
         figures.write_figures(trajectory, config.law(), metrics, out_dir)
     return metrics
 

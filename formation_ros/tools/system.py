@@ -28,8 +28,8 @@ import os
 import re
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple
 
-from formation_ros.core.exits import RECORDING_FAILED
-from formation_ros.core.names import robot_name
+from formation_ros.core.settings.exits import RECORDING_FAILED
+from formation_ros.core.settings.names import robot_name
 from formation_ros.ros.topics import CMD_VEL, robot_namespace, robot_topic
 
 PACKAGE = 'formation_ros'
@@ -128,8 +128,8 @@ def plan(run: Run) -> List[NodePlan]:
     The recorder first (it must hear everything), then the plant, the world and the relay,
     or the relay, the reference node and the robots. With the plant the reference and the
     robots run on its ``/clock``; beside a world the relay does too, and the robots are given
-    the relay's rate as that of their states (``core.params.world_robot_rates``); in a lab they
-    are told ``use_sim_time: false`` (a file that says otherwise would stop them). A robot's
+    the relay's rate as that of their states (``core.settings.params.world_robot_rates``); in a lab
+    they are told ``use_sim_time: false`` (a file that says otherwise would stop them). A robot's
     first command waits for 1 subscriber of its cmd_vel (the plant, the world, or in a lab the
     base driver on the remapped topic), 2 when the recorder listens too (remapped onto the
     same topics). Raises PlanError for remapped commands in fleets.
@@ -157,7 +157,7 @@ def plan(run: Run) -> List[NodePlan]:
     robot: Tuple[Tuple[str, Any], ...] = (
         ('wait_for_subscribers', 2 if run.record is not None else 1), sim_time)
     if run.world:
-        from formation_ros.core.params import world_robot_rates
+        from formation_ros.core.settings.params import world_robot_rates
         robot += world_robot_rates(run.relay_rate)
     per_process = run.robots_per_process
     if per_process == 1:
@@ -360,10 +360,10 @@ def topics_of(template: str, num_robots: int, names: Sequence[str],
     """
     Return robot 1..N's topics from a template (``{i}`` id, ``{name}`` relay.source_names).
 
-    The same checks as ``relay.source_topic`` (``core.params.template_problems``), and every
-    topic must be an absolute ROS name. Raises PlanError naming ``option``, one line.
+    The same checks as ``relay.source_topic`` (``core.settings.params.template_problems``), and
+    every topic must be an absolute ROS name. Raises PlanError naming ``option``, one line.
     """
-    from formation_ros.core.params import fill_template, template_problems
+    from formation_ros.core.settings.params import fill_template, template_problems
     problems = template_problems(template, names, num_robots, template_key=option)
     if problems:
         key, message = problems[0]
@@ -391,9 +391,9 @@ def read_formation(params_file: str, plant: bool = True, cmd_topic: Optional[str
     line, naming the option) for the templates, for a lab (no ``plant``) with ``transport:
     team`` and for a world whose relay would not read it (:func:`world_problem`).
     """
-    from formation_ros.core.declarations import Exe, ParamError
-    from formation_ros.core.params import validate, validate_for_every_executable
-    from formation_ros.core.params_file import load_params_file
+    from formation_ros.core.settings.declarations import Exe, ParamError
+    from formation_ros.core.settings.params import validate, validate_for_every_executable
+    from formation_ros.core.settings.params_file import load_params_file
     raw = load_params_file(params_file)
     if source_topic is not None:
         raw['relay.source_topic'] = source_topic

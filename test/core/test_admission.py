@@ -5,7 +5,7 @@
 
 import math
 
-from formation_ros.core.admission import poses_refusal, Reason, refusal, Refusals
+from formation_ros.core.rules.admission import poses_refusal, Reason, refusal, Refusals
 import numpy as np
 
 UNIT = (0.0, 0.0, 0.0, 1.0)

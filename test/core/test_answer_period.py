@@ -5,10 +5,10 @@
 
 import os
 
-from formation_ros.core.answers import AnswerBudget
-from formation_ros.core.declarations import Exe
-from formation_ros.core.params import validate, world_robot_rates
-from formation_ros.core.params_file import load_params_file
+from formation_ros.core.rules.answers import AnswerBudget
+from formation_ros.core.settings.declarations import Exe
+from formation_ros.core.settings.params import validate, world_robot_rates
+from formation_ros.core.settings.params_file import load_params_file
 import pytest
 
 CONFIG = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(

@@ -3,8 +3,8 @@
 
 """Which states a robot answers: copies, floods, the budget, stale inputs, start-up, watchdog."""
 
-from formation_ros.core.answers import (Act, AnswerPolicy, BURST, COPY_GAP_NS, FAST_COPIES,
-                                        INPUTS, STALE_MARGIN_NS)
+from formation_ros.core.rules.answers import (Act, AnswerPolicy, BURST, COPY_GAP_NS, FAST_COPIES,
+                                              INPUTS, STALE_MARGIN_NS)
 import pytest
 
 PERIOD = 20_000_000

@@ -3,8 +3,8 @@
 
 """The answer budget bounds a robot's answers in every window; duplicates are due as promised."""
 
-from formation_ros.core.answers import AnswerBudget, BURST, RATE_MARGIN
-from formation_ros.core.team import duplicate_due, DUPLICATE_GRACE
+from formation_ros.core.rules.answers import AnswerBudget, BURST, RATE_MARGIN
+from formation_ros.core.settings.team import duplicate_due, DUPLICATE_GRACE
 import numpy as np
 
 PERIOD_NS = 20_000_000

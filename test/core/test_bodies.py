@@ -1,16 +1,17 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""Unicycle bodies in the plant model (core/bodies.py, core/plant.py)."""
+"""Unicycle bodies in the plant model (core/model/bodies.py, core/model/plant.py)."""
 
 import math
 
-from formation_ros.core.bodies import make_bodies, PointBodies, random_headings, UnicycleBodies
-from formation_ros.core.law import make_law, team_command
-from formation_ros.core.params import validate
-from formation_ros.core.plant import Commands, CommandStatus, PlantModel
-from formation_ros.core.reference import Reference
-from formation_ros.core.unicycle import command_bounds, hand_points, unicycle_commands
+from formation_ros.core.maths.law import make_law, team_command
+from formation_ros.core.maths.reference import Reference
+from formation_ros.core.maths.unicycle import command_bounds, hand_points, unicycle_commands
+from formation_ros.core.model.bodies import (make_bodies, PointBodies, random_headings,
+                                             UnicycleBodies)
+from formation_ros.core.model.plant import Commands, CommandStatus, PlantModel
+from formation_ros.core.settings.params import validate
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -176,7 +177,7 @@ def test_random_headings_are_uniform_and_seeded():
 
 
 def test_chunks_keep_the_body_arrays(tmp_path):
-    from formation_ros.core.trajectory import ChunkWriter, read_body_chunks, read_chunks
+    from formation_ros.core.runs.trajectory import ChunkWriter, read_body_chunks, read_chunks
     writer = ChunkWriter(str(tmp_path / 'chunks'))
     for k in range(5):
         writer.append(0.1 * k, np.full((3, 2), k), np.ones((3, 2)), heading=np.full(3, 0.5 * k),

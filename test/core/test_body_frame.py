@@ -1,13 +1,13 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""Body-frame commands (core/frames.py, core/bodies.py): rotations against independent ones."""
+"""Body-frame commands (frames.py, bodies.py): rotations against independent ones."""
 
 import math
 
-from formation_ros.core.bodies import PointBodies
-from formation_ros.core.frames import from_body_frame, to_body_frame, valid_quaternions
-from formation_ros.core.unicycle import quaternions_from_headings
+from formation_ros.core.maths.frames import from_body_frame, to_body_frame, valid_quaternions
+from formation_ros.core.maths.unicycle import quaternions_from_headings
+from formation_ros.core.model.bodies import PointBodies
 import numpy as np
 from scipy.spatial.transform import Rotation
 

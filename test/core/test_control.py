@@ -3,12 +3,12 @@
 
 """One path computes the commands of one robot and of K: each robot's as if it were alone."""
 
-from formation_ros.core.control import Control, Sensed
-from formation_ros.core.frames import to_body_frame
-from formation_ros.core.law import make_law, robot_command
-from formation_ros.core.reference import Reference
-from formation_ros.core.unicycle import (hand_points, headings_from_quaternions,
-                                         quaternions_from_headings, unicycle_commands)
+from formation_ros.core.maths.frames import to_body_frame
+from formation_ros.core.maths.law import make_law, robot_command
+from formation_ros.core.maths.reference import Reference
+from formation_ros.core.maths.unicycle import (hand_points, headings_from_quaternions,
+                                               quaternions_from_headings, unicycle_commands)
+from formation_ros.core.rules.control import Control, Sensed
 import numpy as np
 import pytest
 

@@ -1,20 +1,20 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""Non-ideal bodies (core/dynamics.py, D1-D4): lag, acceleration limit, noise, delay."""
+"""Non-ideal bodies (core/model/dynamics.py, D1-D4): lag, acceleration limit, noise, delay."""
 
 from dataclasses import replace
 import math
 import os
 
-from formation_ros.core.dynamics import (IDEAL, Imperfections, lagged_velocity, point_step,
-                                         unicycle_step)
-from formation_ros.core.law import make_law
-from formation_ros.core.params import load_config, validate
-from formation_ros.core.params_file import load_params_file
-from formation_ros.core.plant import Commands, CommandStatus, PlantModel
-from formation_ros.core.reference import Reference
-from formation_ros.tools.sim import simulate
+from formation_ros.core.maths.law import make_law
+from formation_ros.core.maths.reference import Reference
+from formation_ros.core.model.dynamics import (IDEAL, Imperfections, lagged_velocity, point_step,
+                                               unicycle_step)
+from formation_ros.core.model.plant import Commands, CommandStatus, PlantModel
+from formation_ros.core.settings.params import load_config, validate
+from formation_ros.core.settings.params_file import load_params_file
+from formation_ros.simulation.simulate import simulate
 import numpy as np
 import pytest
 

@@ -1,16 +1,16 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""Events of a run (core/events.py) and its per-segment metrics (core/metrics.py)."""
+"""Events of a run (core/runs/events.py) and its per-segment metrics (core/runs/metrics.py)."""
 
 import itertools
 import math
 
-from formation_ros.core.events import (Event, EventKind, segments, shape_in_force, stopped_at,
-                                       with_shapes)
-from formation_ros.core.frames import FrameSample, stationary_frame
-from formation_ros.core.metrics import segment_metrics
-from formation_ros.core.trajectory import Trajectory
+from formation_ros.core.maths.frames import FrameSample, stationary_frame
+from formation_ros.core.runs.events import (Event, EventKind, segments, shape_in_force, stopped_at,
+                                            with_shapes)
+from formation_ros.core.runs.metrics import segment_metrics
+from formation_ros.core.runs.trajectory import Trajectory
 import numpy as np
 import pytest
 

@@ -1,18 +1,18 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""The parameters-file guard (core/file_guard.py): what it refuses, where, and what it lets by."""
+"""The parameters-file guard (file_guard.py): what it refuses, where, and what it lets by."""
 
 import glob
 import os
 
-from formation_ros.core.declarations import ParamError
-from formation_ros.core.file_guard import (array_limit, check_params_text, FileLimits,
-                                           MAX_DEPTH, MAX_FILE_BYTES, MAX_VALUES,
-                                           MIN_ARRAY_VALUES, ParamsFileError,
-                                           read_params_file_text)
-from formation_ros.core.params_file import (_Loader, flatten, load_params_file, nest,
-                                            parse_params_text, write_params_file)
+from formation_ros.core.settings.declarations import ParamError
+from formation_ros.core.settings.file_guard import (array_limit, check_params_text, FileLimits,
+                                                    MAX_DEPTH, MAX_FILE_BYTES, MAX_VALUES,
+                                                    MIN_ARRAY_VALUES, ParamsFileError,
+                                                    read_params_file_text)
+from formation_ros.core.settings.params_file import (_Loader, flatten, load_params_file, nest,
+                                                     parse_params_text, write_params_file)
 import numpy as np
 import pytest
 import yaml

@@ -1,16 +1,16 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""Moving references and the formation frame J (core/reference.py, core/frames.py)."""
+"""Moving references and the formation frame J (core/maths/reference.py, core/maths/frames.py)."""
 
 import math
 import os
 
-from formation_ros.core.frames import (_rotations, advance, desired_positions, frame_from_pose,
-                                       frame_to_pose, from_frame_velocity,
-                                       matrix_from_quaternion, quaternion_from_matrix,
-                                       rotation_of_vector, to_frame)
-from formation_ros.core.reference import GERONO_LOOP_LENGTH, Reference
+from formation_ros.core.maths.frames import (_rotations, advance, desired_positions,
+                                             frame_from_pose, frame_to_pose, from_frame_velocity,
+                                             matrix_from_quaternion, quaternion_from_matrix,
+                                             rotation_of_vector, to_frame)
+from formation_ros.core.maths.reference import GERONO_LOOP_LENGTH, Reference
 import numpy as np
 import pytest
 
@@ -131,10 +131,11 @@ def test_bad_reference_rejected():
 
 
 def test_reference_kinds_are_one_enum_and_the_file_check_says_what_the_reference_says():
-    from formation_ros.core.declarations import BY_NAME, ParamError, ReferenceKind
-    from formation_ros.core.params import validate
-    from formation_ros.core.params_file import load_params_file
-    from formation_ros.core.reference import PERIODIC
+    from formation_ros.core.settings.declarations import BY_NAME, ParamError
+    from formation_ros.core.maths.reference import ReferenceKind
+    from formation_ros.core.settings.params import validate
+    from formation_ros.core.settings.params_file import load_params_file
+    from formation_ros.core.maths.reference import PERIODIC
     assert set(BY_NAME['reference.kind'].choices) == {kind.value for kind in ReferenceKind}
     assert Reference('circle', 2, speed=1.0).kind is ReferenceKind.CIRCLE
     assert Reference(ReferenceKind.HELIX, 3, speed=1.0).kind is ReferenceKind.HELIX

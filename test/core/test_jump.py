@@ -1,11 +1,11 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""Jump functions of Lemma 1 (core/jump.py)."""
+"""Jump functions of Lemma 1 (core/maths/jump.py)."""
 
 import math
 
-from formation_ros.core.jump import make_jump, PolyJump, SmoothJump
+from formation_ros.core.maths.jump import make_jump, PolyJump, SmoothJump
 import numpy as np
 import pytest
 from scipy import integrate, special
@@ -145,8 +145,8 @@ def test_bad_arguments_rejected():
 
 
 def test_jump_kinds_are_one_enum_and_make_jump_dispatches_on_it():
-    from formation_ros.core.declarations import BY_NAME
-    from formation_ros.core.jump import JumpKind, make_jump, PolyJump, SmoothJump
+    from formation_ros.core.settings.declarations import BY_NAME
+    from formation_ros.core.maths.jump import JumpKind, make_jump, PolyJump, SmoothJump
     assert set(BY_NAME['jump.kind'].choices) == {kind.value for kind in JumpKind}
     for kind, cls in ((JumpKind.POLY, PolyJump), (JumpKind.SMOOTH, SmoothJump)):
         assert isinstance(make_jump(kind), cls) and isinstance(make_jump(kind.value), cls)

@@ -5,10 +5,10 @@
 
 import os
 
-from formation_ros.core.declarations import CommandFrame, CommandType, Exe, SourceType
-from formation_ros.core.params import validate_for_every_executable
-from formation_ros.core.params_file import load_params_file
-from formation_ros.core.unicycle import command_bounds
+from formation_ros.core.maths.unicycle import command_bounds
+from formation_ros.core.settings.declarations import CommandFrame, CommandType, Exe, SourceType
+from formation_ros.core.settings.params import validate_for_every_executable
+from formation_ros.core.settings.params_file import load_params_file
 import pytest
 
 CONFIG = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(

@@ -1,14 +1,14 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""The lab's parameters: world_frame, command.*, relay.*, the non-ideal plant (core/params.py)."""
+"""The lab's parameters: world_frame, command.*, relay.*, the non-ideal plant (params.py)."""
 
 import os
 
-from formation_ros.core.declarations import (CommandFrame, CommandType, Exe, ParamError,
-                                             SourceType)
-from formation_ros.core.params import validate, validate_for_every_executable
-from formation_ros.core.params_file import load_params_file
+from formation_ros.core.settings.declarations import (CommandFrame, CommandType, Exe, ParamError,
+                                                      SourceType)
+from formation_ros.core.settings.params import validate, validate_for_every_executable
+from formation_ros.core.settings.params_file import load_params_file
 import numpy as np
 import pytest
 

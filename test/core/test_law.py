@@ -1,14 +1,14 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""The bounded control law (core/law.py): eqs. (8)-(14), (25)."""
+"""The bounded control law (core/maths/law.py): eqs. (8)-(14), (25)."""
 
 import math
 
-from formation_ros.core.frames import stationary_frame
-from formation_ros.core.law import (log_potential, make_law, potential, robot_command,
-                                    team_command)
-from formation_ros.core.reference import Reference
+from formation_ros.core.maths.frames import stationary_frame
+from formation_ros.core.maths.law import (log_potential, make_law, potential, robot_command,
+                                          team_command)
+from formation_ros.core.maths.reference import Reference
 import numpy as np
 import pytest
 
@@ -175,8 +175,8 @@ def test_team_command_with_the_callers_tree_is_the_same_command():
 
 
 def test_every_psi_kind_has_its_function_and_bound_and_strings_name_them():
-    from formation_ros.core.declarations import BY_NAME
-    from formation_ros.core.law import psi, PSI_FUNCTIONS, PsiKind
+    from formation_ros.core.settings.declarations import BY_NAME
+    from formation_ros.core.maths.law import psi, PSI_FUNCTIONS, PsiKind
     assert set(PSI_FUNCTIONS) == set(PsiKind)
     assert set(BY_NAME['controller.psi'].choices) == {kind.value for kind in PsiKind}
     omega = np.array([-1e6, -0.7, 0.0, 0.3, 1e6])

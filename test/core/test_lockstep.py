@@ -1,11 +1,11 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""A lockstep plant's wait for answers (core/lockstep.py): who is named, when, and the end."""
+"""A lockstep plant's wait for answers (lockstep.py): who is named, when, and the end."""
 
-from formation_ros.core.lockstep import (AnswerWait, NAME_AFTER, REPEAT_EVERY, robots_and_names,
-                                         WAITED, WAITING_FOR)
-from formation_ros.core.plant_intake import CommandIntake
+from formation_ros.core.rules.lockstep import (AnswerWait, NAME_AFTER, REPEAT_EVERY,
+                                               robots_and_names, WAITED, WAITING_FOR)
+from formation_ros.core.rules.plant_intake import CommandIntake
 
 S = 1_000_000_000
 

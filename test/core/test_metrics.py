@@ -1,16 +1,16 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""Run metrics (core/metrics.py) against brute-force and hand-computed references."""
+"""Run metrics (core/runs/metrics.py) against brute-force and hand-computed references."""
 
 import itertools
 import json
 import math
 
-from formation_ros.core import metrics
-from formation_ros.core.metrics import (closest_pair_distance, compute_metrics, dis_all,
-                                        dis_all_series, dis_min_series, formation_errors,
-                                        settle_time)
+from formation_ros.core.runs import metrics
+from formation_ros.core.runs.metrics import (closest_pair_distance, compute_metrics, dis_all,
+                                             dis_all_series, dis_min_series, formation_errors,
+                                             settle_time)
 import numpy as np
 import pytest
 

@@ -1,9 +1,9 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""Another team on a domain (core/occupants.py): the one rule of the plant and the launcher."""
+"""Another team on a domain (occupants.py): the one rule of the plant and the launcher."""
 
-from formation_ros.core.occupants import is_hub, occupants
+from formation_ros.core.rules.occupants import is_hub, occupants
 
 OWN = '/plant'
 

@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 
 """
-The grid search of core.pairs against a k-d tree and brute force, and the plant model's pairs.
+The grid search of maths.pairs against a k-d tree and brute force, and the plant model's pairs.
 
 The plant model keeps candidates within (1 + PAIR_SKIN) b and filters them each step; every
 step's pairs must be those a fresh search finds, in the order the law sums them.
@@ -10,10 +10,10 @@ step's pairs must be those a fresh search finds, in the order the law sums them.
 
 import math
 
-from formation_ros.core.law import make_law, team_command
-from formation_ros.core.pairs import closest_pair, pairs_within, squared_norms
-from formation_ros.core.plant import Commands, PlantModel
-from formation_ros.core.reference import Reference
+from formation_ros.core.maths.law import make_law, team_command
+from formation_ros.core.maths.pairs import closest_pair, pairs_within, squared_norms
+from formation_ros.core.maths.reference import Reference
+from formation_ros.core.model.plant import Commands, PlantModel
 import numpy as np
 import pytest
 from scipy.spatial import cKDTree

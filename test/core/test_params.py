@@ -1,15 +1,15 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""Parameter files and their validation (core/params.py)."""
+"""Parameter files and their validation (core/settings/params.py)."""
 
 import math
 import os
 import re
 
-from formation_ros.core.declarations import DECLARATIONS as SCHEMA, ParamError, REQUIRED
-from formation_ros.core.params import load_config, shape_problem, validate
-from formation_ros.core.params_file import load_params_file
+from formation_ros.core.settings.declarations import DECLARATIONS as SCHEMA, ParamError, REQUIRED
+from formation_ros.core.settings.params import load_config, shape_problem, validate
+from formation_ros.core.settings.params_file import load_params_file
 import numpy as np
 import pytest
 import yaml

@@ -1,17 +1,17 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""The plant model (core/plant.py): zero-order hold, admission, bound audit, collisions, sensor."""
+"""The plant model (plant.py): zero-order hold, admission, bound audit, collisions, sensor."""
 
 import math
 import os
 
-from formation_ros.core.law import make_law, neighbour_pairs, team_command
-from formation_ros.core.params import load_config
-from formation_ros.core.plant import (Commands, CommandStatus, PlantModel, random_start,
-                                      start_positions, StartSpec)
-from formation_ros.core.reference import Reference
-from formation_ros.tools.sim import simulate
+from formation_ros.core.maths.law import make_law, neighbour_pairs, team_command
+from formation_ros.core.maths.reference import Reference
+from formation_ros.core.model.plant import (Commands, CommandStatus, PlantModel, random_start,
+                                            start_positions, StartSpec)
+from formation_ros.core.settings.params import load_config
+from formation_ros.simulation.simulate import simulate
 import numpy as np
 import pytest
 

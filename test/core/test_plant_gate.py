@@ -1,11 +1,11 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""The plant's start gate (core/plant_gate.py): look at the domain, hold the clock, start."""
+"""The plant's start gate (core/rules/plant_gate.py): look at the domain, hold the clock, start."""
 
-from formation_ros.core.plant_gate import (CLOCK_MATCH_WAIT, ClockMatch, domain_verdict,
-                                           LOOK_LIMIT, LOOK_PERIOD, LOOK_TIME, Phase,
-                                           refusal_line, StartGate, Verdict, waiting_line)
+from formation_ros.core.rules.plant_gate import (CLOCK_MATCH_WAIT, ClockMatch, domain_verdict,
+                                                 LOOK_LIMIT, LOOK_PERIOD, LOOK_TIME, Phase,
+                                                 refusal_line, StartGate, Verdict, waiting_line)
 import pytest
 
 OWN = '/plant'

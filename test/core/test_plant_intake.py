@@ -1,10 +1,10 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""The plant's intake of commands (core/plant_intake.py): frame check, storing, refusals."""
+"""The plant's intake of commands (core/rules/plant_intake.py): frame check, storing, refusals."""
 
-from formation_ros.core.admission import Reason, Refusals
-from formation_ros.core.plant_intake import CommandIntake, refused_by_robot, TEAM
+from formation_ros.core.rules.admission import Reason, Refusals
+from formation_ros.core.rules.plant_intake import CommandIntake, refused_by_robot, TEAM
 import numpy as np
 
 WORLD = 'world'

@@ -3,10 +3,10 @@
 
 """Property tests of the plant model: whatever the commands, what is applied stays bounded."""
 
-from formation_ros.core.frames import to_frame_velocity
-from formation_ros.core.law import make_law
-from formation_ros.core.plant import Commands, CommandStatus, PlantModel
-from formation_ros.core.reference import Reference
+from formation_ros.core.maths.frames import to_frame_velocity
+from formation_ros.core.maths.law import make_law
+from formation_ros.core.maths.reference import Reference
+from formation_ros.core.model.plant import Commands, CommandStatus, PlantModel
 from hypothesis import given, settings, strategies as st
 import numpy as np
 

@@ -1,19 +1,19 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""The plant's run statistics (core/plant_stats.py): latency, the record, plant_stats.json."""
+"""The plant's run statistics (plant_stats.py): latency, the record, plant_stats.json."""
 
 import json
 import os
 
-from formation_ros.core.admission import Reason, Refusals
-from formation_ros.core.law import make_law
-from formation_ros.core.plant import Commands, PLANT_STATS_FILE, PlantModel
-from formation_ros.core.plant_intake import TEAM
-from formation_ros.core.plant_stats import (AnswerTimes, DurationHistogram, PUBLISHES_TIMED,
-                                            RunOutput, RunStats, stats_text)
-from formation_ros.core.reference import Reference
-from formation_ros.core.trajectory import CHUNKS_DIR, Trajectory, TRAJECTORY_FILE
+from formation_ros.core.maths.law import make_law
+from formation_ros.core.maths.reference import Reference
+from formation_ros.core.model.plant import Commands, PLANT_STATS_FILE, PlantModel
+from formation_ros.core.rules.admission import Reason, Refusals
+from formation_ros.core.rules.plant_intake import TEAM
+from formation_ros.core.rules.plant_stats import (AnswerTimes, DurationHistogram, PUBLISHES_TIMED,
+                                                  RunOutput, RunStats, stats_text)
+from formation_ros.core.runs.trajectory import CHUNKS_DIR, Trajectory, TRAJECTORY_FILE
 import numpy as np
 import pytest
 

@@ -1,16 +1,16 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""The plant's status (core/plant_status.py): diagnostics values and level, command notes."""
+"""The plant's status (core/rules/plant_status.py): diagnostics values and level, command notes."""
 
-from formation_ros.core.admission import Reason, Refusals
-from formation_ros.core.law import make_law
-from formation_ros.core.lockstep import WAITED, WAITING_FOR
-from formation_ros.core.plant import Commands, CommandStatus, PlantModel
-from formation_ros.core.plant_gate import Phase
-from formation_ros.core.plant_intake import TEAM
-from formation_ros.core.plant_status import (CommandWatch, Heard, PlantStatus, robots_named)
-from formation_ros.core.reference import Reference
+from formation_ros.core.maths.law import make_law
+from formation_ros.core.maths.reference import Reference
+from formation_ros.core.model.plant import Commands, CommandStatus, PlantModel
+from formation_ros.core.rules.admission import Reason, Refusals
+from formation_ros.core.rules.lockstep import WAITED, WAITING_FOR
+from formation_ros.core.rules.plant_gate import Phase
+from formation_ros.core.rules.plant_intake import TEAM
+from formation_ros.core.rules.plant_status import CommandWatch, Heard, PlantStatus, robots_named
 import numpy as np
 
 LAW = make_law(2.0, 1.0, 'arctan', 'poly', 2, 0.5)

@@ -7,12 +7,12 @@ from dataclasses import dataclass, replace
 import os
 from typing import Tuple
 
-from formation_ros.core.admission import Reason
-from formation_ros.core.frames import frame_to_pose, FrameSample
-from formation_ros.core.params import load_params_file, validate
-from formation_ros.core.reference_track import OTHER_IN_ROW, ReferenceTrack
-from formation_ros.core.timeline import Mode, ReferenceTimeline, TeamState, Timeline
-from formation_ros.core.units import NS_PER_S
+from formation_ros.core.maths.frames import frame_to_pose, FrameSample
+from formation_ros.core.maths.units import NS_PER_S
+from formation_ros.core.rules.admission import Reason
+from formation_ros.core.rules.reference_track import OTHER_IN_ROW, ReferenceTrack
+from formation_ros.core.runs.timeline import Mode, ReferenceTimeline, TeamState, Timeline
+from formation_ros.core.settings.params import load_params_file, validate
 import numpy as np
 import pytest
 

@@ -3,9 +3,9 @@
 
 """A robot's state intake: the frame / finite / orientation rule, the clock rule and its jumps."""
 
-from formation_ros.core.admission import Reason
-from formation_ros.core.robot_intake import StateIntake
-from formation_ros.core.units import NS_PER_S
+from formation_ros.core.maths.units import NS_PER_S
+from formation_ros.core.rules.admission import Reason
+from formation_ros.core.rules.robot_intake import StateIntake
 import pytest
 
 TIMEOUT = NS_PER_S // 2

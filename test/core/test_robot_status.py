@@ -5,10 +5,10 @@
 
 import os
 
-from formation_ros.core.law import Command
-from formation_ros.core.params import load_params_file, validate
-from formation_ros.core.reference_track import reference_values
-from formation_ros.core.robot_status import startup_line, status_level, status_values
+from formation_ros.core.maths.law import Command
+from formation_ros.core.rules.reference_track import reference_values
+from formation_ros.core.rules.robot_status import startup_line, status_level, status_values
+from formation_ros.core.settings.params import load_params_file, validate
 import numpy as np
 
 SQUARE = os.path.join(os.path.dirname(__file__), '..', '..', 'config', 'square_4.yaml')

@@ -1,12 +1,12 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""The distance the potential guarantees (core/safety.py)."""
+"""The distance the potential guarantees (core/maths/safety.py)."""
 
 import math
 
-from formation_ros.core.law import beta, log_potential, make_law
-from formation_ros.core.safety import body_clearance, guaranteed_min_distance
+from formation_ros.core.maths.law import beta, log_potential, make_law
+from formation_ros.core.maths.safety import body_clearance, guaranteed_min_distance
 import numpy as np
 import pytest
 

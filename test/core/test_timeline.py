@@ -1,13 +1,13 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""What holds when (core/timeline.py): the change in force at a stamp, whatever the order."""
+"""What holds when (core/runs/timeline.py): the change in force at a stamp, whatever the order."""
 
 import itertools
 
-from formation_ros.core.reference import Reference
-from formation_ros.core.timeline import (MAX_CHANGES, Mode, ReferenceTimeline, Shape, TeamState,
-                                         Timeline)
+from formation_ros.core.maths.reference import Reference
+from formation_ros.core.runs.timeline import (MAX_CHANGES, Mode, ReferenceTimeline, Shape,
+                                              TeamState, Timeline)
 import numpy as np
 
 

@@ -3,13 +3,13 @@
 
 """The team transport's pure parts: layouts, a fleet's sensing and its commands in one call."""
 
-from formation_ros.core.frames import frame_from_pose, STATIONARY
-from formation_ros.core.law import make_law, robot_command, robot_commands
-from formation_ros.core.names import robot_name
-from formation_ros.core.sensing import neighbour_lists, sensed_pairs, sensor_radii
-from formation_ros.core.transport import (command_of, command_vectors, commands_of,
-                                          robot_indices, state_rows)
-from formation_ros.core.unicycle import quaternions_from_headings
+from formation_ros.core.maths.frames import frame_from_pose, STATIONARY
+from formation_ros.core.maths.law import make_law, robot_command, robot_commands
+from formation_ros.core.maths.sensing import neighbour_lists, sensed_pairs, sensor_radii
+from formation_ros.core.maths.unicycle import quaternions_from_headings
+from formation_ros.core.rules.transport import (command_of, command_vectors, commands_of,
+                                                robot_indices, state_rows)
+from formation_ros.core.settings.names import robot_name
 import numpy as np
 import pytest
 from scipy.spatial import cKDTree

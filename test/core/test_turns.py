@@ -1,11 +1,11 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""Bounded looks in turn (``core.turns``): every item within ceil(n / limit) calls, no more."""
+"""Bounded looks in turn (``rules.turns``): every item within ceil(n / limit) calls, no more."""
 
 import math
 
-from formation_ros.core.turns import Turns
+from formation_ros.core.rules.turns import Turns
 import pytest
 
 

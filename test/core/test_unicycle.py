@@ -1,13 +1,14 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""Unicycles and their hand points (core/unicycle.py) against independent references."""
+"""Unicycles and their hand points (core/maths/unicycle.py) against independent references."""
 
 import math
 
-from formation_ros.core.unicycle import (command_bounds, hand_points, hand_velocity,
-                                         headings_from_quaternions, quaternions_from_headings,
-                                         unicycle_commands, unicycle_rates, zoh_step)
+from formation_ros.core.maths.unicycle import (command_bounds, hand_points, hand_velocity,
+                                               headings_from_quaternions,
+                                               quaternions_from_headings, unicycle_commands,
+                                               unicycle_rates, zoh_step)
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp

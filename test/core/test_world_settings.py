@@ -3,9 +3,9 @@
 
 """world.*: declared like every parameter, validated into WorldSettings for formation_sim."""
 
-from formation_ros.core.declarations import BY_NAME, Exe, ParamError
-from formation_ros.core.params import load_config, validate, WorldSettings
-from formation_ros.core.params_file import load_params_file
+from formation_ros.core.settings.declarations import BY_NAME, Exe, ParamError
+from formation_ros.core.settings.params import load_config, validate, WorldSettings
+from formation_ros.core.settings.params_file import load_params_file
 import pytest
 
 SQUARE = 'config/square_4.yaml'

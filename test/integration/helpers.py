@@ -13,7 +13,7 @@ import signal
 import subprocess
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros.core.params_file import load_params_file, write_params_file
+from formation_ros.core.settings.params_file import load_params_file, write_params_file
 from formation_ros.ros import fields, qos
 from formation_ros.tools.supervise import ProcessSpec
 from geometry_msgs.msg import TwistStamped

@@ -4,8 +4,9 @@
 """
 A stand-in for a lab, run by the test's probe node: real-ish bodies, their bases and a mocap.
 
-Written here, independently of the package's plant model (``core.plant``, ``core.unicycle``):
-the point of a lab test is that the robots meet bodies the package did not write.
+Written here, independently of the package's plant model (``core.model.plant``,
+``core.maths.unicycle``): the point of a lab test is that the robots meet bodies the package did
+not write.
 
 * Bodies: holonomic points (velocity (vx, vy) in the world) or differential-drive unicycles
   (forward speed v, turn rate w), each with a first-order lag (time constant ``lag``, s) from

@@ -13,7 +13,7 @@ noticed by its commands' age, not by refusing to match it.
 
 import os
 
-from formation_ros.core.params_file import load_params_file, write_params_file
+from formation_ros.core.settings.params_file import load_params_file, write_params_file
 from formation_ros.ros import qos
 from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
 from helpers import CONFIG, node, plant_value, SimClock, Statuses

@@ -8,7 +8,7 @@ import os
 import subprocess
 import sys
 
-from formation_ros.core.params import load_config
+from formation_ros.core.settings.params import load_config
 from helpers import ROOT
 
 

@@ -13,8 +13,8 @@ import json
 import math
 import subprocess
 
-from formation_ros.core.params import load_config
-from formation_ros.core.trajectory import Trajectory
+from formation_ros.core.runs.trajectory import Trajectory
+from formation_ros.core.settings.params import load_config
 from formation_ros.ros import fields, qos
 from geometry_msgs.msg import PoseStamped, TwistStamped
 from helpers import exe, launch, SimClock, stop_when, TWICE_REAL_TIME, write_params

@@ -14,8 +14,8 @@ import math
 import signal
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros.core.params import load_config
-from formation_ros.core.trajectory import Trajectory
+from formation_ros.core.runs.trajectory import Trajectory
+from formation_ros.core.settings.params import load_config
 from formation_ros.ros import qos
 from geometry_msgs.msg import PoseStamped, Twist
 from helpers import launch, logged, node, plant_value, Statuses, stop_when, write_params

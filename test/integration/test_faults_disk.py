@@ -16,8 +16,8 @@ import re
 import subprocess
 import time
 
-from formation_ros.core.exits import RECORDING_FAILED
-from formation_ros.core.trajectory import CHUNKS_DIR, read_chunks
+from formation_ros.core.runs.trajectory import CHUNKS_DIR, read_chunks
+from formation_ros.core.settings.exits import RECORDING_FAILED
 from formation_ros.tools.bag import read_messages
 from helpers import launch, START_UP, wait_exit, write_params
 import pytest

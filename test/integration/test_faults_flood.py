@@ -4,8 +4,8 @@
 """A flood of forged poses on one robot: its commands stay at about one per state."""
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros.core.answers import BURST, RATE_MARGIN
-from formation_ros.core.params import load_config
+from formation_ros.core.rules.answers import BURST, RATE_MARGIN
+from formation_ros.core.settings.params import load_config
 from formation_ros.ros import fields, qos
 from geometry_msgs.msg import PoseStamped, TwistStamped
 from helpers import node, SQUARE

@@ -9,9 +9,9 @@ import os
 import signal
 import subprocess
 
-from formation_ros.core.law import robot_command
-from formation_ros.core.params import load_config
-from formation_ros.core.trajectory import Trajectory
+from formation_ros.core.maths.law import robot_command
+from formation_ros.core.runs.trajectory import Trajectory
+from formation_ros.core.settings.params import load_config
 from formation_ros.ros import messages, qos
 from formation_ros.tools.supervise import ProcessSpec
 from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped

@@ -17,9 +17,9 @@ import subprocess
 import sys
 import time
 
-from formation_ros.core.declarations import Exe
-from formation_ros.core.params import load_config
-from formation_ros.core.trajectory import Trajectory
+from formation_ros.core.runs.trajectory import Trajectory
+from formation_ros.core.settings.declarations import Exe
+from formation_ros.core.settings.params import load_config
 from formation_ros.ros.runner import LauncherWatch
 from formation_ros.ros.watch import process_start
 from helpers import (exe, launch, project_processes, SimClock, SQUARE, START_UP, stop_when,

@@ -7,7 +7,7 @@ import json
 import signal
 import subprocess
 
-from formation_ros.core.params import load_config
+from formation_ros.core.settings.params import load_config
 from formation_ros.ros.bag_writer import BagError
 from formation_ros.tools.bag import read_messages, recover_bag
 from helpers import exe, launch, node, SimClock, SQUARE, START_UP, wait_exit

@@ -15,7 +15,7 @@ import signal
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
-from formation_ros.core.trajectory import Trajectory
+from formation_ros.core.runs.trajectory import Trajectory
 from formation_ros.nodes.robots_link import LISTENER_LOOKS
 from formation_ros.ros import qos
 from formation_ros.ros.diagnostics import PERIOD

@@ -23,8 +23,9 @@ import subprocess
 import sys
 import time
 
-from formation_ros.core.declarations import Exe, ReferenceKind
-from formation_ros.core.params import load_config
+from formation_ros.core.maths.reference import ReferenceKind
+from formation_ros.core.settings.declarations import Exe
+from formation_ros.core.settings.params import load_config
 from formation_ros.ros.watch import watch_environment
 from formation_ros.tools import hosts as hosts_module
 from formation_ros.tools.bag import read_messages

@@ -16,8 +16,8 @@ formation it is stopped with Ctrl-C and must end cleanly, leaving no process beh
 
 import math
 
-from formation_ros.core.params import load_config
-from formation_ros.core.params_file import load_params_file, write_params_file
+from formation_ros.core.settings.params import load_config
+from formation_ros.core.settings.params_file import load_params_file, write_params_file
 from helpers import CONFIG, launch, project_processes, START_UP, stop_when
 from lab_standin import Base, Lab
 import numpy as np

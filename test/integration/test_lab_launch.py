@@ -14,9 +14,9 @@ relay, the reference node and the robots run on wall-clock time.
 import json
 import time
 
-from formation_ros.core.frames import desired_positions
-from formation_ros.core.params import load_config
-from formation_ros.core.params_file import load_params_file
+from formation_ros.core.maths.frames import desired_positions
+from formation_ros.core.settings.params import load_config
+from formation_ros.core.settings.params_file import load_params_file
 from formation_ros.ros import qos
 from formation_ros.tools.bag import read_messages
 from geometry_msgs.msg import PoseStamped, TwistStamped

@@ -12,7 +12,7 @@ has answered, must say within NAME_AFTER s of wall time which robot it waits for
 import re
 import signal
 
-from formation_ros.core.lockstep import NAME_AFTER, REPEAT_EVERY, WAITED, WAITING_FOR
+from formation_ros.core.rules.lockstep import NAME_AFTER, REPEAT_EVERY, WAITED, WAITING_FOR
 from helpers import SimClock, start_system, START_UP, Statuses, write_params
 import pytest
 

@@ -6,9 +6,9 @@
 import json
 import math
 
-from formation_ros.core.law import robot_command
-from formation_ros.core.params import load_config
-from formation_ros.core.trajectory import Trajectory
+from formation_ros.core.maths.law import robot_command
+from formation_ros.core.runs.trajectory import Trajectory
+from formation_ros.core.settings.params import load_config
 from formation_ros.ros import fields, messages, qos
 from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
 from helpers import node, SQUARE

@@ -3,8 +3,8 @@
 
 """What `ros2 param list/get/dump` would see: every declared parameter answers with a value."""
 
-from formation_ros.core.declarations import Exe, used_by
-from formation_ros.core.params_file import load_params_file
+from formation_ros.core.settings.declarations import Exe, used_by
+from formation_ros.core.settings.params_file import load_params_file
 from helpers import node, SQUARE
 from rcl_interfaces.msg import ParameterType
 from rcl_interfaces.srv import GetParameters, ListParameters

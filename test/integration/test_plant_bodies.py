@@ -5,10 +5,10 @@
 
 import json
 
-from formation_ros.core.bodies import make_bodies
-from formation_ros.core.declarations import Exe
-from formation_ros.core.params import load_config
-from formation_ros.core.plant import Commands, PlantModel
+from formation_ros.core.model.bodies import make_bodies
+from formation_ros.core.model.plant import Commands, PlantModel
+from formation_ros.core.settings.declarations import Exe
+from formation_ros.core.settings.params import load_config
 from formation_ros.ros import fields, qos
 from geometry_msgs.msg import PoseStamped
 from helpers import node, write_params

@@ -5,12 +5,12 @@
 
 import json
 
-from formation_ros.core.metrics import compute_metrics
-from formation_ros.core.params import load_config
-from formation_ros.core.trajectory import Trajectory
+from formation_ros.core.runs.metrics import compute_metrics
+from formation_ros.core.runs.trajectory import Trajectory
+from formation_ros.core.settings.params import load_config
 from formation_ros.ros import fields, qos
+from formation_ros.simulation.simulate import simulate
 from formation_ros.tools.bag import read_messages
-from formation_ros.tools.sim import simulate
 from geometry_msgs.msg import PoseArray, PoseStamped
 from helpers import (launch, node, plant_value, SimClock, SQUARE, Statuses, stop_when,
                      write_params)

@@ -7,9 +7,9 @@ import json
 import os
 import signal
 
-from formation_ros.core.params import load_config
-from formation_ros.core.trajectory import Trajectory
-from formation_ros.tools.sim import simulate
+from formation_ros.core.runs.trajectory import Trajectory
+from formation_ros.core.settings.params import load_config
+from formation_ros.simulation.simulate import simulate
 from helpers import (exe, launch, matched, node, plant_value, project_processes, SimClock,
                      SQUARE, start_system, Statuses, stop_when, watch_commands, write_params)
 import numpy as np

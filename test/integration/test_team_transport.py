@@ -15,11 +15,11 @@ import signal
 import time
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros.core.params import load_config
-from formation_ros.core.trajectory import Trajectory
+from formation_ros.core.runs.trajectory import Trajectory
+from formation_ros.core.settings.params import load_config
 from formation_ros.ros import fields, qos
 from formation_ros.ros.cdr import encode_header, encode_names, encode_team_commands
-from formation_ros.tools.sim import simulate
+from formation_ros.simulation.simulate import simulate
 from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
 from helpers import (launch, logged, node, said_once, SimClock, start_system, START_UP,
                      Statuses, stop_when, write_params)

@@ -6,13 +6,14 @@
 import json
 import math
 
-from formation_ros.core.law import robot_command
-from formation_ros.core.params import load_config
-from formation_ros.core.trajectory import Trajectory
-from formation_ros.core.unicycle import (command_bounds, hand_points, headings_from_quaternions,
-                                         quaternions_from_headings, unicycle_commands)
+from formation_ros.core.maths.law import robot_command
+from formation_ros.core.maths.unicycle import (command_bounds, hand_points,
+                                               headings_from_quaternions,
+                                               quaternions_from_headings, unicycle_commands)
+from formation_ros.core.runs.trajectory import Trajectory
+from formation_ros.core.settings.params import load_config
 from formation_ros.ros import fields, messages, qos
-from formation_ros.tools.sim import simulate
+from formation_ros.simulation.simulate import simulate
 from geometry_msgs.msg import Pose, PoseArray, PoseStamped, TwistStamped
 from helpers import launch, node, plant_value, SimClock, Statuses, stop_when, write_params
 from nav_msgs.msg import Odometry

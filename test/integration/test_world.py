@@ -10,8 +10,8 @@ import shutil
 import signal
 import time
 
-from formation_ros.core.params_file import load_params_file, write_params_file
-from formation_ros.core.trajectory import Trajectory
+from formation_ros.core.runs.trajectory import Trajectory
+from formation_ros.core.settings.params_file import load_params_file, write_params_file
 from formation_ros.ros import qos
 from formation_ros.tools.report import load_run
 from geometry_msgs.msg import PoseStamped, Twist, TwistStamped

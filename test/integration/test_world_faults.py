@@ -9,8 +9,8 @@ import re
 import signal
 import socket
 
-from formation_ros.core.exits import ENGINE_FAILED, REFUSED
-from formation_ros.core.params_file import write_params_file
+from formation_ros.core.settings.exits import ENGINE_FAILED, REFUSED
+from formation_ros.core.settings.params_file import write_params_file
 from formation_ros.ros import qos
 from geometry_msgs.msg import Twist, TwistStamped
 from helpers import (CONFIG, launch, logged, node, project_processes, SimClock, wait_exit,

@@ -20,8 +20,8 @@ world heard) is within c M1, the held command at the body's true heading within 
 import json
 import math
 
-from formation_ros.core.params import load_config
-from formation_ros.core.unicycle import hand_points, headings_from_quaternions
+from formation_ros.core.maths.unicycle import hand_points, headings_from_quaternions
+from formation_ros.core.settings.params import load_config
 from formation_ros.ros import qos
 from geometry_msgs.msg import PoseStamped, Twist, TwistStamped
 from helpers import launch, project_processes, START_UP, stop_when, write_params

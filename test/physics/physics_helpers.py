@@ -5,7 +5,7 @@
 
 import math
 
-from formation_ros.core.params import validate
+from formation_ros.core.settings.params import validate
 import numpy as np
 
 TURTLEBOT = {'body.kind': 'unicycle', 'body.hand_distance': 0.08, 'body.radius': 0.11,

@@ -10,7 +10,7 @@ import pytest
 
 mujoco = pytest.importorskip('mujoco')
 
-from formation_ros.core.params import load_config  # noqa: E402, I100
+from formation_ros.core.settings.params import load_config  # noqa: E402, I100
 from formation_ros.physics.engine import Engine  # noqa: E402, I100
 from formation_ros.physics.parts import ModelKind  # noqa: E402, I100
 from formation_ros.physics.scene import build_scene, WORLD_FILE  # noqa: E402, I100

@@ -11,10 +11,11 @@ import pytest
 
 mujoco = pytest.importorskip('mujoco')
 
-from formation_ros.core.exits import ENGINE_FAILED  # noqa: E402, I100
-from formation_ros.core.metrics import formation_errors  # noqa: E402
-from formation_ros.core.params_file import load_params_file, write_params_file  # noqa: E402
-from formation_ros.core.trajectory import Trajectory  # noqa: E402
+from formation_ros.core.runs.metrics import formation_errors  # noqa: E402, I100
+from formation_ros.core.runs.trajectory import Trajectory  # noqa: E402
+from formation_ros.core.settings.exits import ENGINE_FAILED  # noqa: E402
+from formation_ros.core.settings.params_file import (load_params_file,  # noqa: E402
+                                                     write_params_file)
 from formation_ros.tools.report import main as report_main  # noqa: E402
 from formation_ros.tools.sim import main as sim_main  # noqa: E402
 

@@ -3,7 +3,7 @@
 
 """The world's intake of cmd_vel: the frame and finite rule, stamps, the latest kept per robot."""
 
-from formation_ros.core.admission import Reason
+from formation_ros.core.rules.admission import Reason
 from formation_ros.physics.intake import CommandInbox
 import numpy as np
 

@@ -5,12 +5,11 @@
 
 import math
 
-from formation_ros.core.frames import frame_from_pose, frame_to_pose
+from formation_ros.core.maths.frames import frame_from_pose, frame_to_pose
 from formation_ros.ros import messages
 from formation_ros.ros.cdr import (CdrError, encode_clock, encode_odometry, encode_twist,
-                                   encode_twist_stamped, read_odometry,
-                                   read_pose_array, read_pose_stamped, read_twist,
-                                   read_twist_stamped)
+                                   encode_twist_stamped, read_odometry, read_pose_array,
+                                   read_pose_stamped, read_twist, read_twist_stamped)
 from formation_ros.ros.fields import points_of, stamp_to_ns
 from geometry_msgs.msg import (Point, Pose, PoseArray, PoseStamped, Quaternion, Twist,
                                TwistStamped, Vector3)

@@ -3,8 +3,8 @@
 
 """Headings on the wire: state messages of unicycles against rclpy's deserialisation."""
 
-from formation_ros.core.sensing import sensed_pairs
-from formation_ros.core.unicycle import headings_from_quaternions, quaternions_from_headings
+from formation_ros.core.maths.sensing import sensed_pairs
+from formation_ros.core.maths.unicycle import headings_from_quaternions, quaternions_from_headings
 from formation_ros.ros.cdr import read_pose_array, StateEncoder
 from geometry_msgs.msg import Pose, PoseArray, PoseStamped
 import numpy as np

@@ -3,7 +3,7 @@
 
 """The plant's state messages written as bytes equal the messages built one by one."""
 
-from formation_ros.core.sensing import sensed_pairs
+from formation_ros.core.maths.sensing import sensed_pairs
 from formation_ros.ros import fields, messages
 from formation_ros.ros.cdr import StateEncoder
 from geometry_msgs.msg import PoseArray, PoseStamped

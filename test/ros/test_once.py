@@ -3,7 +3,7 @@
 
 """Conditions logged once when they start and once when they end, alone or many at once."""
 
-from formation_ros.core.admission import Reason
+from formation_ros.core.rules.admission import Reason
 from formation_ros.ros.once import OnceLog, RefusalLog, robots_named
 
 

@@ -10,9 +10,9 @@ in test/core/test_reference_track.py; here through the node's callbacks and time
 
 import os
 
-from formation_ros.core.admission import Reason
-from formation_ros.core.frames import FrameSample
-from formation_ros.core.units import NS_PER_S
+from formation_ros.core.maths.frames import FrameSample
+from formation_ros.core.maths.units import NS_PER_S
+from formation_ros.core.rules.admission import Reason
 from formation_ros.nodes.robot import RobotNode
 from geometry_msgs.msg import Point, Pose, PoseArray
 import pytest

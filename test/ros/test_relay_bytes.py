@@ -3,7 +3,7 @@
 
 """What the relay reads and writes as bytes: exact readers, forwarded orientations."""
 
-from formation_ros.core.sensing import sensed_pairs
+from formation_ros.core.maths.sensing import sensed_pairs
 from formation_ros.ros.cdr import (CdrError, encode_odometry, read_odometry, read_pose_stamped,
                                    StateEncoder)
 from geometry_msgs.msg import PoseArray, PoseStamped

@@ -12,8 +12,8 @@ its callbacks would give them, and its rclpy clock is read as its timers read it
 import os
 import time
 
-from formation_ros.core.declarations import ParamError
-from formation_ros.core.units import NS_PER_S
+from formation_ros.core.maths.units import NS_PER_S
+from formation_ros.core.settings.declarations import ParamError
 from formation_ros.nodes.robot import RobotNode
 from formation_ros.nodes.robots_link import RobotsLink
 from geometry_msgs.msg import Point, Pose, PoseArray

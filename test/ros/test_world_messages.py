@@ -3,7 +3,7 @@
 
 """What the world node writes: PoseStamped bytes as rclpy's, its topics where the relay looks."""
 
-from formation_ros.core.declarations import BY_NAME
+from formation_ros.core.settings.declarations import BY_NAME
 from formation_ros.ros import qos, topics
 from formation_ros.ros.cdr import encode_pose_stamped
 from geometry_msgs.msg import PoseStamped

@@ -1,0 +1,138 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+The commands of K >= 1 robots of one process: their points, the law, their command frames.
+
+:class:`Control` is the one path from what the robots sensed to what they publish: the points
+the law acts on (positions, or hand points for unicycles: docs/equations.md U1-U5), u of eqs.
+(14), (25) from ``core.maths.law.robot_commands``, then (v, w) for unicycles or u turned into the
+body frame (``command.frame: body``). A robot process is K = 1, a process's link to its
+robots (``nodes.robots_link``) K.
+"""
+
+from dataclasses import dataclass
+from typing import Optional, Tuple
+
+from formation_ros.core.maths.frames import FrameSample, to_body_frame
+from formation_ros.core.maths.law import Command, LawParams, robot_commands
+from formation_ros.core.maths.unicycle import (hand_points, headings_from_quaternions,
+                                               unicycle_commands)
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+Float = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Sensed:
+    """
+    What K robots know at a state, as the law takes it.
+
+    indices: (K,) the robots' 0-based ids; points: (K, dim) the points the law acts on, m
+    (:meth:`Control.points`); headings: (K,) rad; orientations: (K, 4) quaternions (x, y, z,
+    w); (observer, neighbours): (P,) indices into the K robots and (P, dim) the points each
+    sensed, in order (``core.maths.law.robot_commands``).
+    """
+
+    indices: NDArray[np.intp]
+    points: Float
+    headings: Float
+    orientations: Float
+    observer: NDArray[np.intp]
+    neighbours: Float
+
+
+@dataclass(frozen=True)
+class Commands:
+    """
+    The commands of K robots: ``law`` (u, u_hat, omega: (K, dim) m/s) and what is published.
+
+    body: (K, 2) (v, w) in m/s and rad/s for unicycles, (K, dim) u in the body frame with
+    ``command.frame: body``, None when u is published in the world frame.
+    """
+
+    law: Command
+    body: Optional[Float]
+
+    @property
+    def published(self) -> Float:
+        """Return the commands as published: (K, width), in their command frames."""
+        return self.law.u if self.body is None else self.body
+
+    def row(self, k: int) -> Tuple[Command, Optional[Float]]:
+        """Return robot k's command ((dim,) arrays) and its published form, if not u."""
+        law = self.law
+        return (Command(u=law.u[k], u_hat=law.u_hat[k], omega=law.omega[k]),
+                None if self.body is None else self.body[k])
+
+
+class Control:
+    """
+    The law of K robots and the map of its commands to their command frames.
+
+    law: the law's constants; radii: (K,) R_i of the robots, m; dim: 2 or 3; unicycle, with
+    hand_distance (m): the law acts on hand points and commands are (v, w); body_frame: u is
+    published in each robot's body frame.
+    """
+
+    def __init__(self, law: LawParams, radii: ArrayLike, dim: int, unicycle: bool,
+                 hand_distance: float, body_frame: bool) -> None:
+        """Keep the constants; ``radii`` is copied."""
+        self.law = law
+        self.radii = np.array(radii, dtype=float)
+        self.dim = dim
+        self.unicycle = unicycle
+        self.hand_distance = hand_distance
+        self.body_frame = body_frame
+        self.width = 2 if unicycle else dim
+
+    def points(self, positions: ArrayLike, orientations: ArrayLike) -> Tuple[Float, Float]:
+        """
+        Return (points, headings) of M robots' poses: the points the law acts on.
+
+        positions: (M, >= dim) m; orientations: (M, 4) quaternions (x, y, z, w). points:
+        (M, dim), the positions or (unicycles) the hand points; headings: (M,) rad (zeros
+        but for unicycles).
+        """
+        q = np.asarray(positions, dtype=float)[:, :self.dim]
+        if not self.unicycle:
+            return q, np.zeros(len(q))
+        headings = np.asarray(headings_from_quaternions(orientations), dtype=float)
+        return hand_points(q, headings, self.hand_distance), headings
+
+    def alone(self, index: int, position: ArrayLike, orientation: ArrayLike,
+              positions: ArrayLike, orientations: ArrayLike) -> Sensed:
+        """
+        Return what one robot (0-based id ``index``) knows, as the law takes it (K = 1).
+
+        position: (>= dim,) m and orientation (4,) of its pose; positions: (P, >= dim) m and
+        orientations: (P, 4) of the neighbours it sensed.
+        """
+        own = np.asarray(orientation, dtype=float)[None, :]
+        points, headings = self.points(np.vstack([np.asarray(position, dtype=float)[None, :],
+                                                  positions]),
+                                       np.vstack([own, orientations]))
+        return Sensed(np.array([index], dtype=np.intp), points[:1], headings[:1], own,
+                      np.zeros(len(points) - 1, dtype=np.intp), points[1:])
+
+    def zero(self) -> Float:
+        """Return the K robots' zero commands: (K, width)."""
+        return np.zeros((len(self.radii), self.width))
+
+    def commands(self, sensed: Sensed, vertices: ArrayLike,
+                 frame: Optional[FrameSample]) -> Commands:
+        """
+        Return the K robots' commands: u of eqs. (14), (25), then in their command frames.
+
+        sensed: what they know (:class:`Sensed`); vertices: (K, dim) their places in the
+        formation frame; frame: the reference's frame at the state.
+        """
+        law = robot_commands(sensed.points, vertices, sensed.observer, sensed.neighbours,
+                             self.radii, self.law, frame)
+        body: Optional[Float] = None
+        if self.unicycle:
+            body = unicycle_commands(law.u, sensed.headings, self.hand_distance)
+        elif self.body_frame:
+            body = to_body_frame(law.u, sensed.orientations)
+        return Commands(law, body)
