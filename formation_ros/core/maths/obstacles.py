@@ -1,0 +1,210 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+Static obstacles and their repulsion: the collision function beta of eq. (11) against a surface.
+
+Beyond the paper (docs/equations.md, "Obstacles"): a static obstacle o adds to robot i's
+potential the factor ``beta_io = h(0, b_o**2 / 2, d_io**2 / 2)`` of the distance ``d_io`` from
+its position to the obstacle's surface, as eq. (11) does for a pair of robots with ``b_ij``;
+``Omega_i`` of eq. (13) gains ``-kappa * betabar'_io * (q_i - p_io)``, with ``p_io`` the
+surface point closest to ``q_i`` (``||q_i - p_io|| = d_io`` outside the obstacle) and
+``betabar' = h'/h``. That is the gradient of ``-kappa * log beta_io`` with respect to ``q_i``,
+since the gradient of ``d_io`` is the unit normal ``(q_i - p_io) / d_io``.
+
+Three shapes, all in the world frame (m):
+
+* circles ``(x, y, r)``: discs in 2D; in 3D vertical pillars of radius r, unbounded in z;
+* walls ``(x1, y1, x2, y2, t)``: the points within t of the segment; in 3D vertical walls,
+  unbounded in z;
+* spheres ``(x, y, z, r)``: 3D only.
+
+Positions are rows ``(N, dim)``, ``dim`` 2 or 3. A distance is negative inside an obstacle and
+zero on its surface; nothing here modifies its arguments.
+"""
+
+from dataclasses import dataclass
+import math
+from typing import NamedTuple, Tuple
+
+from formation_ros.core.maths.jump import JumpFunction
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+MAX_OBSTACLE_REPULSION = 1e200
+"""The repulsion of a robot on or inside an obstacle's surface, along its outward normal (the
+term has no value there; the command saturates at c M1 as for two robots at one point)."""
+CIRCLE_COLUMNS = 3
+WALL_COLUMNS = 5
+SPHERE_COLUMNS = 4
+
+
+class Surface(NamedTuple):
+    """
+    Where the obstacles' surfaces are, seen from robots.
+
+    points: (N, M, dim) the surface point p_io closest to robot i, m; distances: (N, M) d_io,
+    m, negative inside; normals: (N, M, dim) the unit outward normals at those points.
+    """
+
+    points: NDArray[np.float64]
+    distances: NDArray[np.float64]
+    normals: NDArray[np.float64]
+
+
+def _rows(values: ArrayLike, columns: int, name: str) -> NDArray[np.float64]:
+    """Return ``values`` as a read-only (K, columns) float array; ValueError if it is not one."""
+    array = np.array(values, dtype=float).reshape(-1) if np.size(values) else np.zeros(0)
+    if array.size % columns:
+        raise ValueError(f'{name} takes {columns} numbers an obstacle, got {array.size}')
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f'{name} must be finite numbers')
+    rows = array.reshape(-1, columns)
+    rows.setflags(write=False)
+    return rows
+
+
+@dataclass(frozen=True)
+class Obstacles:
+    """
+    The static obstacles of an arena, in the world frame.
+
+    circles: (C, 3) rows (x, y, r), r > 0; walls: (W, 5) rows (x1, y1, x2, y2, t), t > 0 (a
+    wall whose ends coincide is a disc of radius t); spheres: (S, 4) rows (x, y, z, r), r > 0,
+    only when ``dim`` is 3; clearance: b_o in m, the distance from a surface within which an
+    obstacle repels (> 0); dim: 2 or 3. Flat lists are accepted (``obstacles.circles`` etc.).
+    """
+
+    circles: NDArray[np.float64]
+    walls: NDArray[np.float64]
+    spheres: NDArray[np.float64]
+    clearance: float
+    dim: int
+
+    def __post_init__(self) -> None:
+        """Check shapes and values once, so that the hot path need not."""
+        object.__setattr__(self, 'circles', _rows(self.circles, CIRCLE_COLUMNS, 'circles'))
+        object.__setattr__(self, 'walls', _rows(self.walls, WALL_COLUMNS, 'walls'))
+        object.__setattr__(self, 'spheres', _rows(self.spheres, SPHERE_COLUMNS, 'spheres'))
+        if self.dim not in (2, 3):
+            raise ValueError(f'dim must be 2 or 3, got {self.dim!r}')
+        if not (math.isfinite(self.clearance) and self.clearance > 0.0):
+            raise ValueError(f'clearance must be a finite number > 0, got {self.clearance!r}')
+        if np.any(self.circles[:, 2] <= 0.0) or np.any(self.spheres[:, 3] <= 0.0):
+            raise ValueError('an obstacle radius must be > 0')
+        if np.any(self.walls[:, 4] <= 0.0):
+            raise ValueError('a wall half-thickness must be > 0')
+        if len(self.spheres) and self.dim != 3:
+            raise ValueError('spheres are 3D obstacles; this team is 2D')
+
+    @property
+    def count(self) -> int:
+        """The number of obstacles M: circles, then walls, then spheres."""
+        return len(self.circles) + len(self.walls) + len(self.spheres)
+
+    def surface(self, q: ArrayLike) -> Surface:
+        """
+        Return the :class:`Surface` of every obstacle as every robot sees it.
+
+        q: (N, dim) positions, m; obstacles in the order of :attr:`count`. Circles and walls
+        act in the plane: in 3D their points keep the robot's z and their normals have no z.
+        A position on an obstacle's axis or segment (no direction to the surface) takes +x.
+        """
+        q = np.asarray(q, dtype=float).reshape(-1, self.dim)
+        parts = [_circle_surface(q, self.circles), _wall_surface(q, self.walls),
+                 _sphere_surface(q, self.spheres)]
+        return Surface(*(np.concatenate([part[k] for part in parts], axis=1) for k in range(3)))
+
+
+def _toward(offset: NDArray[np.float64]) -> Tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Return the unit directions of offsets (..., k) and their norms; +x for a zero offset."""
+    norm = np.linalg.norm(offset, axis=-1)
+    unit = np.zeros_like(offset)
+    unit[..., 0] = 1.0
+    away = norm > 0.0
+    unit[away] = offset[away] / norm[away][:, None]
+    return unit, norm
+
+
+def _in_plane(q: NDArray[np.float64], axis_xy: NDArray[np.float64], reach: NDArray[np.float64]
+              ) -> Surface:
+    """Return the surface of plane shapes from their axis points (N, K, 2) and radii (K,)."""
+    unit, norm = _toward(q[:, None, :2] - axis_xy)
+    points = np.repeat(q[:, None, :], axis_xy.shape[1], axis=1)
+    points[..., :2] = axis_xy + reach[:, None] * unit
+    normals = np.zeros_like(points)
+    normals[..., :2] = unit
+    return Surface(points, norm - reach, normals)
+
+
+def _circle_surface(q: NDArray[np.float64], circles: NDArray[np.float64]) -> Surface:
+    """Discs (2D) or vertical pillars (3D): the closest point keeps the robot's z."""
+    centres = np.broadcast_to(circles[None, :, :2], (len(q), len(circles), 2))
+    return _in_plane(q, centres, circles[:, 2])
+
+
+def _wall_surface(q: NDArray[np.float64], walls: NDArray[np.float64]) -> Surface:
+    """Thick segments: the closest point of the segment, then the half-thickness towards q."""
+    start, end = walls[:, 0:2], walls[:, 2:4]
+    along = end - start
+    length_sq = np.einsum('kd,kd->k', along, along)
+    reach = np.einsum('nkd,kd->nk', q[:, None, :2] - start, along)
+    with np.errstate(invalid='ignore', divide='ignore'):
+        fraction = np.where(length_sq > 0.0, reach / length_sq, 0.0)
+    nearest = start + np.clip(fraction, 0.0, 1.0)[..., None] * along
+    return _in_plane(q, nearest, walls[:, 4])
+
+
+def _sphere_surface(q: NDArray[np.float64], spheres: NDArray[np.float64]) -> Surface:
+    """Balls: the closest point along the line from the centre."""
+    if len(spheres) == 0:
+        none = np.zeros((len(q), 0, q.shape[1]))
+        return Surface(none, np.zeros((len(q), 0)), none)
+    unit, norm = _toward(q[:, None, :] - spheres[:, :3])
+    radius = spheres[:, 3]
+    return Surface(spheres[:, :3] + radius[:, None] * unit, norm - radius, unit)
+
+
+def obstacle_beta(distance: ArrayLike, jump: JumpFunction, clearance: float
+                  ) -> NDArray[np.float64]:
+    """beta_io = h(0, b_o**2 / 2, d_io**2 / 2) of distances d_io (any shape, m); 0 at contact."""
+    d = np.asarray(distance, dtype=float)
+    return np.where(d > 0.0, jump.h(0.5 * d * d, 0.0, 0.5 * clearance * clearance), 0.0)
+
+
+def obstacle_terms(q: ArrayLike, surface: Surface, jump: JumpFunction, clearance: float,
+                   sensing_radii: ArrayLike) -> NDArray[np.float64]:
+    """
+    Return sum_o betabar'_io (q_i - p_io) for every robot: its obstacles' part of eq. (13).
+
+    q: (N, dim) positions; surface: :meth:`Obstacles.surface` of q; sensing_radii: (N,) R_i,
+    m. Only obstacles nearer than R_i and than b_o count (betabar' vanishes at and beyond b_o).
+    Returns (N, dim) in 1/m, the world frame. On or inside an obstacle (d_io <= 0), or nearer
+    than the doubles can tell, the term is :data:`MAX_OBSTACLE_REPULSION` along the normal.
+    """
+    d = surface.distances
+    radii = np.asarray(sensing_radii, dtype=float).reshape(-1, 1)
+    near = (d < clearance) & (d < radii)
+    outside = near & (d > 0.0)
+    weight = np.zeros_like(d)
+    with np.errstate(over='ignore', invalid='ignore'):
+        weight[outside] = jump.ratio(0.5 * d[outside] ** 2, 0.0, 0.5 * clearance * clearance)
+        terms = weight[..., None] * (np.asarray(q, dtype=float)[:, None, :] - surface.points)
+    huge = (near & (d <= 0.0)) | (outside & ~np.all(np.isfinite(terms), axis=-1))
+    terms[huge] = MAX_OBSTACLE_REPULSION * surface.normals[huge]
+    summed: NDArray[np.float64] = terms.sum(axis=1)
+    return summed
+
+
+def log_obstacle_factor(q: ArrayLike, obstacles: Obstacles, jump: JumpFunction,
+                        kappa: float) -> float:
+    """
+    Return -kappa * sum_{i, o} log beta_io, the obstacles' part of log(phi + 1), a float.
+
+    Its gradient with respect to q_i is kappa times minus the sum of :func:`obstacle_terms`
+    (every obstacle counted, whatever R_i): the check of the terms. +inf at a contact.
+    """
+    distances = obstacles.surface(q).distances
+    with np.errstate(divide='ignore'):
+        logs = np.log(obstacle_beta(distances, jump, obstacles.clearance))
+    return -kappa * float(np.sum(logs))

@@ -1,0 +1,159 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+Obstacles (maths/obstacles.py): surfaces against sampled boundaries, terms against the gradient.
+
+The closest surface points are checked against a brute-force search over densely sampled
+boundaries and an independent inside test; the repulsion terms against a central finite
+difference of the obstacles' part of log(phi + 1), for every jump kind, in 2D and 3D.
+"""
+
+import math
+
+from formation_ros.core.maths.jump import make_jump
+from formation_ros.core.maths.obstacles import (log_obstacle_factor, MAX_OBSTACLE_REPULSION,
+                                                obstacle_beta, obstacle_terms, Obstacles)
+import numpy as np
+import pytest
+
+CIRCLES = [0.0, 0.0, 1.0, 3.0, 2.0, 0.4]
+WALLS = [-2.0, -3.0, 2.0, -3.0, 0.1, 4.0, -1.0, 4.0, -1.0, 0.3]
+SPHERES = [0.0, 4.0, 1.0, 0.7]
+JUMPS = [('poly', 1), ('poly', 2), ('poly', 4), ('smooth', 2)]
+
+
+def segment_distance(points, a, b):
+    """Distances (K,) of points (K, 2) to the segment from a to b (a point when a is b)."""
+    if np.array_equal(a, b):
+        return np.linalg.norm(points - a, axis=1)
+    s = np.clip((points - a) @ (b - a) / np.dot(b - a, b - a), 0.0, 1.0)
+    return np.linalg.norm(points - (a + s[:, None] * (b - a)), axis=1)
+
+
+def boundary_2d(circles, walls, per=20000):
+    """Points on the boundary of each 2D shape: a list of (K, 2) arrays, in obstacle order."""
+    angles = np.linspace(0.0, 2.0 * math.pi, per, endpoint=False)
+    ring = np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    shapes = [np.array(c[:2]) + c[2] * ring for c in np.reshape(circles, (-1, 3))]
+    for x1, y1, x2, y2, t in np.reshape(walls, (-1, 5)):
+        a, b = np.array([x1, y1]), np.array([x2, y2])
+        if np.array_equal(a, b):
+            shapes.append(a + t * ring)
+            continue
+        normal = np.array([a[1] - b[1], b[0] - a[0]]) / np.linalg.norm(b - a)
+        spine = a + np.linspace(0.0, 1.0, per)[:, None] * (b - a)
+        caps = np.concatenate([a + t * ring, b + t * ring])
+        caps = caps[segment_distance(caps, a, b) >= t * (1.0 - 1e-9)]
+        shapes.append(np.concatenate([spine + t * normal, spine - t * normal, caps]))
+    return shapes
+
+
+def inside_2d(p, circles, walls):
+    """Whether p is strictly inside each 2D shape, from the definitions."""
+    result = [math.dist(p, c[:2]) < c[2] for c in np.reshape(circles, (-1, 3))]
+    for x1, y1, x2, y2, t in np.reshape(walls, (-1, 5)):
+        gap = segment_distance(p[None, :], np.array([x1, y1]), np.array([x2, y2]))[0]
+        result.append(gap < t)
+    return result
+
+
+def test_the_closest_surface_points_in_2d_are_those_of_a_dense_search():
+    obstacles = Obstacles(CIRCLES, WALLS, [], 0.5, 2)
+    rng = np.random.default_rng(3)
+    q = rng.uniform(-4.0, 6.0, size=(60, 2))
+    surface = obstacles.surface(q)
+    shapes = boundary_2d(CIRCLES, WALLS)
+    assert surface.points.shape == (60, 4, 2) and surface.distances.shape == (60, 4)
+    for i, p in enumerate(q):
+        inside = inside_2d(p, CIRCLES, WALLS)
+        for o, shape in enumerate(shapes):
+            gaps = np.linalg.norm(shape - p, axis=1)
+            nearest = shape[np.argmin(gaps)]
+            sign = -1.0 if inside[o] else 1.0
+            assert surface.distances[i, o] == pytest.approx(sign * gaps.min(), abs=2e-3)
+            assert np.linalg.norm(surface.points[i, o] - nearest) < 0.05
+            assert abs(np.linalg.norm(surface.normals[i, o]) - 1.0) < 1e-12
+
+
+def test_pillars_walls_and_spheres_in_3d_keep_the_robots_height():
+    obstacles = Obstacles(CIRCLES, WALLS, SPHERES, 0.5, 3)
+    q = np.array([[1.5, 0.0, 7.0], [0.0, 4.0, 2.0], [0.0, -2.5, -1.0]])
+    surface = obstacles.surface(q)
+    assert surface.points.shape == (3, 5, 3)
+    assert np.allclose(surface.points[:, :4, 2], q[:, 2:3])
+    assert np.allclose(surface.normals[:, :4, 2], 0.0)
+    assert surface.distances[0, 0] == pytest.approx(0.5)
+    assert surface.distances[1, 4] == pytest.approx(1.0 - 0.7)
+    assert np.allclose(surface.points[1, 4], [0.0, 4.0, 1.7])
+    assert surface.distances[2, 2] == pytest.approx(0.5 - 0.1)
+
+
+@pytest.mark.parametrize('kind,order', JUMPS)
+@pytest.mark.parametrize('dim', [2, 3])
+def test_the_terms_are_the_gradient_of_the_obstacles_log_factor(kind, order, dim):
+    jump = make_jump(kind, order)
+    kappa, clearance = 0.7, 0.8
+    obstacles = Obstacles(CIRCLES, WALLS, SPHERES if dim == 3 else [], clearance, dim)
+    rng = np.random.default_rng(11 + dim + order)
+    q = rng.uniform(-3.0, 5.0, size=(400, dim))
+    d = obstacles.surface(q).distances
+    q = q[np.all(d > 0.05, axis=1) & np.any(d < clearance - 0.05, axis=1)][:12]
+    assert len(q) >= 6
+    terms = obstacle_terms(q, obstacles.surface(q), jump, clearance, np.full(len(q), 10.0))
+    step = 1e-6
+    for i in range(len(q)):
+        for axis in range(dim):
+            up, down = q.copy(), q.copy()
+            up[i, axis] += step
+            down[i, axis] -= step
+            slope = (log_obstacle_factor(up, obstacles, jump, kappa)
+                     - log_obstacle_factor(down, obstacles, jump, kappa)) / (2.0 * step)
+            assert -kappa * terms[i, axis] == pytest.approx(slope, rel=1e-5, abs=1e-6)
+
+
+def test_only_obstacles_within_the_clearance_and_the_sensing_radius_count():
+    jump = make_jump('poly', 2)
+    obstacles = Obstacles([0.0, 0.0, 1.0], [], [], 0.5, 2)
+    q = np.array([[1.3, 0.0], [1.6, 0.0], [1.3, 0.0]])
+    before = q.copy()
+    terms = obstacle_terms(q, obstacles.surface(q), jump, 0.5, [1.0, 1.0, 0.25])
+    assert np.array_equal(q, before)
+    assert terms[0, 0] > 0.0 and terms[0, 1] == 0.0
+    assert np.all(terms[1:] == 0.0)
+    assert obstacle_beta([0.6, 0.5, 0.2, 0.0, -0.1], jump, 0.5).tolist()[:2] == [1.0, 1.0]
+    assert obstacle_beta([0.0, -0.1], jump, 0.5).tolist() == [0.0, 0.0]
+
+
+def test_a_robot_on_or_inside_an_obstacle_is_pushed_out_at_the_cap():
+    jump = make_jump('smooth', 2)
+    obstacles = Obstacles([0.0, 0.0, 1.0], [], [0.0, 0.0, 5.0, 1.0], 0.5, 3)
+    q = np.array([[0.0, 0.5, 0.0], [0.0, 1.0, 3.0], [0.0, 0.0, 5.5]])
+    terms = obstacle_terms(q, obstacles.surface(q), jump, 0.5, np.full(3, 2.0))
+    assert np.array_equal(terms[0], [0.0, MAX_OBSTACLE_REPULSION, 0.0])
+    assert np.array_equal(terms[1], [0.0, MAX_OBSTACLE_REPULSION, 0.0])
+    assert np.array_equal(terms[2], [MAX_OBSTACLE_REPULSION, 0.0, MAX_OBSTACLE_REPULSION])
+    assert log_obstacle_factor(q[:1], obstacles, jump, 1.0) == math.inf
+
+
+@pytest.mark.parametrize('kwargs,message', [
+    ({'circles': [0.0, 0.0]}, 'circles takes 3 numbers'),
+    ({'circles': [0.0, 0.0, -1.0]}, 'radius must be > 0'),
+    ({'walls': [0.0, 0.0, 1.0, 1.0, 0.0]}, 'half-thickness must be > 0'),
+    ({'spheres': [0.0, 0.0, 0.0, 1.0]}, 'spheres are 3D obstacles'),
+    ({'circles': [math.nan, 0.0, 1.0]}, 'must be finite'),
+    ({'clearance': 0.0}, 'clearance must be'),
+])
+def test_invalid_obstacles_are_refused_with_the_reason(kwargs, message):
+    values = {'circles': [], 'walls': [], 'spheres': [], 'clearance': 0.5, 'dim': 2, **kwargs}
+    with pytest.raises(ValueError, match=message):
+        Obstacles(**values)
+
+
+def test_the_obstacles_keep_their_own_copies():
+    circles = np.array([0.0, 0.0, 1.0])
+    obstacles = Obstacles(circles, [], [], 0.5, 2)
+    circles[2] = 5.0
+    assert obstacles.circles[0, 2] == 1.0 and obstacles.count == 1
+    with pytest.raises(ValueError):
+        obstacles.circles[0, 2] = 2.0
