@@ -12,8 +12,10 @@ difference of the obstacles' part of log(phi + 1), for every jump kind, in 2D an
 import math
 
 from formation_ros.core.maths.jump import make_jump
+from formation_ros.core.maths.law import log_potential, make_law, robot_command, team_command
 from formation_ros.core.maths.obstacles import (log_obstacle_factor, MAX_OBSTACLE_REPULSION,
                                                 obstacle_beta, obstacle_terms, Obstacles)
+from formation_ros.core.maths.reference import Reference
 import numpy as np
 import pytest
 
@@ -157,3 +159,59 @@ def test_the_obstacles_keep_their_own_copies():
     assert obstacles.circles[0, 2] == 1.0 and obstacles.count == 1
     with pytest.raises(ValueError):
         obstacles.circles[0, 2] = 2.0
+
+
+def law_and_team(dim, kind='poly', order=2):
+    law = make_law(0.3, 0.05, 'arctan', kind, order, 0.6)
+    rng = np.random.default_rng(5 + dim)
+    obstacles = Obstacles(CIRCLES, WALLS, SPHERES if dim == 3 else [], 0.5, dim)
+    q = rng.uniform(-3.0, 5.0, size=(300, dim))
+    d = obstacles.surface(q).distances
+    q = q[np.all(d > 0.1, axis=1)][:8]
+    q = q[np.all(np.linalg.norm(q[:, None] - q[None], axis=2) + np.eye(len(q)) > 0.1, axis=1)]
+    return law, obstacles, q, rng.uniform(-1.0, 1.0, size=q.shape)
+
+
+@pytest.mark.parametrize('kind,order', JUMPS)
+@pytest.mark.parametrize('dim', [2, 3])
+def test_omega_with_obstacles_is_the_gradient_of_the_log_potential(kind, order, dim):
+    law, obstacles, q, vertices = law_and_team(dim, kind, order)
+    radii = np.full(len(q), 10.0)
+    command = team_command(q, vertices, radii, law, obstacles=obstacles)
+    step = 1e-6
+    for i in range(len(q)):
+        for axis in range(dim):
+            up, down = q.copy(), q.copy()
+            up[i, axis] += step
+            down[i, axis] -= step
+            slope = (log_potential(up, vertices, law, obstacles=obstacles)
+                     - log_potential(down, vertices, law, obstacles=obstacles)) / (2.0 * step)
+            assert command.omega[i, axis] == pytest.approx(slope, rel=1e-5, abs=1e-6)
+
+
+@pytest.mark.parametrize('dim', [2, 3])
+def test_one_robot_and_the_team_agree_with_obstacles_in_a_moving_frame(dim):
+    law, obstacles, q, vertices = law_and_team(dim)
+    reference = Reference('circle' if dim == 2 else 'helix', dim, origin=[0.5] * dim,
+                          radius=2.0, speed=0.4, pitch=1.0)
+    frame = reference.sample(3.0)
+    radii = np.linspace(0.6, 3.0, len(q))
+    team = team_command(q, vertices, radii, law, frame, obstacles=obstacles)
+    for i in range(len(q)):
+        others = np.delete(q, i, axis=0)
+        one = robot_command(q[i], vertices[i], others, radii[i], law, frame, obstacles)
+        assert np.allclose(one.u, team.u[i], rtol=1e-12, atol=1e-12)
+    bare = team_command(q, vertices, radii, law, frame)
+    near = np.any(obstacles.surface(q).distances < obstacles.clearance, axis=1)
+    assert np.any(near) and not np.allclose(team.omega[near], bare.omega[near])
+    assert np.array_equal(team.omega[~near], bare.omega[~near])
+
+
+def test_the_command_stays_bounded_on_and_inside_obstacles():
+    law = make_law(0.3, 0.05, 'tanh', 'smooth', 2, 0.6)
+    obstacles = Obstacles(CIRCLES, WALLS, [], 0.5, 2)
+    q = np.array([[0.0, 1.0], [0.2, 0.1], [0.0, -2.9], [3.0, 2.4000001]])
+    command = team_command(q, np.zeros_like(q), np.full(4, 2.0), law, obstacles=obstacles)
+    assert np.all(np.isfinite(command.u))
+    assert np.max(np.abs(command.u_hat)) <= law.u_bound
+    assert command.u_hat[0, 1] == pytest.approx(law.u_bound)

@@ -22,6 +22,7 @@ from formation_ros.core.maths.choice import Choice
 from formation_ros.core.maths.frames import (FrameSample, from_frame_velocity, STATIONARY,
                                              to_frame, to_frame_vectors)
 from formation_ros.core.maths.jump import JumpFunction, JumpKind, make_jump
+from formation_ros.core.maths.obstacles import log_obstacle_factor, obstacle_terms, Obstacles
 from formation_ros.core.maths.pairs import (pairs_within, row_differences, sorted_pairs,
                                             squared_norms)
 import numpy as np
@@ -182,26 +183,29 @@ class Command:
 
 def robot_command(q_i: ArrayLike, vertex_i: ArrayLike, neighbours: ArrayLike,
                   sensing_radius: float, law: LawParams,
-                  frame: Optional[FrameSample] = STATIONARY) -> Command:
+                  frame: Optional[FrameSample] = STATIONARY,
+                  obstacles: Optional[Obstacles] = None) -> Command:
     """
     Control of one robot from what it knows (eqs. 13, 14, 21, 25).
 
     q_i: (dim,) own position, world frame, m. vertex_i: (dim,) own place in the formation frame.
     neighbours: (K, dim) positions the robot has sensed, world frame; those at distance
     >= ``sensing_radius`` (R_i) are ignored. frame: a ``FrameSample`` of the reference (the
-    default is stabilisation: q_od = 0, J = I). Returns a :class:`Command` with (dim,) arrays.
+    default is stabilisation: q_od = 0, J = I); obstacles: the static obstacles, if any
+    (docs/equations.md, "Obstacles"). Returns a :class:`Command` with (dim,) arrays.
     """
     q_i = np.asarray(q_i, dtype=float)
     neighbours = np.asarray(neighbours, dtype=float).reshape(-1, q_i.shape[0])
     command = robot_commands(q_i[None, :], np.asarray(vertex_i, dtype=float)[None, :],
                              np.zeros(len(neighbours), dtype=np.intp), neighbours,
-                             [sensing_radius], law, frame)
+                             [sensing_radius], law, frame, obstacles)
     return Command(u=command.u[0], u_hat=command.u_hat[0], omega=command.omega[0])
 
 
 def robot_commands(q_own: ArrayLike, vertices: ArrayLike, observer: ArrayLike,
                    neighbours: ArrayLike, sensing_radii: ArrayLike, law: LawParams,
-                   frame: Optional[FrameSample] = STATIONARY) -> Command:
+                   frame: Optional[FrameSample] = STATIONARY,
+                   obstacles: Optional[Obstacles] = None) -> Command:
     """
     Control of K robots, each from what it knows: :func:`robot_command` for all in one call.
 
@@ -210,8 +214,9 @@ def robot_commands(q_own: ArrayLike, vertices: ArrayLike, observer: ArrayLike,
     (P, dim) world positions, row p a neighbour robot ``observer[p]`` has sensed (as the rows
     of each robot's ``neighbours``, in the same order: the sums run in that order); those at
     distance >= R_i (``sensing_radii``, (K,) m) of their observer are ignored. frame: the
-    reference's ``FrameSample`` (one for all). Returns a :class:`Command` with (K, dim) arrays;
-    :func:`robot_command` is this for K = 1.
+    reference's ``FrameSample`` (one for all); obstacles: the static obstacles, each robot
+    using those within its R_i (:func:`obstacle_sum`). Returns a :class:`Command` with (K, dim)
+    arrays; :func:`robot_command` is this for K = 1.
     """
     q_own = np.asarray(q_own, dtype=float)
     k, dim = q_own.shape
@@ -221,7 +226,10 @@ def robot_commands(q_own: ArrayLike, vertices: ArrayLike, observer: ArrayLike,
     in_range = np.einsum('kd,kd->k', q_ij, q_ij) < radii[observer] ** 2
     terms = repulsion_terms(to_frame_vectors(q_ij[in_range], frame), law)
     heard = observer[in_range]
-    rep = np.stack([np.bincount(heard, terms[:, axis], k) for axis in range(dim)], axis=1)
+    rep: NDArray[np.float64] = np.stack([np.bincount(heard, terms[:, axis], k)
+                                         for axis in range(dim)], axis=1)
+    if obstacles is not None:
+        rep = rep + obstacle_sum(q_own, radii, law, frame, obstacles)
     error_hat = to_frame(q_own, frame) - np.asarray(vertices, dtype=float)
     omega_hat = omega(error_hat, rep, law)
     u_hat = bounded_command(omega_hat, law)
@@ -246,7 +254,8 @@ def neighbour_pairs(q: ArrayLike, radius: float,
 def team_command(q: ArrayLike, vertices: ArrayLike, sensing_radii: ArrayLike, law: LawParams,
                  frame: Optional[FrameSample] = STATIONARY,
                  tree: Optional['cKDTree'] = None,
-                 pairs: Optional[NDArray[np.intp]] = None) -> Command:
+                 pairs: Optional[NDArray[np.intp]] = None,
+                 obstacles: Optional[Obstacles] = None) -> Command:
     """
     Control of every robot at once (the vectorised form of :func:`robot_command`).
 
@@ -257,7 +266,8 @@ def team_command(q: ArrayLike, vertices: ArrayLike, sensing_radii: ArrayLike, la
     or robots farther apart than about 1e150 m (the k-d tree cannot search them). tree: a k-d
     tree of ``q`` (world frame) if the caller has one, so a step builds one tree, not two;
     pairs: the (P, 2) pairs i < j within b of each other, if the caller has them (the plant
-    model keeps them for ``formation_sim``), so they are not searched again.
+    model keeps them for ``formation_sim``), so they are not searched again; obstacles: the
+    static obstacles, each robot using those within its R_i (:func:`obstacle_sum`).
     """
     q = np.asarray(q, dtype=float)
     radii = np.asarray(sensing_radii, dtype=float)
@@ -273,9 +283,29 @@ def team_command(q: ArrayLike, vertices: ArrayLike, sensing_radii: ArrayLike, la
     heard_by_i, heard_by_j = (_within(terms, d2, radii_sq[k]) for k in (i, j))
     rep = np.stack([np.bincount(i, heard_by_i[:, axis], n) - np.bincount(j, heard_by_j[:, axis], n)
                     for axis in range(dim)], axis=1)
+    if obstacles is not None:
+        rep = rep + obstacle_sum(q, radii, law, frame, obstacles)
     omega_hat = omega(q_hat - np.asarray(vertices, dtype=float), rep, law)
     u_hat = bounded_command(omega_hat, law)
     return Command(u=from_frame_velocity(u_hat, q, frame), u_hat=u_hat, omega=omega_hat)
+
+
+def obstacle_sum(q: ArrayLike, sensing_radii: ArrayLike, law: LawParams,
+                 frame: Optional[FrameSample], obstacles: Obstacles) -> NDArray[np.float64]:
+    """
+    Return each robot's sum over its obstacles of betabar'_io (q_i - p_io), formation frame.
+
+    q: (N, dim) world positions, m; sensing_radii: (N,) R_i, m. The obstacles' part of the
+    repulsion sum of eq. (13) (``core.maths.obstacles.obstacle_terms``, docs/equations.md,
+    "Obstacles") with the law's jump function, rotated into the formation frame as the pairs'
+    q_ij are. (N, dim) in 1/m; zeros without obstacles.
+    """
+    q = np.asarray(q, dtype=float)
+    if obstacles.count == 0:
+        return np.zeros_like(q)
+    terms = obstacle_terms(q, obstacles.surface(q), law.jump, obstacles.clearance,
+                           np.minimum(np.asarray(sensing_radii, dtype=float), RADIUS_MAX))
+    return to_frame_vectors(terms, frame)
 
 
 def _within(terms: NDArray[np.float64], d2: NDArray[np.float64],
@@ -289,13 +319,14 @@ def _within(terms: NDArray[np.float64], d2: NDArray[np.float64],
 
 
 def log_potential(q: ArrayLike, vertices: ArrayLike, law: LawParams,
-                  frame: Optional[FrameSample] = STATIONARY) -> float:
+                  frame: Optional[FrameSample] = STATIONARY,
+                  obstacles: Optional[Obstacles] = None) -> float:
     """
     Return log(phi + 1) = gamma - kappa * sum_{i<j} log beta_ij (eqs. 8-11), a float.
 
     phi itself overflows quickly (e**gamma / beta**kappa); its logarithm is monotone in phi and
     its gradient with respect to q_i (formation frame) is exactly Omega_i of eq. (13). Returns
-    +inf at a collision within b.
+    +inf at a collision within b. obstacles: their factors beta_io too (world positions).
     """
     q_hat = to_frame(np.asarray(q, dtype=float), frame)
     gamma = 0.5 * float(np.sum((q_hat - np.asarray(vertices, dtype=float)) ** 2))
@@ -303,7 +334,10 @@ def log_potential(q: ArrayLike, vertices: ArrayLike, law: LawParams,
     diff = q_hat[pairs[:, 0]] - q_hat[pairs[:, 1]]
     with np.errstate(divide='ignore'):
         log_beta = np.log(beta(np.einsum('kd,kd->k', diff, diff), law))
-    return gamma - law.kappa * float(np.sum(log_beta))
+    value = gamma - law.kappa * float(np.sum(log_beta))
+    if obstacles is not None:
+        value += log_obstacle_factor(np.asarray(q, dtype=float), obstacles, law.jump, law.kappa)
+    return value
 
 
 def potential(q: ArrayLike, vertices: ArrayLike, law: LawParams,
