@@ -1,0 +1,72 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""Obstacle metrics (runs/obstacle_metrics.py): closest approach, contacts, stuck robots."""
+
+import math
+
+from formation_ros.core.maths.obstacles import Obstacles
+from formation_ros.core.runs.obstacle_metrics import obstacle_metrics, stuck_robots
+import numpy as np
+import pytest
+
+PILLAR = Obstacles([0.0, 0.0, 1.0], [], [], 0.5, 2)
+
+
+def passing(xs, y):
+    """One robot at height y passing along x, a second far away: (T, 2, 2)."""
+    first = np.stack([xs, np.full_like(xs, y)], axis=1)
+    second = np.tile([10.0, 10.0], (len(xs), 1))
+    return np.stack([first, second], axis=1)
+
+
+def test_the_closest_approach_subtracts_the_footprint():
+    q = passing(np.linspace(-3.0, 3.0, 61), 1.3)
+    metrics = obstacle_metrics(q, PILLAR)
+    assert metrics['min_obstacle_clearance'] == pytest.approx(0.3)
+    assert metrics['obstacle_contacts'] == 0
+    footprint = obstacle_metrics(q, PILLAR, body_radius=0.1)
+    assert footprint['min_obstacle_clearance'] == pytest.approx(0.2)
+
+
+def test_each_stretch_in_contact_counts_once():
+    xs = np.concatenate([np.linspace(-3.0, 3.0, 61), np.linspace(3.0, -3.0, 61)])
+    q = passing(xs, 0.5)
+    inside = np.abs(xs) <= math.sqrt(1.0 - 0.25)
+    assert inside.any()
+    metrics = obstacle_metrics(q, PILLAR)
+    assert metrics['obstacle_contacts'] == 2
+    assert metrics['min_obstacle_clearance'] == pytest.approx(0.5 - 1.0)
+    assert obstacle_metrics(q[:1], PILLAR)['obstacle_contacts'] == 0
+    assert obstacle_metrics(passing(np.zeros(3), 0.0), PILLAR)['obstacle_contacts'] == 1
+
+
+def test_no_obstacles_no_clearance():
+    none = Obstacles([], [], [], 0.5, 2)
+    assert obstacle_metrics(passing(np.zeros(3), 0.0), none) == {
+        'min_obstacle_clearance': None, 'obstacle_contacts': 0}
+
+
+def test_a_robot_still_and_far_from_its_place_is_named_with_its_nearest_obstacle():
+    t = np.linspace(0.0, 20.0, 201)
+    xs = np.concatenate([np.linspace(-4.0, -1.2, 101), np.full(100, -1.2)])
+    q = passing(xs, 0.0)
+    q_desired = np.tile([[2.0, 0.0], [10.0, 10.0]], (len(t), 1, 1))
+    stuck = stuck_robots(t, q, q_desired, PILLAR)
+    assert [s.robot for s in stuck] == [0]
+    assert stuck[0].error == pytest.approx(3.2) and stuck[0].nearest == 0
+    assert stuck[0].gap == pytest.approx(0.2)
+    assert stuck[0].line() == ('robot 1 stuck at (-1.2, 0), 3.2 m from its place; nearest '
+                               'obstacle 1, 0.2 m away')
+    alone = stuck_robots(t, q, q_desired)[0]
+    assert alone.line() == 'robot 1 stuck at (-1.2, 0), 3.2 m from its place'
+
+
+def test_a_robot_still_moving_or_at_its_place_or_a_short_run_is_not_stuck():
+    t = np.linspace(0.0, 20.0, 201)
+    creeping = passing(np.linspace(-4.0, -1.2, 201), 0.0)
+    q_desired = np.tile([[2.0, 0.0], [10.0, 10.0]], (len(t), 1, 1))
+    assert stuck_robots(t, creeping, q_desired, PILLAR) == []
+    arrived = np.tile([[2.0, 0.0], [10.0, 10.0]], (len(t), 1, 1))
+    assert stuck_robots(t, arrived, q_desired, PILLAR) == []
+    assert stuck_robots(t[:10], arrived[:10] + 5.0, q_desired[:10], PILLAR) == []
