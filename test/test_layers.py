@@ -148,3 +148,15 @@ def test_the_package_works_without_mujoco():
                             cwd=ROOT, timeout=120)
     assert result.returncode == 0, result.stderr
     assert json.loads(result.stdout.strip().splitlines()[-1]) == [0.002, False]
+
+
+def test_no_module_of_the_package_is_ignored_by_git():
+    """A module git ignores is missing from every clone (a room once lost its __init__.py)."""
+    inside = subprocess.run(['git', 'rev-parse', '--is-inside-work-tree'], cwd=ROOT,
+                            capture_output=True, text=True)
+    if inside.returncode != 0:
+        pytest.skip('not a git checkout')
+    modules = [os.path.relpath(path, ROOT) for layer in FORBIDDEN for path in layer_files(layer)]
+    ignored = subprocess.run(['git', 'check-ignore', '--no-index', *modules], cwd=ROOT,
+                             capture_output=True, text=True)
+    assert ignored.returncode == 1 and not ignored.stdout, ignored.stdout
