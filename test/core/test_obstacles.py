@@ -51,6 +51,17 @@ def boundary_2d(circles, walls, per=20000):
     return shapes
 
 
+def central_gradient(function, q, step=1e-6):
+    """The gradient of a scalar function of positions q (N, dim) by central differences."""
+    slope = np.zeros_like(q)
+    for index in np.ndindex(*q.shape):
+        up, down = q.copy(), q.copy()
+        up[index] += step
+        down[index] -= step
+        slope[index] = (function(up) - function(down)) / (2.0 * step)
+    return slope
+
+
 def inside_2d(p, circles, walls):
     """Whether p is strictly inside each 2D shape, from the definitions."""
     result = [math.dist(p, c[:2]) < c[2] for c in np.reshape(circles, (-1, 3))]
@@ -103,15 +114,8 @@ def test_the_terms_are_the_gradient_of_the_obstacles_log_factor(kind, order, dim
     q = q[np.all(d > 0.05, axis=1) & np.any(d < clearance - 0.05, axis=1)][:12]
     assert len(q) >= 6
     terms = obstacle_terms(q, obstacles.surface(q), jump, clearance, np.full(len(q), 10.0))
-    step = 1e-6
-    for i in range(len(q)):
-        for axis in range(dim):
-            up, down = q.copy(), q.copy()
-            up[i, axis] += step
-            down[i, axis] -= step
-            slope = (log_obstacle_factor(up, obstacles, jump, kappa)
-                     - log_obstacle_factor(down, obstacles, jump, kappa)) / (2.0 * step)
-            assert -kappa * terms[i, axis] == pytest.approx(slope, rel=1e-5, abs=1e-6)
+    slope = central_gradient(lambda x: log_obstacle_factor(x, obstacles, jump, kappa), q)
+    assert np.allclose(-kappa * terms, slope, rtol=1e-5, atol=1e-6)
 
 
 def test_only_obstacles_within_the_clearance_and_the_sensing_radius_count():
@@ -178,15 +182,8 @@ def test_omega_with_obstacles_is_the_gradient_of_the_log_potential(kind, order, 
     law, obstacles, q, vertices = law_and_team(dim, kind, order)
     radii = np.full(len(q), 10.0)
     command = team_command(q, vertices, radii, law, obstacles=obstacles)
-    step = 1e-6
-    for i in range(len(q)):
-        for axis in range(dim):
-            up, down = q.copy(), q.copy()
-            up[i, axis] += step
-            down[i, axis] -= step
-            slope = (log_potential(up, vertices, law, obstacles=obstacles)
-                     - log_potential(down, vertices, law, obstacles=obstacles)) / (2.0 * step)
-            assert command.omega[i, axis] == pytest.approx(slope, rel=1e-5, abs=1e-6)
+    slope = central_gradient(lambda x: log_potential(x, vertices, law, obstacles=obstacles), q)
+    assert np.allclose(command.omega, slope, rtol=1e-5, atol=1e-6)
 
 
 @pytest.mark.parametrize('dim', [2, 3])
