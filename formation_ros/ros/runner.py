@@ -22,11 +22,11 @@ have to be set in a ``preexec_fn``, which is unsafe in a launcher whose relay th
 """
 
 import ctypes
+import faulthandler
 import gc
 import os
 import signal
 import sys
-import threading
 import time
 from typing import Any, Callable, List, Mapping, Optional, Sequence, Union
 
@@ -45,9 +45,12 @@ SIGNAL_LATENCY = 0.1
 TEARDOWN_LIMIT = 5.0
 """
 Seconds the destruction of the nodes and rclpy's shutdown may take once every node has finished
-(its files written): they take well under a second, but a Fast DDS lock-order deadlock between
-a reader being destroyed and the liveliness thread can hang them for ever (seen once in about
-90 launcher kills), and signals are ignored by then. The process then ends without them.
+(its files written): they take well under a second, but Fast DDS (2.14) can hang in them for
+ever, and signals are ignored by then. Seen in 2 of 360 launcher kills on a busy machine: the
+participant's destruction spinning in ``DomainParticipant::set_listener`` until no discovery
+callback runs, while a callback about a peer's reader or writer gone at the same moment waits
+for the participant's lock, which that loop keeps taking. The process then ends without them,
+with exit code 1 (:func:`_watch_teardown`).
 """
 
 
@@ -170,6 +173,28 @@ def _exit_now(code: int) -> None:
     teardown, which destroys the DDS participant and took about a second on a busy machine,
     while nobody waits for this process any more. Python's and C's output is flushed first.
     """
+    _flush_output()
+    os._exit(code)
+
+
+def _watch_teardown() -> None:
+    """
+    End the process with exit code 1 unless the teardown is done within TEARDOWN_LIMIT s.
+
+    The watchdog is faulthandler's thread, which runs without the GIL. A Python thread (a
+    ``threading.Timer``) cannot be one: rclpy holds the GIL through its calls into rcl and
+    Fast DDS, so a timer whose time is up waits for the GIL as long as the hang lasts (seen
+    20 s after the launcher's kill: the timer's thread in ``take_gil``, the main thread still
+    destroying the participant). Before it ends the process, the watchdog writes every thread's
+    stack to stderr (file descriptor 2), where the hang shows; it cannot keep the process's own
+    exit code. The output so far is flushed now, as it would not be then.
+    """
+    _flush_output()
+    faulthandler.dump_traceback_later(TEARDOWN_LIMIT, exit=True, file=2)
+
+
+def _flush_output() -> None:
+    """Flush Python's stdout and stderr, and C's streams (what os._exit would not)."""
     for stream in (sys.stdout, sys.stderr):
         try:
             stream.flush()
@@ -179,7 +204,6 @@ def _exit_now(code: int) -> None:
         ctypes.CDLL(None).fflush(None)
     except (OSError, AttributeError):
         pass
-    os._exit(code)
 
 
 def _exit_request(nodes: Sequence[Node]) -> Optional[int]:
@@ -223,9 +247,10 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
     (:data:`formation_ros.core.settings.exits.RECORDING_FAILED`), a plant that finds another team
     on its domain (:data:`formation_ros.core.settings.exits.REFUSED`); the node has said why, in
     its own line. Returns the exit code: 0; 1 if a node's ``finish()`` failed (the others still
-    finish); 2 for invalid parameters (one line per bad parameter) or a command line rclpy
-    cannot start from; a node's ``exit_code``. robots_rule: the process's limit on a parameters
-    file's ``num_robots`` (the world's), checked before rcl parses the file.
+    finish), and from a process whose teardown hung (:data:`TEARDOWN_LIMIT`); 2 for invalid
+    parameters (one line per bad parameter) or a command line rclpy cannot start from; a
+    node's ``exit_code``. robots_rule: the process's limit on a parameters file's
+    ``num_robots`` (the world's), checked before rcl parses the file.
     """
     if not _init(args, name, robots_rule):
         return REFUSED
@@ -283,22 +308,13 @@ def run(make_nodes: NodeFactory, args: Optional[List[str]] = None, name: str = '
         requested = _exit_request(nodes)
         if requested is not None and code == 0:
             code = requested
-        watchdog = threading.Timer(TEARDOWN_LIMIT, _teardown_hung, args=(name, code))
-        watchdog.daemon = True
-        watchdog.start()
+        _watch_teardown()
         for node in nodes:
             node.destroy_node()
         if executor is not None:
             executor.shutdown()
         rclpy.try_shutdown()
-        watchdog.cancel()
+        faulthandler.cancel_dump_traceback_later()
         if orphaned:
             _exit_now(code)
     return code
-
-
-def _teardown_hung(name: str, code: int) -> None:
-    """End a process whose DDS teardown has not returned in TEARDOWN_LIMIT s (work saved)."""
-    print(f'{name}: the DDS teardown did not end within {TEARDOWN_LIMIT:g} s; exiting without it',
-          file=sys.stderr)
-    _exit_now(code)
