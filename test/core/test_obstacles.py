@@ -52,7 +52,7 @@ def boundary_2d(circles, walls, per=20000):
 
 
 def central_gradient(function, q, step=1e-6):
-    """The gradient of a scalar function of positions q (N, dim) by central differences."""
+    """Return the gradient of a function of positions q (N, dim) by central differences."""
     slope = np.zeros_like(q)
     for index in np.ndindex(*q.shape):
         up, down = q.copy(), q.copy()

@@ -99,7 +99,7 @@ class Obstacles:
 
     @property
     def count(self) -> int:
-        """The number of obstacles M: circles, then walls, then spheres."""
+        """Return the number of obstacles M: circles, then walls, then spheres."""
         return len(self.circles) + len(self.walls) + len(self.spheres)
 
     def surface(self, q: ArrayLike) -> Surface:
