@@ -28,13 +28,13 @@ from formation_ros.core.maths.units import NS_PER_S
 from formation_ros.core.rules.admission import Reason
 from formation_ros.core.rules.answers import Act, AnswerPolicy
 from formation_ros.core.rules.control import Commands, Control, Sensed
-from formation_ros.core.rules.reference_track import reference_values, ReferenceTrack
+from formation_ros.core.rules.reference_track import ReferenceTrack
 from formation_ros.core.rules.robot_intake import Refused, StateIntake
 from formation_ros.core.rules.robot_status import startup_line, status_level, status_values
 from formation_ros.core.runs.timeline import Mode, Shape, TeamState
 from formation_ros.core.settings.declarations import CommandFrame, Exe, PoseType
 from formation_ros.core.settings.names import robot_name
-from formation_ros.core.settings.team import team_values
+from formation_ros.core.settings.team import reference_values, team_values
 from formation_ros.nodes.robots_link import RobotsLink
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import (PoseArrayData, PoseData, read_odometry, read_pose_array,
@@ -72,7 +72,7 @@ class RobotNode(Node):
 
         ``leader``: the first robot of this process (a fleet's other robots); this robot then
         hears the reference and the changes through it, with ``transport: team`` always, else
-        if it has the leader's ``core.rules.reference_track.reference_values``. ``reports``:
+        if it has the leader's ``core.settings.team.reference_values``. ``reports``:
         whether it publishes on /diagnostics itself (a fleet's first robot publishes the others'
         statuses, :attr:`reported`).
         """

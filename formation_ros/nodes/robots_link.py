@@ -22,6 +22,7 @@ from formation_ros.core.rules.robot_intake import Refused
 from formation_ros.core.rules.transport import command_vectors
 from formation_ros.core.settings.declarations import ParamError
 from formation_ros.core.settings.names import robot_name
+from formation_ros.core.settings.team import LINK_VALUES
 from formation_ros.ros import qos, topics
 from formation_ros.ros.cdr import (encode_names, encode_team_commands, PoseArrayData, PoseData,
                                    read_pose_array)
@@ -38,12 +39,6 @@ if TYPE_CHECKING:
 
 LISTENER_LOOKS = 10
 """Robots without a cmd_vel publisher looked up in the graph per look, in turn."""
-TEAM_VALUES = ('num_robots', 'dim', 'world_frame', 'repulsion_radius', 'controller.gain',
-               'controller.kappa', 'controller.psi', 'jump.kind', 'jump.order', 'body.kind',
-               'body.hand_distance', 'command.type', 'command.frame', 'plant.lockstep',
-               'transport')
-"""Parameters the robots of one link share: one call of the law computes their commands (the
-watchdog and input timeout are the leader's)."""
 
 
 class RobotsLink:
@@ -53,14 +48,14 @@ class RobotsLink:
 
     def __init__(self, nodes: Sequence['RobotNode']) -> None:
         """
-        Link ``nodes`` (team transport, sharing :data:`TEAM_VALUES`; ParamError if not).
+        Link ``nodes`` (team transport, sharing :data:`LINK_VALUES`; ParamError if not).
 
         The first is the leader; the link's rows are the robots in id order.
         """
         leader = self.leader = nodes[0]
         self.nodes = sorted(nodes, key=lambda node: node.index)
         config = leader.config
-        differing = [name for name in TEAM_VALUES for node in self.nodes[1:]
+        differing = [name for name in LINK_VALUES for node in self.nodes[1:]
                      if node.config.values.get(name) != config.values.get(name)]
         if differing:
             raise ParamError([(differing[0], 'must be the same for every robot of a process '
