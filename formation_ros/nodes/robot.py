@@ -36,7 +36,7 @@ from formation_ros.core.runs.timeline import Shape, TeamState
 from formation_ros.core.settings.declarations import CommandFrame, Exe, PoseType
 from formation_ros.core.settings.names import robot_name
 from formation_ros.core.settings.team import reference_values, team_values
-from formation_ros.nodes.robots_link import LinkedRobot, RobotsLink
+from formation_ros.nodes.robots_link import Linked, RobotsLink
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import (PoseArrayData, PoseData, read_odometry, read_pose_array,
                                    read_pose_stamped, StatusData)
@@ -122,8 +122,8 @@ class RobotNode(Node):
         self.first: RobotNode = self
         """The robot that hears the reference and the changes for this one (or itself)."""
         self.followers: List[RobotNode] = []
-        self.link: Optional[RobotsLink] = None
-        """The process's link to its robots (team transport), once :meth:`join` ed."""
+        self.linked: Optional[Linked] = None
+        """What this robot's link tells of it (team transport), once :meth:`join` ed."""
         self.answering = self.policy
         """The policy of the robot that answers for this one (its link's leader, or itself)."""
         if not config.team_transport:
@@ -163,12 +163,14 @@ class RobotNode(Node):
         self.get_logger().info(startup_line(config, self.index, self.command_frame,
                                             self.sim_time))
 
-    def serve(self, output: Output, control: Control, senses: Callable[[], Sensed]) -> None:
+    def serve(self, output: Output, control: Control,
+              senses: Callable[[], Sensed]) -> RobotCore:
         """
         Answer, through ``output``, the states of the robots ``control`` commands (once).
 
         senses: what they know of the state heard last; a robot alone serves itself, a link's
-        first robot all of the link's robots. Out of lockstep its watchdog starts.
+        first robot all of the link's robots. Out of lockstep its watchdog starts. Return the
+        core that decides.
         """
         assert self.core is None
         self.output = output
@@ -178,10 +180,11 @@ class RobotNode(Node):
         if not self.lockstep:
             self.watchdog = Wake(self, self.on_watchdog, self.steady)
             self.watchdog.arm(self.watch_ns / NS_PER_S)
+        return self.core
 
-    def join(self, link: RobotsLink, leader: LinkedRobot) -> None:
-        """Be one of ``link``'s robots; its ``leader`` answers for all."""
-        self.link, self.answering = link, leader.policy
+    def join(self, linked: Linked, answering: AnswerPolicy) -> None:
+        """Be one of a link's robots: ``linked`` tells of it, ``answering`` answers for all."""
+        self.linked, self.answering = linked, answering
 
     def _subscribe_to_states(self, pose_type: PoseType) -> None:
         """Robot transport: hear this robot's ``pose`` and ``neighbors``."""
@@ -361,8 +364,8 @@ class RobotNode(Node):
 
     def diagnostic_status(self) -> StatusData:
         """Return this robot's status (``core.rules.robot_status``) with its team values."""
-        if self.link is not None:
-            self.link.report_to(self)
+        if self.linked is not None:
+            self.linked.report()
         else:
             self.last = self.command_of(0)
         policy, now = self.answering, self.now_ns()
@@ -379,8 +382,8 @@ class RobotNode(Node):
         values.update({f'rejected {name} messages ({reason.value})': count
                        for (name, reason), count in self.inputs.refused.items()})
         values['states not answered (flooding)'] = policy.flooded
-        if self.link is not None:
-            values['cmd_vel published'] = self.link.publishes_cmd_vel(self.index)
+        if self.linked is not None:
+            values['cmd_vel published'] = self.linked.publishes_cmd_vel()
         flooding, self.flooded_reported = policy.flooded > self.flooded_reported, policy.flooded
         shared = self.inputs.shared_topics() if self.first is self else self.first.inputs.shared
         if shared:

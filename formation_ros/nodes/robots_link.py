@@ -21,6 +21,7 @@ from formation_ros.core.model.bodies import make_bodies
 from formation_ros.core.rules.admission import Reason
 from formation_ros.core.rules.answers import AnswerPolicy
 from formation_ros.core.rules.control import Control, Sensed
+from formation_ros.core.rules.robot_core import RobotCore
 from formation_ros.core.rules.robot_intake import Refused
 from formation_ros.core.rules.transport import command_vectors
 from formation_ros.core.settings.declarations import ParamError
@@ -75,17 +76,31 @@ class LinkedRobot(Protocol):
             last: Optional[Tuple[Command, Optional[NDArray[np.float64]]]] = None) -> None:
         """Take the robot's pose and neighbours in a state the link read."""
 
-    def command_of(self, k: int) -> Optional[Tuple[Command, Optional[NDArray[np.float64]]]]:
-        """Return row ``k`` of the commands computed last."""
-
-    def serve(self, output: Output, control: Control, senses: Callable[[], Sensed]) -> None:
+    def serve(self, output: Output, control: Control,
+              senses: Callable[[], Sensed]) -> RobotCore:
         """Answer through ``output`` the states of the robots ``control`` commands."""
 
-    def join(self, link: 'RobotsLink', leader: 'LinkedRobot') -> None:
-        """Be one of ``link``'s robots, ``leader`` answering for all."""
+    def join(self, linked: 'Linked', answering: AnswerPolicy) -> None:
+        """Be one of a link's robots: ``linked`` tells of it, ``answering`` answers for all."""
 
     def on_state(self) -> None:
         """Answer the state taken."""
+
+
+class Linked:
+    """What a link tells one of its robots (its diagnostics), without the robot holding it."""
+
+    def __init__(self, link: 'RobotsLink', node: LinkedRobot) -> None:
+        """Tell ``node`` of ``link``."""
+        self._link, self._node = link, node
+
+    def report(self) -> None:
+        """Give the robot what it would have heard and computed (``RobotsLink.report_to``)."""
+        self._link.report_to(self._node)
+
+    def publishes_cmd_vel(self) -> str:
+        """Return 'yes' while the robot's own cmd_vel is published (someone listens)."""
+        return self._link.publishes_cmd_vel(self._node.index)
 
 
 class RobotsLink:
@@ -139,8 +154,8 @@ class RobotsLink:
         for node in self.nodes:
             if node is not leader:
                 leader.state_clock.join(node.state_clock)
-            node.join(self, leader)
-        leader.serve(self, self.control, self.sensed)
+            node.join(Linked(self, node), leader.policy)
+        self.core = leader.serve(self, self.control, self.sensed)
         self.pub = leader.create_publisher(MultiDOFJointTrajectory, topics.TEAM_COMMANDS,
                                            qos.COMMAND)
         self.wake = Wake(leader, self.on_wake, leader.steady)
@@ -208,12 +223,13 @@ class RobotsLink:
             return
         k = int(self.local[node.index])
         seen = self.seen[self.bounds[k]:self.bounds[k + 1]]
+        latest = self.core.latest
         node.see(PoseData(state.stamp_ns, state.frame_id,
                           tuple(state.positions[node.index].tolist()),
                           tuple(state.orientations[node.index].tolist())),
                  PoseArrayData(state.stamp_ns, state.frame_id, state.positions[seen],
                                state.orientations[seen]),
-                 self.taken_ns, new, self.leader.command_of(k))
+                 self.taken_ns, new, None if latest is None else latest.row(k))
 
     def report_to(self, node: LinkedRobot) -> None:
         """Give robot ``node`` what it would have heard and computed (its diagnostics)."""
