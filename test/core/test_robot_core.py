@@ -106,7 +106,7 @@ def started(robot, stamp_ns=START, now_ns=STEADY):
 
 
 def expected(robot, stamp_ns):
-    """The commands of the law at the frame evaluated for ``stamp_ns``: (1, 2)."""
+    """Return the commands of the law at the frame evaluated for ``stamp_ns``: (1, 2)."""
     vertices = robot.changes.shapes.at(stamp_ns).vertices[[0]]
     return robot.control.commands(robot.sensed(), vertices,
                                   robot.timeline.frame_at(stamp_ns)).published
