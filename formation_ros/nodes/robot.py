@@ -6,11 +6,12 @@ Robot node (executable ``robot``): one robot's bounded formation controller.
 
 :class:`RobotNode` adapts messages and timers to the robot's rules, which hold no ROS: what it
 takes of its states and their clock (``core.rules.robot_intake``), the reference it follows
-(``core.rules.reference_track``), which states it answers and when its watchdog looks
-(``core.rules.answers``), and its commands (``core.rules.control``). Callbacks read the bytes
-(``ros.cdr``), store and arm a one-shot timer (``ros.wake``) that answers; the command goes out
-through one output: the robot's ``cmd_vel`` (:class:`CmdVelOutput`), or with ``transport:
-team`` its process's link (``nodes.robots_link``). Topics, parameters and behaviour:
+(``core.rules.reference_track``), and what it answers, when, and with which commands
+(``core.rules.robot_core.RobotCore``). Callbacks read the bytes (``ros.cdr``), admit and note
+them in the core and arm a one-shot timer (``ros.wake``) that asks the core and does what it
+answers through one output: the robot's ``cmd_vel`` (:class:`CmdVelOutput`), or with
+``transport: team`` its process's link (``nodes.robots_link``), which serves the first robot
+with a core of all its robots. Topics, parameters and behaviour:
 docs/ros_interface.md ("Nodes", "Behaviour of the nodes", "Transports"); faults:
 docs/faults.md. One per robot::
 
@@ -22,20 +23,20 @@ import time
 from typing import Any, Callable, Dict, List, Optional, Tuple
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros.core.maths.frames import FrameSample
 from formation_ros.core.maths.law import Command
 from formation_ros.core.maths.units import NS_PER_S
 from formation_ros.core.rules.admission import Reason
-from formation_ros.core.rules.answers import Act, AnswerPolicy
-from formation_ros.core.rules.control import Commands, Control, Sensed
-from formation_ros.core.rules.reference_track import reference_values, ReferenceTrack
+from formation_ros.core.rules.answers import AnswerPolicy
+from formation_ros.core.rules.control import Control, Sensed
+from formation_ros.core.rules.reference_track import ReferenceTrack
+from formation_ros.core.rules.robot_core import Answer, Note, RobotCore, Said, Wake as Due
 from formation_ros.core.rules.robot_intake import Refused, StateIntake
 from formation_ros.core.rules.robot_status import startup_line, status_level, status_values
-from formation_ros.core.runs.timeline import Mode, Shape, TeamState
+from formation_ros.core.runs.timeline import Shape, TeamState
 from formation_ros.core.settings.declarations import CommandFrame, Exe, PoseType
 from formation_ros.core.settings.names import robot_name
-from formation_ros.core.settings.team import team_values
-from formation_ros.nodes.robots_link import RobotsLink
+from formation_ros.core.settings.team import reference_values, team_values
+from formation_ros.nodes.robots_link import Linked, RobotsLink
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import (PoseArrayData, PoseData, read_odometry, read_pose_array,
                                    read_pose_stamped, StatusData)
@@ -72,7 +73,7 @@ class RobotNode(Node):
 
         ``leader``: the first robot of this process (a fleet's other robots); this robot then
         hears the reference and the changes through it, with ``transport: team`` always, else
-        if it has the leader's ``core.rules.reference_track.reference_values``. ``reports``:
+        if it has the leader's ``core.settings.team.reference_values``. ``reports``:
         whether it publishes on /diagnostics itself (a fleet's first robot publishes the others'
         statuses, :attr:`reported`).
         """
@@ -94,7 +95,7 @@ class RobotNode(Node):
                               else config.world_frame)
         self.control = Control(self.law, [self.sensing_radius], self.dim, self.unicycle,
                                config.body.hand_distance, body_frame)
-        """The law of the robots whose commands this node computes (a link's: all of them)."""
+        """This robot's law and command frame (what it senses, its diagnostics)."""
         self.evaluates = config.team_transport or self.sim_time
         """Whether this robot evaluates the reference at each state's stamp itself."""
         self.once = OnceLog(self.get_logger())
@@ -112,19 +113,19 @@ class RobotNode(Node):
                                    self.watch_ns, settings.wait_for_subscribers)
         self.pose: Optional[PoseData] = None
         self.neighbours: Optional[PoseArrayData] = None
-        self.awaiting_neighbours = False
-        self.latest: Optional[Commands] = None
-        """The commands computed last (K rows: this robot's, or every robot's of its link)."""
+        self.core: Optional[RobotCore] = None
+        """What decides this robot's answers (a link's first robot: all of its robots'); None
+        for a link's other robots, answered by the first."""
         self.last: Optional[Tuple[Command, Optional[NDArray[np.float64]]]] = None
         """This robot's latest command and its published form (diagnostics)."""
         self.flooded_reported = 0
         self.first: RobotNode = self
         """The robot that hears the reference and the changes for this one (or itself)."""
         self.followers: List[RobotNode] = []
-        self.link: Optional[RobotsLink] = None
-        """The process's link to its robots (team transport), once :meth:`join` ed."""
-        self.answering: RobotNode = self
-        """The robot that answers for this one (its link's leader, or itself)."""
+        self.linked: Optional[Linked] = None
+        """What this robot's link tells of it (team transport), once :meth:`join` ed."""
+        self.answering = self.policy
+        """The policy of the robot that answers for this one (its link's leader, or itself)."""
         if not config.team_transport:
             self._subscribe_to_states(settings.pose_type)
         if shares and leader is not None:
@@ -145,10 +146,8 @@ class RobotNode(Node):
         self.cmd_vel = CmdVel(self, config.command.stamped, self.command_frame,
                               config.team_transport,
                               config.team_transport and settings.wait_for_subscribers <= 1)
-        self.output: Optional[Output] = (None if config.team_transport
-                                         else CmdVelOutput(self.cmd_vel, self.control))
+        self.output: Optional[Output] = None
         """Where this robot's commands go (None: a link's robot its leader answers for)."""
-        self.senses: Callable[[], Sensed] = self._sensed_alone
         self.reported: List[RobotNode] = [self]
         """The robots whose statuses this node publishes (a fleet's first robot: all of its)."""
         self.announcing: Optional[Tuple[Shape, Dict[str, str]]] = None
@@ -159,17 +158,33 @@ class RobotNode(Node):
             self.create_timer(PERIOD, self.on_diagnostics, clock=self.steady)
         self.answer = Wake(self, self.on_state, self.steady)
         self.watchdog: Optional[Wake] = None
-        if not self.lockstep:
-            self.watchdog = Wake(self, self.on_watchdog, self.steady)
-            self.watchdog.arm(self.watch_ns / NS_PER_S)
+        if not config.team_transport:
+            self.serve(CmdVelOutput(self.cmd_vel, self.control), self.control, self._sensed_alone)
         self.get_logger().info(startup_line(config, self.index, self.command_frame,
                                             self.sim_time))
 
-    def join(self, link: 'RobotsLink', output: Optional[Output], control: Control,
-             senses: Callable[[], Sensed], leader: 'RobotNode') -> None:
-        """Be one of ``link``'s robots; its ``leader`` answers with ``output`` for all."""
-        self.link, self.output, self.answering = link, output, leader
-        self.control, self.senses = control, senses
+    def serve(self, output: Output, control: Control,
+              senses: Callable[[], Sensed]) -> RobotCore:
+        """
+        Answer, through ``output``, the states of the robots ``control`` commands (once).
+
+        senses: what they know of the state heard last; a robot alone serves itself, a link's
+        first robot all of the link's robots. Out of lockstep its watchdog starts. Return the
+        core that decides.
+        """
+        assert self.core is None
+        self.output = output
+        self.core = RobotCore(control, senses, self.policy, self.track, self.changes,
+                              output.listeners, output.what, self.lockstep, self.evaluates,
+                              self.timeout_ns)
+        if not self.lockstep:
+            self.watchdog = Wake(self, self.on_watchdog, self.steady)
+            self.watchdog.arm(self.watch_ns / NS_PER_S)
+        return self.core
+
+    def join(self, linked: Linked, answering: AnswerPolicy) -> None:
+        """Be one of a link's robots: ``linked`` tells of it, ``answering`` answers for all."""
+        self.linked, self.answering = linked, answering
 
     def _subscribe_to_states(self, pose_type: PoseType) -> None:
         """Robot transport: hear this robot's ``pose`` and ``neighbors``."""
@@ -210,13 +225,8 @@ class RobotNode(Node):
                               np.array([pose.orientation]))
         if self.admit_state('pose', state, self.needs_orientation, pose.finite):
             self.pose = pose
-            self.policy.heard(['pose'], self.now_ns(), state=True)
-            if self._paired():
-                self.awaiting_neighbours = False
-                self.answer.arm()
-            elif not self.lockstep:
-                self.awaiting_neighbours = True
-                self.answer.arm(self.watch_ns / NS_PER_S)
+            assert self.core is not None
+            self._arm(self.core.pose_heard(pose.stamp_ns, self.now_ns()))
 
     def on_neighbours(self, data: bytes) -> None:
         """Store the latest sensed neighbour positions, read from the serialized PoseArray."""
@@ -224,10 +234,15 @@ class RobotNode(Node):
         heard = self.inputs.read('neighbour', lambda raw: read_pose_array(raw, most), data)
         if heard is not None and self.admit_state('neighbour', heard, self.unicycle):
             self.neighbours = heard
-            self.policy.heard(['neighbour'], self.now_ns())
-            if self._paired():
-                self.awaiting_neighbours = False
-                self.answer.arm()
+            assert self.core is not None
+            self._arm(self.core.neighbours_heard(heard.stamp_ns, self.now_ns()))
+
+    def _arm(self, due: Due) -> None:
+        """Arm the answer when the core says it is due."""
+        if due.now:
+            self.answer.arm()
+        elif due.after_ns is not None:
+            self.answer.arm(due.after_ns / NS_PER_S)
 
     def see(self, pose: PoseData, neighbours: PoseArrayData, heard_ns: int, new: bool,
             last: Optional[Tuple[Command, Optional[NDArray[np.float64]]]] = None) -> None:
@@ -238,14 +253,12 @@ class RobotNode(Node):
         published form (diagnostics), if one was computed.
         """
         self.pose, self.neighbours = pose, neighbours
-        self.policy.heard(['pose', 'neighbour'], heard_ns, state=new)
+        if self.core is not None:
+            self.core.state_heard(pose.stamp_ns, heard_ns, new)
+        else:
+            self.policy.heard(['pose', 'neighbour'], heard_ns, state=new)
         if last is not None:
             self.last = last
-
-    def _paired(self) -> bool:
-        """Whether the pose and the neighbours stored are of one state (same stamp)."""
-        return (self.pose is not None and self.neighbours is not None
-                and self.neighbours.stamp_ns == self.pose.stamp_ns)
 
     def on_reference(self, data: bytes) -> None:
         """Keep a reference sample the track admits; wake the robots in lockstep."""
@@ -266,9 +279,10 @@ class RobotNode(Node):
 
     def reference_heard(self, now_ns: int) -> None:
         """Note a reference sample heard at ``now_ns`` (steady); answer it in lockstep."""
-        self.policy.heard(['reference'], now_ns)
-        if self.lockstep and self.output is not None:
-            self.answer.arm()
+        if self.core is None:
+            self.policy.heard(['reference'], now_ns)
+        else:
+            self._arm(self.core.reference_heard(now_ns))
 
     def _refuse_change(self, what: str, why: str) -> None:
         """Count and log once a shape or status refused (``ros.changes``)."""
@@ -280,115 +294,48 @@ class RobotNode(Node):
         """Admit reference samples as fast as the reference in force may be."""
         self.track.widen(state.reference(self.config.reference()).rate_limits())
 
-    def _frame_at(self, stamp_ns: int, exact: bool) -> Optional[FrameSample]:
-        """Return the reference frame at ``stamp_ns`` (``ReferenceTrack.frame_at``), or None."""
-        frame, gap = self.track.frame_at(stamp_ns, exact, self.evaluates, self.timeout_ns)
-        if gap is not None:
-            self.inputs.refuse('reference', Refused(Reason.CLOCK, gap_s=gap))
-        elif frame is not None:
-            self.inputs.on_clock('reference', 'reference on the clock of the states')
-        return frame
-
     def _sensed_alone(self) -> Sensed:
         """Return what this robot knows of the state stored (``Control.alone``)."""
         assert self.pose is not None and self.neighbours is not None
         return self.control.alone(self.index, self.pose.position, self.pose.orientation,
                                   self.neighbours.positions, self.neighbours.orientations)
 
-    def _commands(self, stamp_ns: int, exact: bool) -> Optional[NDArray[np.float64]]:
-        """Return the commands (K, width) answering the state ``stamp_ns``; None: zero."""
-        frame = self._frame_at(stamp_ns, exact)
-        if frame is None:
-            return None
-        if self.changes.differs:
-            self.once.start('other-shape', "following the reference's shape: it differs from "
-                                           "this robot's formation.vertices (another "
-                                           'parameters file?)', 'warning')
-        if self.changes.states.at(stamp_ns).mode is Mode.STOPPED:
-            self.once.start('stopped', 'team stopped: holding still', 'info')
-            return None
-        self.once.end('stopped', 'team running again')
-        sensed = self.senses()
-        vertices = self.changes.shapes.at(stamp_ns).vertices[sensed.indices]
-        self.latest = self.control.commands(sensed, vertices, frame)
-        return self.latest.published
-
     def on_state(self) -> None:
         """Answer a state as soon as its pose and neighbours are in (armed by the callbacks)."""
-        if self.output is None:
-            return
-        if self.lockstep:
-            self._answer_lockstep()
-        elif self._paired() or (self.awaiting_neighbours and self.neighbours is not None):
-            self.awaiting_neighbours = False
-            self._answer_newest()
+        if self.core is not None:
+            self._do(self.core.on_state(self.now_ns(), self.get_clock().now().nanoseconds))
 
     def on_watchdog(self) -> None:
         """Watchdog: zero while an input is stale, else answer a state left over; re-armed."""
-        if self.output is None:
-            return
-        self._answer_newest()
-        self._arm_watchdog()
+        if self.core is not None:
+            self._do(self.core.on_watchdog(self.now_ns(), self.get_clock().now().nanoseconds))
 
-    def _arm_watchdog(self) -> None:
-        if self.watchdog is not None:
-            self.watchdog.arm(self.policy.watchdog_delay_ns(self.now_ns()) / NS_PER_S)
-
-    def _ready(self, output: Output) -> bool:
-        """Start-up (``AnswerPolicy.missing``): say once what the robot waits for."""
-        missing = self.policy.missing(output.listeners(), output.what)
-        if missing:
-            self.once.start('waiting', f"waiting for {', '.join(missing)}", 'info')
-            return False
-        self.once.end('waiting')
-        output.started()
-        return True
-
-    def _answer_newest(self) -> None:
-        """Answer the newest state once: compute and publish its command (zero if stale)."""
-        output = self.output
-        if output is None or (self.policy.waiting and not self._ready(output)):
-            return
-        assert self.pose is not None
-        stamp = self.pose.stamp_ns
-        act = self.policy.newest(stamp, self.now_ns(), self.get_clock().now().nanoseconds)
-        if act is Act.ZERO:
-            output.publish(None, stamp)
-            self.once.start('stale', f"no new {', '.join(self.policy.stale)} for "
-                                     f'{self.timeout_ns / NS_PER_S:g} s: publishing zero')
-            return
-        self.once.end('stale', 'inputs fresh again: controlling')
-        self._act(output, act, stamp, False)
-
-    def _answer_lockstep(self) -> None:
-        """Answer each state the plant sends, once, with the reference sample of its stamp."""
-        output = self.output
-        if output is None or self.pose is None or not self.policy.unanswered:
-            return
-        if (self.policy.waiting and not self._ready(output)) or not self._paired():
-            return
-        stamp = self.pose.stamp_ns
-        if stamp != self.policy.answered_stamp and self._frame_at(stamp, True) is None:
-            return
-        act = self.policy.admit(stamp, self.now_ns(), self.get_clock().now().nanoseconds)
-        self._act(output, act, stamp, True)
-
-    def _act(self, output: Output, act: Act, stamp: int, exact: bool) -> None:
-        """Do what the policy decided for the state stamped ``stamp``."""
-        if act is Act.ANSWER:
-            output.publish(self._commands(stamp, exact), stamp)
-            self.policy.answered_state(stamp)
-            return
-        if act is Act.RESEND:
+    def _do(self, answer: Answer) -> None:
+        """Do what the core answered: start, log, publish or send again, look again."""
+        output, core = self.output, self.core
+        assert output is not None and core is not None
+        if answer.started:
+            output.started()
+        for note in answer.notes:
+            self._say(note)
+        if answer.publish:
+            output.publish(answer.commands, answer.stamp_ns)
+        elif answer.resend:
             output.resend()
-        elif act is Act.FLOOD:
-            period = self.policy.budget.period_ns / NS_PER_S
-            self.once.start('flooding', f'states arrive faster than one per {period:.3g} s '
-                                        "(the plant's or relay's period): answering at most "
-                                        'about one per period, the others are dropped (logged '
-                                        'once; counted in diagnostics)', 'warning')
-        if self.policy.unanswered:
-            self._arm_watchdog()
+        if answer.watchdog and self.watchdog is not None:
+            self.watchdog.arm(core.watchdog_delay_ns(self.now_ns()) / NS_PER_S)
+
+    def _say(self, note: Note) -> None:
+        """Log a core's note once (``ros.once``), or count a reference refused (``InputGate``)."""
+        if note.said is Said.START:
+            assert note.text is not None
+            self.once.start(note.key, note.text, note.level)
+        elif note.said is Said.END:
+            self.once.end(note.key, note.text or '')
+        elif note.said is Said.REFERENCE_CLOCK:
+            self.inputs.refuse('reference', Refused(Reason.CLOCK, gap_s=note.gap_s))
+        else:
+            self.inputs.on_clock('reference', 'reference on the clock of the states')
 
     def finish(self) -> None:
         """On a clean stop, command zero for the latest state and wait up to LAST_WORD s."""
@@ -412,15 +359,16 @@ class RobotNode(Node):
 
     def command_of(self, k: int) -> Optional[Tuple[Command, Optional[NDArray[np.float64]]]]:
         """Return row ``k`` of the commands computed last (``Commands.row``), None before."""
-        return None if self.latest is None else self.latest.row(k)
+        latest = None if self.core is None else self.core.latest
+        return None if latest is None else latest.row(k)
 
     def diagnostic_status(self) -> StatusData:
         """Return this robot's status (``core.rules.robot_status``) with its team values."""
-        if self.link is not None:
-            self.link.report_to(self)
+        if self.linked is not None:
+            self.linked.report()
         else:
             self.last = self.command_of(0)
-        policy, now = self.answering.policy, self.now_ns()
+        policy, now = self.answering, self.now_ns()
         points = None
         if self.neighbours is not None and self.pose is not None:
             sensed = self._sensed_alone()
@@ -434,8 +382,8 @@ class RobotNode(Node):
         values.update({f'rejected {name} messages ({reason.value})': count
                        for (name, reason), count in self.inputs.refused.items()})
         values['states not answered (flooding)'] = policy.flooded
-        if self.link is not None:
-            values['cmd_vel published'] = self.link.publishes_cmd_vel(self.index)
+        if self.linked is not None:
+            values['cmd_vel published'] = self.linked.publishes_cmd_vel()
         flooding, self.flooded_reported = policy.flooded > self.flooded_reported, policy.flooded
         shared = self.inputs.shared_topics() if self.first is self else self.first.inputs.shared
         if shared:

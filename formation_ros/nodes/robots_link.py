@@ -5,45 +5,102 @@
 A robot process's link to its robots with ``transport: team``: states in, commands out.
 
 :class:`RobotsLink` reads ``/formation/states`` once for every robot of a process (or fleet),
-admits it through its first robot (the leader, ``RobotNode.admit_state``), senses each robot's
-neighbours with the plant's sensing rule (``core.maths.sensing``) and is the leader's command
-output: every robot's command from one call of ``core.rules.control.Control``, in one
+admits it through its first robot (the leader, a :class:`LinkedRobot`: ``nodes.robot``'s node),
+senses each robot's neighbours with the plant's sensing rule (``core.maths.sensing``) and is the
+output the leader serves (``core.rules.robot_core``): every robot's command from one call of
+``core.rules.control.Control``, in one
 ``/formation/commands`` message, and on a robot's own ``cmd_vel`` while someone subscribes to
 it (``ros.on_demand``). The message layouts and rules: docs/ros_interface.md ("Transports").
 """
 
-from typing import List, Optional, Sequence, Tuple, TYPE_CHECKING
+from typing import Callable, List, Optional, Protocol, Sequence, Tuple
 
+from formation_ros.core.maths.law import Command, LawParams
 from formation_ros.core.maths.sensing import sensed_pairs, sensor_radii
 from formation_ros.core.model.bodies import make_bodies
 from formation_ros.core.rules.admission import Reason
+from formation_ros.core.rules.answers import AnswerPolicy
 from formation_ros.core.rules.control import Control, Sensed
+from formation_ros.core.rules.robot_core import RobotCore
 from formation_ros.core.rules.robot_intake import Refused
 from formation_ros.core.rules.transport import command_vectors
 from formation_ros.core.settings.declarations import ParamError
 from formation_ros.core.settings.names import robot_name
+from formation_ros.core.settings.params import FormationConfig
+from formation_ros.core.settings.team import LINK_VALUES
 from formation_ros.ros import qos, topics
 from formation_ros.ros.cdr import (encode_names, encode_team_commands, PoseArrayData, PoseData,
                                    read_pose_array)
+from formation_ros.ros.command_output import CmdVel, Output
 from formation_ros.ros.on_demand import LISTENERS_PERIOD, OnDemand
+from formation_ros.ros.robot_inputs import InputGate
+from formation_ros.ros.sim_clock import StateClock
 from formation_ros.ros.wake import Wake
 from geometry_msgs.msg import PoseArray
 import numpy as np
 from numpy.typing import NDArray
+from rclpy.clock import Clock
 from rclpy.duration import Duration
+from rclpy.node import Node
 from trajectory_msgs.msg import MultiDOFJointTrajectory
-
-if TYPE_CHECKING:
-    from formation_ros.nodes.robot import RobotNode
 
 LISTENER_LOOKS = 10
 """Robots without a cmd_vel publisher looked up in the graph per look, in turn."""
-TEAM_VALUES = ('num_robots', 'dim', 'world_frame', 'repulsion_radius', 'controller.gain',
-               'controller.kappa', 'controller.psi', 'jump.kind', 'jump.order', 'body.kind',
-               'body.hand_distance', 'command.type', 'command.frame', 'plant.lockstep',
-               'transport')
-"""Parameters the robots of one link share: one call of the law computes their commands (the
-watchdog and input timeout are the leader's)."""
+
+
+class LinkedRobot(Protocol):
+    """What the link uses of one of its robots (``nodes.robot.RobotNode``)."""
+
+    index: int
+    sensing_radius: float
+    config: FormationConfig
+    law: LawParams
+    control: Control
+    cmd_vel: CmdVel
+    state_clock: StateClock
+    steady: Clock
+    inputs: InputGate
+    policy: AnswerPolicy
+
+    def count_subscribers(self, topic_name: str) -> int:
+        """Return the subscribers of a topic in the graph."""
+
+    def now_ns(self) -> int:
+        """Return steady time, ns."""
+
+    def admit_state(self, name: str, state: PoseArrayData, needs_orientation: bool,
+                    finite: Optional[bool] = None) -> bool:
+        """Admit a state of input ``name`` as of now."""
+
+    def see(self, pose: PoseData, neighbours: PoseArrayData, heard_ns: int, new: bool,
+            last: Optional[Tuple[Command, Optional[NDArray[np.float64]]]] = None) -> None:
+        """Take the robot's pose and neighbours in a state the link read."""
+
+    def serve(self, output: Output, control: Control,
+              senses: Callable[[], Sensed]) -> RobotCore:
+        """Answer through ``output`` the states of the robots ``control`` commands."""
+
+    def join(self, linked: 'Linked', answering: AnswerPolicy) -> None:
+        """Be one of a link's robots: ``linked`` tells of it, ``answering`` answers for all."""
+
+    def on_state(self) -> None:
+        """Answer the state taken."""
+
+
+class Linked:
+    """What a link tells one of its robots (its diagnostics), without the robot holding it."""
+
+    def __init__(self, link: 'RobotsLink', node: LinkedRobot) -> None:
+        """Tell ``node`` of ``link``."""
+        self._link, self._node = link, node
+
+    def report(self) -> None:
+        """Give the robot what it would have heard and computed (``RobotsLink.report_to``)."""
+        self._link.report_to(self._node)
+
+    def publishes_cmd_vel(self) -> str:
+        """Return 'yes' while the robot's own cmd_vel is published (someone listens)."""
+        return self._link.publishes_cmd_vel(self._node.index)
 
 
 class RobotsLink:
@@ -51,16 +108,17 @@ class RobotsLink:
 
     what = 'command (team topic and cmd_vel)'
 
-    def __init__(self, nodes: Sequence['RobotNode']) -> None:
+    def __init__(self, nodes: Sequence[LinkedRobot]) -> None:
         """
-        Link ``nodes`` (team transport, sharing :data:`TEAM_VALUES`; ParamError if not).
+        Link ``nodes`` (team transport, sharing :data:`LINK_VALUES`; ParamError if not).
 
         The first is the leader; the link's rows are the robots in id order.
         """
         leader = self.leader = nodes[0]
+        assert isinstance(leader, Node)
         self.nodes = sorted(nodes, key=lambda node: node.index)
         config = leader.config
-        differing = [name for name in TEAM_VALUES for node in self.nodes[1:]
+        differing = [name for name in LINK_VALUES for node in self.nodes[1:]
                      if node.config.values.get(name) != config.values.get(name)]
         if differing:
             raise ParamError([(differing[0], 'must be the same for every robot of a process '
@@ -86,7 +144,7 @@ class RobotsLink:
         self.seen = np.zeros(0, dtype=np.intp)
         self.bounds = np.zeros(len(self.nodes) + 1, dtype=np.intp)
         self.last_sent: Optional[bytes] = None
-        self.sent: List[Tuple['RobotNode', bytes]] = []
+        self.sent: List[Tuple[CmdVel, bytes]] = []
         """The cmd_vel messages that went with the latest team command, by robot."""
         self.on_demand = OnDemand(
             len(self.nodes), LISTENER_LOOKS, lambda k: self.nodes[k].cmd_vel.pub is not None,
@@ -96,8 +154,8 @@ class RobotsLink:
         for node in self.nodes:
             if node is not leader:
                 leader.state_clock.join(node.state_clock)
-            node.join(self, self if node is leader else None, self.control, self.sensed,
-                      leader)
+            node.join(Linked(self, node), leader.policy)
+        self.core = leader.serve(self, self.control, self.sensed)
         self.pub = leader.create_publisher(MultiDOFJointTrajectory, topics.TEAM_COMMANDS,
                                            qos.COMMAND)
         self.wake = Wake(leader, self.on_wake, leader.steady)
@@ -158,21 +216,22 @@ class RobotsLink:
         assert self.sensed_now is not None
         return self.sensed_now
 
-    def _give(self, node: 'RobotNode', new: bool) -> None:
+    def _give(self, node: LinkedRobot, new: bool) -> None:
         """Give robot ``node`` its pose, neighbours and latest command as of the state taken."""
         state = self.state
         if state is None:
             return
         k = int(self.local[node.index])
         seen = self.seen[self.bounds[k]:self.bounds[k + 1]]
+        latest = self.core.latest
         node.see(PoseData(state.stamp_ns, state.frame_id,
                           tuple(state.positions[node.index].tolist()),
                           tuple(state.orientations[node.index].tolist())),
                  PoseArrayData(state.stamp_ns, state.frame_id, state.positions[seen],
                                state.orientations[seen]),
-                 self.taken_ns, new, self.leader.command_of(k))
+                 self.taken_ns, new, None if latest is None else latest.row(k))
 
-    def report_to(self, node: 'RobotNode') -> None:
+    def report_to(self, node: LinkedRobot) -> None:
         """Give robot ``node`` what it would have heard and computed (its diagnostics)."""
         self._give(node, new=False)
 
@@ -200,11 +259,11 @@ class RobotsLink:
         message = encode_team_commands(stamp_ns, self.leader.config.world_frame, self.names,
                                        linear, angular)
         self.pub.publish(message)
-        self.sent = [(self.nodes[k], self.nodes[k].cmd_vel.encode(stamp_ns, linear[k],
-                                                                  angular[k]))
+        self.sent = [(self.nodes[k].cmd_vel, self.nodes[k].cmd_vel.encode(stamp_ns, linear[k],
+                                                                          angular[k]))
                      for k in np.flatnonzero(self.on_demand.listening).tolist()]
-        for node, own in self.sent:
-            node.cmd_vel.publish(own)
+        for cmd_vel, own in self.sent:
+            cmd_vel.publish(own)
         self.last_sent = message
 
     def resend(self) -> None:
@@ -212,8 +271,8 @@ class RobotsLink:
         if self.last_sent is None:
             return
         self.pub.publish(self.last_sent)
-        for node, own in self.sent:
-            node.cmd_vel.publish(own)
+        for cmd_vel, own in self.sent:
+            cmd_vel.publish(own)
 
     def flush(self, seconds: float) -> None:
         """Wait up to ``seconds`` for the team topic's subscribers to have the last command."""

@@ -6,9 +6,9 @@
 import os
 
 from formation_ros.core.maths.law import Command
-from formation_ros.core.rules.reference_track import reference_values
 from formation_ros.core.rules.robot_status import startup_line, status_level, status_values
 from formation_ros.core.settings.params import load_params_file, validate
+from formation_ros.core.settings.team import reference_values
 import numpy as np
 
 SQUARE = os.path.join(os.path.dirname(__file__), '..', '..', 'config', 'square_4.yaml')

@@ -111,11 +111,18 @@ class PointBodies:
             return command
         return from_body_frame(command, quaternions_from_headings(heading))
 
-    def body_command(self, u: Float, heading: Float) -> Float:
-        """Return the command that gives the control point velocity u: u, or R(th)^T u."""
+    def body_command(self, u: Float, heading: Float,
+                     orientations: Optional[Float] = None) -> Float:
+        """
+        Return the command that gives the control point velocity u: u, or R^T u.
+
+        R: the body's rotation, ``orientations`` (N, 4) quaternions (x, y, z, w) where given (a
+        robot's measured pose), else R(th) about +z of the headings (N,) rad.
+        """
         if not self.body_frame:
             return u
-        return to_body_frame(u, quaternions_from_headings(heading))
+        return to_body_frame(u, quaternions_from_headings(heading) if orientations is None
+                             else orientations)
 
     def step(self, q: Float, heading: Float, command: Float, dt: float) -> Tuple[Float, Float]:
         """Zero-order hold over dt: (q + dt u, heading), u the command's world velocity."""
@@ -177,8 +184,9 @@ class UnicycleBodies:
         """Return the hand points' velocities R(th) (v, l w) (N, 2), m/s."""
         return hand_velocity(command, heading, self.hand_distance)
 
-    def body_command(self, u: Float, heading: Float) -> Float:
-        """Return (v, w) (N, 2) that move the hand points with velocities u."""
+    def body_command(self, u: Float, heading: Float,
+                     orientations: Optional[Float] = None) -> Float:
+        """Return (v, w) (N, 2) that move the hand points with velocities u (headings (N,))."""
         return unicycle_commands(u, heading, self.hand_distance)
 
     def step(self, q: Float, heading: Float, command: Float, dt: float) -> Tuple[Float, Float]:

@@ -7,17 +7,18 @@ The commands of K >= 1 robots of one process: their points, the law, their comma
 :class:`Control` is the one path from what the robots sensed to what they publish: the points
 the law acts on (positions, or hand points for unicycles: docs/equations.md U1-U5), u of eqs.
 (14), (25) from ``core.maths.law.robot_commands``, then (v, w) for unicycles or u turned into the
-body frame (``command.frame: body``). A robot process is K = 1, a process's link to its
+body frame (``command.frame: body``); the body mapping is the plant's and the offline tools'
+(``core.model.bodies``). A robot process is K = 1, a process's link to its
 robots (``nodes.robots_link``) K.
 """
 
 from dataclasses import dataclass
 from typing import Optional, Tuple
 
-from formation_ros.core.maths.frames import FrameSample, to_body_frame
+from formation_ros.core.maths.frames import FrameSample
 from formation_ros.core.maths.law import Command, LawParams, robot_commands
-from formation_ros.core.maths.unicycle import (hand_points, headings_from_quaternions,
-                                               unicycle_commands)
+from formation_ros.core.maths.unicycle import headings_from_quaternions
+from formation_ros.core.model.bodies import BodyKind, BodySettings, make_bodies
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -85,7 +86,9 @@ class Control:
         self.unicycle = unicycle
         self.hand_distance = hand_distance
         self.body_frame = body_frame
-        self.width = 2 if unicycle else dim
+        self.bodies = make_bodies(BodySettings(BodyKind.UNICYCLE if unicycle else BodyKind.POINT,
+                                               hand_distance), body_frame=body_frame)
+        self.width = self.bodies.command_width(dim)
 
     def points(self, positions: ArrayLike, orientations: ArrayLike) -> Tuple[Float, Float]:
         """
@@ -96,10 +99,9 @@ class Control:
         but for unicycles).
         """
         q = np.asarray(positions, dtype=float)[:, :self.dim]
-        if not self.unicycle:
-            return q, np.zeros(len(q))
-        headings = np.asarray(headings_from_quaternions(orientations), dtype=float)
-        return hand_points(q, headings, self.hand_distance), headings
+        headings = (np.asarray(headings_from_quaternions(orientations), dtype=float)
+                    if self.bodies.has_heading else np.zeros(len(q)))
+        return self.bodies.control_points(q, headings), headings
 
     def alone(self, index: int, position: ArrayLike, orientation: ArrayLike,
               positions: ArrayLike, orientations: ArrayLike) -> Sensed:
@@ -131,8 +133,6 @@ class Control:
         law = robot_commands(sensed.points, vertices, sensed.observer, sensed.neighbours,
                              self.radii, self.law, frame)
         body: Optional[Float] = None
-        if self.unicycle:
-            body = unicycle_commands(law.u, sensed.headings, self.hand_distance)
-        elif self.body_frame:
-            body = to_body_frame(law.u, sensed.orientations)
+        if self.unicycle or self.body_frame:
+            body = self.bodies.body_command(law.u, sensed.headings, sensed.orientations)
         return Commands(law, body)

@@ -13,7 +13,7 @@ stated in docs/ros_interface.md ("Reference timing", "Time") and docs/faults.md.
 
 from collections import deque
 import math
-from typing import Any, Callable, Deque, Dict, Mapping, Optional, Protocol, Tuple
+from typing import Callable, Deque, Optional, Protocol, Tuple
 
 from formation_ros.core.maths.frames import advance, FrameSample
 from formation_ros.core.maths.units import NS_PER_S
@@ -31,17 +31,6 @@ SAME_REFERENCE = 1e-6
 OTHER_IN_ROW = 2
 """Samples in a row unlike the frame a robot evaluates before the refusal is logged (one may
 only be ahead of the change announced with it: the two topics' callbacks run in either order)."""
-REFERENCE_VALUES = ('num_robots', 'dim', 'world_frame', 'repulsion_radius')
-REFERENCE_PREFIXES = ('reference.', 'formation.', 'formations.')
-"""Parameters that decide how a robot checks the reference's samples and the changes (with
-every ``reference.*``, ``formation.*`` and ``formations.*``): a fleet's robot that has the
-first robot's values hears the reference and the changes through it."""
-
-
-def reference_values(values: Mapping[str, Any]) -> Dict[str, Any]:
-    """Return the parameter values (``FormationConfig.values``) that decide the track."""
-    return {name: value for name, value in values.items()
-            if name in REFERENCE_VALUES or name.startswith(REFERENCE_PREFIXES)}
 
 
 class Sample(Protocol):

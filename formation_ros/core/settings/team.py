@@ -14,13 +14,26 @@ graph and reported as :func:`duplicate_due` says.
 """
 
 import hashlib
-from typing import Dict, Mapping, Optional, Sequence
+from typing import Any, Dict, Mapping, Optional, Sequence
 
 from formation_ros.core.settings.params import FormationConfig
 import numpy as np
 from numpy.typing import NDArray
 
 DIGITS = 12
+FRAME_VALUES = ('num_robots', 'dim', 'world_frame', 'repulsion_radius')
+"""Parameters of the team's frame and size: announced (:func:`team_values`) and deciding, with
+every :data:`REFERENCE_PREFIXES` one, how a robot checks the reference
+(:func:`reference_values`)."""
+LAW_VALUES = ('controller.gain', 'controller.kappa', 'controller.psi', 'jump.kind',
+              'jump.order', 'body.kind', 'body.hand_distance')
+"""Parameters of the law and the bodies, announced by :func:`team_values`."""
+LINK_VALUES = FRAME_VALUES + LAW_VALUES + ('command.type', 'command.frame', 'plant.lockstep',
+                                           'transport')
+"""Parameters the robots of one process with ``transport: team`` share: one call of the law
+computes their commands (the watchdog and input timeout are the first robot's)."""
+REFERENCE_PREFIXES = ('reference.', 'formation.', 'formations.')
+"""Prefixes of the parameters that decide the reference a robot follows and its changes."""
 DUPLICATE_GRACE = 25.0
 """A second publisher with the expected node's own name is reported after this many seconds
 without other evidence that it runs: a node restarted after a hard kill shares its topics with
@@ -58,6 +71,18 @@ def team_values(config: FormationConfig, shape: NDArray[np.float64]) -> Dict[str
     if 'transport' in config.values:
         values['transport'] = config.transport.value
     return values
+
+
+def reference_values(values: Mapping[str, Any]) -> Dict[str, Any]:
+    """
+    Return the parameter values (``FormationConfig.values``) that decide a robot's reference.
+
+    :data:`FRAME_VALUES` and every ``reference.*``, ``formation.*`` and ``formations.*``: a
+    fleet's robot that has the first robot's values hears the reference and the changes
+    through it.
+    """
+    return {name: value for name, value in values.items()
+            if name in FRAME_VALUES or name.startswith(REFERENCE_PREFIXES)}
 
 
 def differences(own: Mapping[str, str], other: Mapping[str, str]) -> Dict[str, str]:
