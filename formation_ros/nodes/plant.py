@@ -147,7 +147,7 @@ class PlantNode(Node):
             if self.team_transport else [])
         self.diagnostics_pub = self.create_publisher(
             DiagnosticArray, topics.DIAGNOSTICS, qos.DIAGNOSTICS)
-        period = RESEND_AFTER if self.lockstep else self.model.dt / settings.realtime_factor
+        period = RESEND_AFTER if self.lockstep else self.pacer.step_period_s
         self.step_timer = self.create_timer(period, self.advance_run, clock=self.steady)
         self.step_wake = Wake(self, self.advance_run, self.steady)
         self.diagnostics_timer = self.create_timer(PERIOD, self.on_diagnostics,

@@ -66,6 +66,11 @@ class Pacer:
             behind = self.catch_up_steps
         return max(0, behind)
 
+    @property
+    def step_period_s(self) -> float:
+        """Return the wall-clock time of one step at the factor, s (a free plant's tick)."""
+        return self.step_ns / NS_PER_S / self.factor
+
     def ahead_ns(self, wall_ns: int, steps: int) -> float:
         """
         Return how far the run at ``steps`` is ahead of wall-clock ``wall_ns`` x factor, ns.
