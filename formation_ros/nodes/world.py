@@ -30,7 +30,7 @@ from formation_ros.core.rules.admission import Reason
 from formation_ros.core.rules.pacing import Pacer
 from formation_ros.core.rules.plant_gate import (leftover_line, Phase, StartGate, Verdict,
                                                  WORLD_LOOK_TIME)
-from formation_ros.core.runs.output import fixed_shape, RunOutput
+from formation_ros.core.runs.output import FixedShape, RunOutput
 from formation_ros.core.runs.trajectory import TRAJECTORY_FILE
 from formation_ros.core.runs.world_stats import WORLD_STATS_FILE
 from formation_ros.core.settings.declarations import CommandFrame, Exe
@@ -432,7 +432,7 @@ class WorldNode(Node):
             return
         failed = self.output.write(WORLD_STATS_FILE, stats.record(),
                                    self.config.reference().sample,
-                                   fixed_shape(self.config.vertices), self.unicycles,
+                                   FixedShape(self.config.vertices), self.unicycles,
                                    self.engine.time_s)
         if failed is not None:
             self.get_logger().error(failed)

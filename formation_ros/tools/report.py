@@ -35,7 +35,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 from formation_ros.core.maths.frames import FrameSample
 from formation_ros.core.model.plant import PLANT_STATS_FILE
 from formation_ros.core.runs.events import Event, events_from_records
-from formation_ros.core.runs.output import ChunkShapeError, fixed_shape, trajectory_from_chunks
+from formation_ros.core.runs.output import ChunkShapeError, FixedShape, trajectory_from_chunks
 from formation_ros.core.runs.trajectory import CHUNKS_DIR, Trajectory, TRAJECTORY_FILE
 from formation_ros.core.settings.declarations import ParamError
 from formation_ros.core.settings.file_guard import ParamsFileError
@@ -114,7 +114,7 @@ def _load_chunks(path: str, params: str, chunks: str, notes: Optional[List[str]]
     try:
         config = load_config(params)
         trajectory = trajectory_from_chunks(
-            chunks, config.reference().sample, fixed_shape(config.vertices),
+            chunks, config.reference().sample, FixedShape(config.vertices),
             config.body.is_unicycle, (config.num_robots, config.dim))
     except ParamError as exc:
         raise ReportError(_param_problem(exc)) from None

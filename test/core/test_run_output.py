@@ -12,7 +12,7 @@ from formation_ros.core.maths.reference import Reference
 from formation_ros.core.model.plant import Commands, PLANT_STATS_FILE, PlantModel
 from formation_ros.core.rules.admission import Refusals
 from formation_ros.core.rules.plant_stats import RunStats, trajectory_sample
-from formation_ros.core.runs.output import (ChunkShapeError, fixed_shape, RunOutput, stats_text,
+from formation_ros.core.runs.output import (ChunkShapeError, FixedShape, RunOutput, stats_text,
                                             trajectory_from_chunks)
 from formation_ros.core.runs.trajectory import CHUNKS_DIR, ChunkWriter, Trajectory, TRAJECTORY_FILE
 from formation_ros.core.runs.world_stats import BlowUp, Contact, WorldRunStats
@@ -22,7 +22,7 @@ import pytest
 LAW = make_law(2.0, 1.0, 'arctan', 'poly', 2, 0.5)
 FIXED = Reference('fixed', 2)
 MS = 10_000_000
-SHAPE = fixed_shape(np.zeros((3, 2)))
+SHAPE = FixedShape(np.zeros((3, 2)))
 
 
 def model():
@@ -91,6 +91,8 @@ def test_the_trajectory_from_chunks_checks_the_robots_and_reads_held_commands(tm
     trajectory = trajectory_from_chunks(writer.folder, FIXED.sample, SHAPE, False, (3, 2))
     assert trajectory.t.tolist() == [0.0, 0.5, 1.0, 1.5] and trajectory.heading is None
     assert np.all(trajectory.u_held == 2.0) and trajectory.u_hat_held is not None
+    each = trajectory_from_chunks(writer.folder, FIXED.sample, lambda t: np.zeros((3, 2)), False)
+    assert np.array_equal(each.q_desired, trajectory.q_desired)
     with pytest.raises(ChunkShapeError) as caught:
         trajectory_from_chunks(writer.folder, FIXED.sample, SHAPE, False, (4, 2))
     assert caught.value.found == (3, 2) and str(caught.value).endswith(': 3 robots in 2D')

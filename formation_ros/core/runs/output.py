@@ -44,6 +44,22 @@ class ChunkShapeError(ValueError):
         self.folder, self.found = folder, found
 
 
+class FixedShape:
+    """
+    The :data:`ShapeAt` of a shape that never changes: ``vertices`` (N, dim), m, at every time.
+
+    :func:`trajectory_from_chunks` then keeps one (N, dim) array, not one per sample.
+    """
+
+    def __init__(self, vertices: ArrayLike) -> None:
+        """Keep a copy of ``vertices``."""
+        self.vertices: NDArray[np.float64] = np.array(vertices, dtype=float)
+
+    def __call__(self, t_ns: int) -> NDArray[np.float64]:
+        """Return the vertices, whatever the time."""
+        return self.vertices
+
+
 def trajectory_from_chunks(folder: str, frame_at: FrameAt, shape_at: ShapeAt, bodies: bool,
                            robots: Optional[Tuple[int, int]] = None) -> Trajectory:
     """
@@ -59,7 +75,8 @@ def trajectory_from_chunks(folder: str, frame_at: FrameAt, shape_at: ShapeAt, bo
     if robots is not None and q.shape[1:] != tuple(robots):
         raise ChunkShapeError(folder, (int(q.shape[1]), int(q.shape[2])))
     frames = [frame_at(time_s) for time_s in t]
-    shapes = [np.asarray(shape_at(int(round(time_s * NS_PER_S))), dtype=float) for time_s in t]
+    shapes = (shape_at.vertices if isinstance(shape_at, FixedShape) else
+              [np.asarray(shape_at(int(round(time_s * NS_PER_S))), dtype=float) for time_s in t])
     trajectory = Trajectory.from_frames(t, q, u, frames, shapes)
     body = read_body_chunks(folder) if bodies else None
     if body is not None:
@@ -206,9 +223,3 @@ class RunOutput:
             shutil.rmtree(self.chunks.folder, ignore_errors=True)
         self.trajectory_written = trajectory is not None
         return None
-
-
-def fixed_shape(vertices: ArrayLike) -> ShapeAt:
-    """Return the :data:`ShapeAt` of a shape that never changes ((N, dim) vertices, m)."""
-    shape: NDArray[np.float64] = np.array(vertices, dtype=float)
-    return lambda t_ns: shape
