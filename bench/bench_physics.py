@@ -109,14 +109,15 @@ def run_size(n: int, args: argparse.Namespace) -> Dict[str, Any]:
         engine.step(chunk)
         done += chunk
     cpu = time.process_time() - cpu_begun
-    stats = engine.stats()
+    stats = engine.stats(engine.wall)
     begun = time.perf_counter()
     mujoco.mj_step(engine.mj_model, engine.data, steps)
     alone = time.perf_counter() - begun
-    return {'robots': n, 'timestep_s': args.timestep, 'simulated_s': stats.simulated,
-            'wall_s': stats.wall, 'cpu_s': cpu, 'realtime_factor': stats.achieved_realtime_factor,
-            'steps_per_s': stats.steps / stats.wall, 'mujoco_alone_realtime_factor':
-            stats.simulated / alone, 'contacts': stats.contacts,
+    return {'robots': n, 'timestep_s': args.timestep, 'simulated_s': stats.simulated_time,
+            'wall_s': stats.engine_wall_time, 'cpu_s': cpu,
+            'realtime_factor': stats.engine_realtime_factor,
+            'steps_per_s': stats.steps / stats.engine_wall_time, 'mujoco_alone_realtime_factor':
+            stats.simulated_time / alone, 'contacts': stats.contacts,
             'min_body_distance': stats.min_body_distance}
 
 

@@ -153,13 +153,13 @@ def engine_job(job: Tuple[str, Settings, int, float]) -> Dict[str, Any]:
     run = run_on_engine(config, duration, control_dt, control_dt, shapes_of(config),
                         Progress(duration, quiet=True))
     metrics = run_metrics(run.trajectory, config, f'MuJoCo, the law every {control_dt:g} s')
-    stats = run.stats
+    stats = run.stats.record()
     return {
         'seed': int(config.values['start.seed']),
         'closest_bodies': stats['min_body_distance'],
         'footprint_gap': stats['min_footprint_gap'],
         'contacts': stats['contacts'],
-        'first_contact': run.events[0] if run.events else None,
+        'first_contact': stats['contact_events'][0] if stats['contact_events'] else None,
         'settle_time': metrics['settle_time'],
         'converged': metrics['settle_time'] is not None,
         'final_max_error': metrics['final_max_error'],

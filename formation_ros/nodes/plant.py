@@ -10,7 +10,8 @@ steps) with the commands it hears and publishes ``/clock``, what each robot sens
 and ``plant_stats.json``. Topics, transports, start-up and lockstep: docs/ros_interface.md; faults
 and another team on the domain: docs/faults.md. Its rules are core objects it feeds with what
 it read: the start gate (``core.rules.plant_gate``), the intake of commands
-(``core.rules.plant_intake``), the run statistics (``core.rules.plant_stats``) and the status
+(``core.rules.plant_intake``), the pace (``core.rules.pacing``), the run statistics
+(``core.rules.plant_stats``), the output (``core.runs.output``) and the status
 (``core.rules.plant_status``). Callbacks store, timers act.
 """
 
@@ -21,18 +22,21 @@ from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.maths.frames import desired_positions
 from formation_ros.core.maths.units import NS_PER_S
 from formation_ros.core.model.bodies import make_bodies
-from formation_ros.core.model.plant import PlantModel, StepReport
+from formation_ros.core.model.plant import PLANT_STATS_FILE, PlantModel, StepReport
 from formation_ros.core.rules.admission import Reason
 from formation_ros.core.rules.lockstep import AnswerWait
+from formation_ros.core.rules.pacing import Pacer
 from formation_ros.core.rules.plant_gate import (CLOCK_MATCH_LINE, ClockMatch, GAVE_UP_LINE,
                                                  leftover_line, Phase, StartGate, Verdict,
                                                  waiting_line)
 from formation_ros.core.rules.plant_intake import CommandIntake, Source, TEAM
-from formation_ros.core.rules.plant_stats import RunOutput, RunStats
+from formation_ros.core.rules.plant_stats import RunStats, trajectory_sample
 from formation_ros.core.rules.plant_status import (collision_lines, CommandWatch, Heard, Note,
                                                    PlantStatus, start_line, violation_lines)
 from formation_ros.core.runs.events import event_records, timeline_events
+from formation_ros.core.runs.output import RunOutput
 from formation_ros.core.runs.timeline import Mode
+from formation_ros.core.runs.trajectory import TRAJECTORY_FILE
 from formation_ros.core.settings.declarations import CommandFrame, Exe
 from formation_ros.core.settings.exits import REFUSED
 from formation_ros.core.settings.team import team_values
@@ -104,6 +108,7 @@ class PlantNode(Node):
         self.gate = StartGate(time.monotonic(), settings.wait_for_robots or self.lockstep,
                               self.own_name)
         self.stats = RunStats(self.model, self.publish_every, self.lockstep, self.unicycles)
+        self.pacer = Pacer(settings.step_ns, settings.realtime_factor, settings.step_ns)
         self.watch = CommandWatch(self.n)
         self.status_report = PlantStatus(
             self.lockstep, self.unicycles, self.team_transport,
@@ -113,8 +118,11 @@ class PlantNode(Node):
         self.refusal: Optional[str] = None
         self.exit_code: Optional[int] = None
         self.clock_heard = 0
-        self.output = (RunOutput(settings.output_dir, self.unicycles)
-                       if settings.output_dir else None)
+        self.output = RunOutput(settings.output_dir, 'plant', 'the plant goes on controlling')
+        if settings.output_dir:
+            failed = self.output.start(self.model.t)
+            if failed is not None:
+                self.get_logger().error(failed)
         self.paths = Paths(self.n, PATH_LENGTH)
         self.last_publish_wall = 0.0
         self.state_topics = PlantTopics(
@@ -139,12 +147,12 @@ class PlantNode(Node):
             if self.team_transport else [])
         self.diagnostics_pub = self.create_publisher(
             DiagnosticArray, topics.DIAGNOSTICS, qos.DIAGNOSTICS)
-        period = RESEND_AFTER if self.lockstep else self.model.dt / settings.realtime_factor
+        period = RESEND_AFTER if self.lockstep else self.pacer.step_period_s
         self.step_timer = self.create_timer(period, self.advance_run, clock=self.steady)
         self.step_wake = Wake(self, self.advance_run, self.steady)
         self.diagnostics_timer = self.create_timer(PERIOD, self.on_diagnostics,
                                                    clock=self.steady)
-        if self.output is not None:
+        if settings.output_dir:
             self.chunk_timer = self.create_timer(CHUNK_PERIOD, self.write_chunk,
                                                  clock=self.steady)
         if settings.marker_rate > 0.0:
@@ -170,9 +178,10 @@ class PlantNode(Node):
         except CdrError as exc:
             self.refusals.refuse(index, Reason.MALFORMED, str(exc))
             return
-        self._took(index, self.intake.take(index, command.frame_id, command.linear,
-                                           command.angular, command.stamp_ns,
-                                           time.monotonic_ns()), command.frame_id)
+        reason = self.intake.take(index, command.frame_id, command.linear, command.angular,
+                                  command.stamp_ns, time.monotonic_ns())
+        self._took(index, reason, command.frame_id if reason is not Reason.NON_FINITE
+                   else f'linear {command.linear}, angular {command.angular}')
 
     def on_team_command(self, data: bytes) -> None:
         """Team transport: store the commands of one team message, as :meth:`on_command`."""
@@ -186,10 +195,10 @@ class PlantNode(Node):
                                                message.stamp_ns, time.monotonic_ns()),
                    message.frame_id)
 
-    def _took(self, source: Source, reason: Optional[Reason], frame_id: str) -> None:
+    def _took(self, source: Source, reason: Optional[Reason], detail: str) -> None:
         """Count a refusal (logged once while it lasts), or in lockstep wake the step."""
         if reason is not None:
-            self.refusals.refuse(source, reason, frame_id)
+            self.refusals.refuse(source, reason, detail)
         elif self.lockstep:
             self.step_wake.arm()
 
@@ -211,8 +220,8 @@ class PlantNode(Node):
         now = time.monotonic()
         if not self.gate.looked and not self._look_at_domain(now):
             return
-        if self.stats.started is None:
-            self.stats.started = now
+        if self.pacer.started_ns is None:
+            self.pacer.start(time.monotonic_ns(), self.model.counts.steps)
             self._publish()
             return
         if self.gate.phase is Phase.WAITING and not self._start_clock(now):
@@ -267,7 +276,7 @@ class PlantNode(Node):
         self.gate.start()
         if self.team_transport:
             self.state_topics.look_at_listeners()
-        self.stats.started = now
+        self.pacer.start(time.monotonic_ns(), self.model.counts.steps)
         self.status_report.restart(now, self.model.counts.steps)
         self.once.end('clock-match')
         self.once.end('waiting')
@@ -277,8 +286,7 @@ class PlantNode(Node):
 
     def _lockstep_tick(self, now: float) -> None:
         """Lockstep: step once every robot answered and the run is not ahead; else resend."""
-        assert self.stats.started is not None
-        ahead_s = self.model.t / self.settings.realtime_factor - (now - self.stats.started)
+        ahead_s = self.pacer.ahead_ns(time.monotonic_ns(), self.model.counts.steps) / NS_PER_S
         answered = self.intake.answered(self.model.t_ns)
         line = self.answer_wait.look([] if answered else self.intake.silent(self.model.t_ns),
                                      now)
@@ -300,8 +308,9 @@ class PlantNode(Node):
         self.stats.answers.time(self.intake.commands, self.intake.arrived_ns)
         held = self.changes.states.at(self.model.t_ns).mode is Mode.STOPPED
         report = self.model.advance(self.intake.commands)
-        if self.stats.stepped(self.model, report, held) and self.output is not None:
-            self.output.append(report)
+        if self.stats.stepped(self.model, report, held) and self.output.running:
+            t, q, u, extras = trajectory_sample(report, self.unicycles)
+            self.output.append(t, q, u, **extras)
         self._log(report)
 
     def _log(self, report: StepReport) -> None:
@@ -401,27 +410,28 @@ class PlantNode(Node):
         if self.refusal:
             self._announce_refusal()
             return
-        if self.stats.started is None or self.model.counts.steps == 0:
+        if self.pacer.started_ns is None or self.model.counts.steps == 0:
             self.get_logger().info('plant: stopped before the first step')
             return
-        wall = time.monotonic() - self.stats.started
+        wall = self.pacer.wall_s(time.monotonic_ns())
         desired = desired_positions(self._vertices_at(self.model.t_ns),
                                     self.reference.sample(self.model.t))
-        failure = self.output.failure if self.output is not None else None
+        failure = self.output.failure
         self.get_logger().info(self.stats.summary(self.model, wall, desired, self.law.u_bound)
                                + (f'; output stopped early: {failure}' if failure else ''))
-        if self.output is None or failure is not None:
+        if not self.output.running:
             return
         record = self.stats.record(
             self.model, wall, self.refusals.refusals, len(self.changes.shapes.changes()),
             event_records(timeline_events(self.changes.shapes, self.changes.states)),
             self.config.imperfections.as_dict(), self.config.transport.value)
-        wrote, line = self.output.write(record, self.reference.sample, self._vertices_at,
-                                        self.model.t)
-        if wrote:
-            self.get_logger().info(line)
-        else:
-            self.get_logger().error(line)
+        failed = self.output.write(PLANT_STATS_FILE, record, self.reference.sample,
+                                   self._vertices_at, self.unicycles, self.model.t)
+        if failed is not None:
+            self.get_logger().error(failed)
+            return
+        self.get_logger().info(f'plant: wrote {TRAJECTORY_FILE} and {PLANT_STATS_FILE} to '
+                               f'{self.settings.output_dir}')
 
     def _announce_refusal(self) -> None:
         """Publish the refusal as the last status (the other plant names this one from it)."""

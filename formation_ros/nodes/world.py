@@ -5,22 +5,19 @@
 World node (executable ``world``): the physics engine behind the topics a simulated lab has.
 
 It steps :class:`formation_ros.physics.engine.Engine` (MuJoCo) on the steady clock at
-``world.realtime_factor`` (``physics.pacing``) and gives the robots what a simulator and its
+``world.realtime_factor`` (``core.rules.pacing``) and gives the robots what a simulator and its
 ROS bridge give a lab (Gazebo with ros_gz_bridge): ``/clock``, each robot's ground truth on
 ``/robot_<i>/measured_pose`` (the relay's default source) and, for wheeled bases, wheel
 odometry on ``/robot_<i>/odom``; it drives the bodies from ``/robot_<i>/cmd_vel``, whose
 callbacks only store (``physics.intake``). It counts contacts between robots and, with
-``world.output_dir``, writes ``world.xml``, ``trajectory.npz`` and ``world_stats.json``.
+``world.output_dir``, writes ``world.xml``, ``trajectory.npz`` and ``world_stats.json``
+(``core.runs.output``, ``core.runs.world_stats``).
 Before its first step it looks at the domain through the plant's start gate
 (``core.rules.plant_gate``, ``ros.clock_look``): beside another plant or world it refuses (exit 2).
 How to start it, what it refuses and writes: docs/physics.md ("The world node"); its topics:
 docs/ros_interface.md.
 """
 
-from dataclasses import asdict, replace
-import json
-import os
-import shutil
 import time
 from typing import Any, Dict, List, Optional
 
@@ -30,17 +27,17 @@ from formation_ros.core.maths.units import NS_PER_S
 from formation_ros.core.model.commanded import (commanded_velocity, HeardOrientations,
                                                 needs_orientation)
 from formation_ros.core.rules.admission import Reason
+from formation_ros.core.rules.pacing import Pacer
 from formation_ros.core.rules.plant_gate import (leftover_line, Phase, StartGate, Verdict,
                                                  WORLD_LOOK_TIME)
-from formation_ros.core.runs.trajectory import (CHUNKS_DIR, ChunkWriter, read_body_chunks,
-                                                read_chunks, read_held_chunks, save_atomically,
-                                                Trajectory, TRAJECTORY_FILE)
+from formation_ros.core.runs.output import FixedShape, RunOutput
+from formation_ros.core.runs.trajectory import TRAJECTORY_FILE
+from formation_ros.core.runs.world_stats import WORLD_STATS_FILE
 from formation_ros.core.settings.declarations import CommandFrame, Exe
 from formation_ros.core.settings.exits import ENGINE_FAILED, REFUSED
 from formation_ros.core.settings.params import world_size_problem
 from formation_ros.physics.engine import Engine, Unstable, unstable_line
 from formation_ros.physics.intake import CommandInbox
-from formation_ros.physics.pacing import Pacer
 from formation_ros.physics.scene import WORLD_FILE
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import (CdrError, encode_clock, encode_odometry, encode_pose_stamped,
@@ -60,13 +57,12 @@ from rclpy.node import Node
 from rosgraph_msgs.msg import Clock as ClockMsg
 
 WORLD_STATUS = 'formation_ros/world'
-WORLD_STATS_FILE = 'world_stats.json'
 MIN_TICK = 0.005
 """The shortest period of the step timer, s (wall clock): a fast world publishes several poses
 per tick rather than waking more often."""
 CATCH_UP = 0.2
 """The most wall-clock time a tick catches up when the world is behind, s (times the factor:
-simulated); the rest is let go and counted (``physics.pacing``)."""
+simulated); the rest is let go and counted (``core.rules.pacing``)."""
 KEPT_UP = 0.9
 """A world whose real-time factor over the last second is below this share of the one asked
 for is behind: WARN in /diagnostics, said once in the log."""
@@ -115,8 +111,7 @@ class WorldNode(Node):
         """(N,) commands of each robot already stale when the step timer applied them."""
         self.rate_window = (time.monotonic_ns(), 0)
         self.output_dir = self.world.output_dir
-        self.output_failure: Optional[str] = None
-        self.chunks: Optional[ChunkWriter] = None
+        self.output = RunOutput(self.output_dir, 'world', 'the world goes on')
         self.gate = StartGate(time.monotonic(), False, self.get_fully_qualified_name(),
                               WORLD_LOOK_TIME)
         self.team_check = TeamCheck(self, WORLD_STATUS)
@@ -172,13 +167,9 @@ class WorldNode(Node):
         """
         if not self.output_dir:
             return
-        where = self.output_dir
-        try:
-            where = self.engine.scene.write(self.output_dir)
-            where = os.path.join(self.output_dir, CHUNKS_DIR)
-            self.chunks = ChunkWriter(where)
-        except OSError as exc:
-            self._output_failed(exc, where)
+        failed = self.output.start(self.engine.time_s, self.engine.scene.write)
+        if failed is not None:
+            self.get_logger().error(failed)
 
     def _refusal_line(self, index: int, reason: Reason, detail: str) -> str:
         kind = 'TwistStamped' if self.stamped else 'Twist'
@@ -289,7 +280,7 @@ class WorldNode(Node):
             pub.publish(encode_pose_stamped(t_ns, frame, position, orientation))
         if self.odometry_pubs:
             self._publish_odometry(t_ns)
-        if self.chunks is not None:
+        if self.output.running:
             self._sample(t_ns)
 
     def _publish_odometry(self, t_ns: int) -> None:
@@ -328,12 +319,11 @@ class WorldNode(Node):
         unstamped commands, which do not say which state); u_held, for commands that need a
         heading: the held command read at the body's true heading now.
         """
-        assert self.chunks is not None
         positions, headings = self.engine.planar_state()
         held = self._held()
         t = t_ns / NS_PER_S
         if not needs_orientation(self.unicycles, self.body_frame):
-            self.chunks.append(t, positions, held)
+            self.output.append(t, positions, held)
             return
         answered = (self.heard.rows(self.engine.stamp_ns) if self.heard is not None
                     else np.full((self.n, 4), np.nan))
@@ -342,11 +332,11 @@ class WorldNode(Node):
             commanded_velocity(held, orientations, self.unicycles, distance, self.body_frame)
             for orientations in (answered, quaternions_from_headings(headings)))
         if self.unicycles:
-            self.chunks.append(t, hand_points(positions, headings, distance), commanded,
+            self.output.append(t, hand_points(positions, headings, distance), commanded,
                                heading=headings, q_body=positions, body_command=held,
                                u_held=at_truth)
             return
-        self.chunks.append(t, positions, commanded, u_held=at_truth)
+        self.output.append(t, positions, commanded, u_held=at_truth)
 
     def _log_contacts(self) -> None:
         """Log each new contact between two robots once: the pair and the simulated time."""
@@ -411,73 +401,9 @@ class WorldNode(Node):
 
     def write_chunk(self) -> None:
         """Write the samples since the last chunk into ``world.output_dir`` (a failure: once)."""
-        if self.chunks is None or self.output_failure is not None:
-            return
-        try:
-            self.chunks.flush()
-        except OSError as exc:
-            self._output_failed(exc, self.chunks.folder)
-
-    def _output_failed(self, exc: OSError, where: str) -> None:
-        """Say in one line that the output stopped, where and why; write nothing more there."""
-        reason = exc.strerror or ' '.join(str(exc).split()) or type(exc).__name__
-        self.output_failure = f'cannot write to {where} ({reason})'
-        self.chunks = None
-        self.get_logger().error(f'world: output stopped at t = {self.engine.time_s:.2f} s: '
-                                f'{self.output_failure}; the world goes on and writes nothing '
-                                'more there')
-
-    def stats(self, wall: float) -> Dict[str, Any]:
-        """Return ``world_stats.json``: the engine's figures, the node's pace, the refusals."""
-        engine = self.engine.stats()
-        steps = engine.steps
-        achieved = engine.simulated / wall if wall > 0.0 else 0.0
-        stats: Dict[str, Any] = asdict(engine)
-        stats['engine_realtime_factor'] = stats.pop('achieved_realtime_factor')
-        stats.update({
-            'achieved_realtime_factor': achieved,
-            'realtime_factor': self.world.realtime_factor,
-            'wall_time': wall,
-            'simulated_time': engine.simulated,
-            'steps_per_second': steps / wall if wall > 0.0 else 0.0,
-            'ticks_behind': self.pacer.falls,
-            'simulated_time_let_go': self.pacer.dropped_s,
-            'contact_events': [{'i': e.i, 'j': e.j, 't': e.t}
-                               for e in self.engine.contacts.events],
-            'stale_command_messages': {str(i + 1): count for i, count
-                                       in enumerate(self.late.tolist()) if count},
-            'model': self.engine.model.kind.value,
-            'timestep': self.world.timestep,
-            'unstable': None if self.engine.failure is None else {
-                'robot': self.engine.failure.robot, 't': self.engine.failure.t,
-                'what': self.engine.failure.what},
-            'refused_command_messages': {
-                reason.name.lower(): {str(index + 1): count for (index, why), count
-                                      in self.refusals.refusals.items() if why is reason}
-                for reason in REFUSAL_WORDS}})
-        stats['engine_wall_time'] = stats.pop('wall')
-        stats.pop('simulated')
-        return stats
-
-    def trajectory(self) -> Optional[Trajectory]:
-        """Return the run written so far: a sample per published pose, as the plant's."""
-        if self.chunks is None:
-            return None
-        self.write_chunk()
-        if self.chunks is None:
-            return None
-        try:
-            t, q, u = read_chunks(self.chunks.folder)
-        except ValueError:
-            return None
-        reference = self.config.reference()
-        frames = [reference.sample(s) for s in t]
-        trajectory = Trajectory.from_frames(t, q, u, frames, self.config.vertices)
-        body = read_body_chunks(self.chunks.folder) if self.unicycles else None
-        if body is not None:
-            trajectory = replace(trajectory, **body)
-        held = read_held_chunks(self.chunks.folder)
-        return trajectory if held is None else trajectory.with_held(held, frames)
+        failed = self.output.flush(self.engine.time_s)
+        if failed is not None:
+            self.get_logger().error(failed)
 
     def finish(self) -> None:
         """Log a summary; with ``world.output_dir`` write world_stats.json and trajectory.npz."""
@@ -486,32 +412,33 @@ class WorldNode(Node):
         if self.pacer.started_ns is None:
             self.get_logger().info('world: stopped before the first step')
             return
-        wall = (time.monotonic_ns() - self.pacer.started_ns) / NS_PER_S
-        stats = self.stats(wall)
+        wall = self.pacer.wall_s(time.monotonic_ns())
+        stats = self.engine.stats(
+            wall, self.pacer,
+            {i + 1: count for i, count in enumerate(self.late.tolist()) if count},
+            {reason.name.lower(): {index + 1: count for (index, why), count
+                                   in self.refusals.refusals.items() if why is reason}
+             for reason in REFUSAL_WORDS})
+        failure = self.output.failure
         self.get_logger().info(
-            f"world: {stats['steps']} steps ({stats['simulated_time']:.2f} s simulated in "
-            f"{wall:.1f} s, {stats['achieved_realtime_factor']:.3g} x real time of "
-            f'{self.world.realtime_factor:g}), {stats["contacts"]} contacts between robots, '
-            f"min body distance {stats['min_body_distance']:.4g} m, "
+            f'world: {stats.steps} steps ({stats.simulated_time:.2f} s simulated in '
+            f'{wall:.1f} s, {stats.achieved_realtime_factor:.3g} x real time of '
+            f'{self.world.realtime_factor:g}), {stats.contacts} contacts between robots, '
+            f'min body distance {stats.min_body_distance:.4g} m, '
             f'{self.refusals.refusals.count()} cmd_vel messages refused'
-            + (f'; output stopped early: {self.output_failure}' if self.output_failure else '')
+            + (f'; output stopped early: {failure}' if failure else '')
             + ('; the engine blew up' if self.engine.failure is not None else ''))
-        if not self.output_dir or self.output_failure is not None:
+        if not self.output.running:
             return
-        text = (json.dumps(stats, indent=2) + '\n').encode()
-        where = os.path.join(self.output_dir, WORLD_STATS_FILE)
-        try:
-            save_atomically(where, lambda stream: stream.write(text))
-            trajectory = self.trajectory()
-            where = os.path.join(self.output_dir, TRAJECTORY_FILE)
-            if trajectory is not None:
-                trajectory.save(where)
-        except OSError as exc:
-            self._output_failed(exc, where)
+        failed = self.output.write(WORLD_STATS_FILE, stats.record(),
+                                   self.config.reference().sample,
+                                   FixedShape(self.config.vertices), self.unicycles,
+                                   self.engine.time_s)
+        if failed is not None:
+            self.get_logger().error(failed)
             return
-        if trajectory is not None and self.chunks is not None:
-            shutil.rmtree(self.chunks.folder, ignore_errors=True)
-        written = [WORLD_FILE, WORLD_STATS_FILE] + ([TRAJECTORY_FILE] if trajectory else [])
+        written = [WORLD_FILE, WORLD_STATS_FILE] + (
+            [TRAJECTORY_FILE] if self.output.trajectory_written else [])
         self.get_logger().info(f"world: wrote {', '.join(written)} to {self.output_dir}")
 
 

@@ -12,15 +12,17 @@ crazyswarm2's simulator backends share one. It builds the scene of a validated c
   unicycle; the velocity of a point in the world or, with ``command.frame: body``, its body
   frame), each stamped (ns of simulated time). A command is held until the next; one older
   than ``world.cmd_timeout``, or none at all, stops the robot's motors (their set points are
-  zero), as ``diff_drive_controller`` does. Non-finite commands are refused (the robot keeps
-  its last command). A command beyond the motors is not refused: the motors are limited;
+  zero), as ``diff_drive_controller`` does. It takes commands an intake admitted
+  (``core.rules.admission.command_refusal``: finite) and raises ValueError on any other. A
+  command beyond the motors is not refused: the motors are limited;
 * :meth:`Engine.step` advances ``world.timestep`` at a time (integer ns: :attr:`time_ns`);
 * :meth:`Engine.poses` is the ground truth (positions (N, 3) m, orientations (N, 4)
   quaternions x, y, z, w), :meth:`Engine.measured_poses` the same with ``world.pose_noise``,
   :meth:`Engine.odometry` the wheel-encoder odometry of differential-drive bases (updated
   every ``odometry.ODOMETRY_PERIOD``);
 * :attr:`Engine.contacts` counts contact events between robots from MuJoCo's contact list and
-  :attr:`Engine.closest` keeps the closest approach of two robots' positions.
+  :attr:`Engine.closest` keeps the closest approach of two robots' positions;
+* :meth:`Engine.stats` is what the run did (``core.runs.world_stats.WorldRunStats``).
 
 A step that makes a body's pose non-finite or absurd (MuJoCo's own check of the state, which
 resets it, or a body faster than :data:`ABSURD_SPEED`) raises :class:`Unstable` naming the
@@ -30,11 +32,13 @@ of the step before (docs/physics.md, "When the engine blows up").
 
 from dataclasses import dataclass
 import time
-from typing import Optional, Sequence, Tuple
+from typing import Dict, Optional, Sequence, Tuple
 
 from formation_ros.core.maths.unicycle import headings_from_quaternions
 from formation_ros.core.maths.units import NS_PER_S
 from formation_ros.core.model.dynamics import NOISE_SEED_OFFSET
+from formation_ros.core.rules.pacing import Pacer
+from formation_ros.core.runs.world_stats import BlowUp, Contact, ratio, WorldRunStats
 from formation_ros.core.settings.params import FormationConfig, WorldSettings
 from formation_ros.physics.contacts import ClosestApproach, ContactLog, RELEASE_GAP
 from formation_ros.physics.diff_drive import DiffDrive
@@ -99,26 +103,6 @@ class Poses:
     def headings(self) -> Float:
         """Return the yaw of each orientation (N,), rad."""
         return headings_from_quaternions(self.orientations)
-
-
-@dataclass(frozen=True)
-class WorldStats:
-    """
-    What a run on the engine did (``world_stats.json``).
-
-    contacts: contact events between robots; min_body_distance: the closest approach of two
-    robots' positions, m; min_footprint_gap: that less twice the footprint radius, m (< 0:
-    they overlapped); steps: engine steps; simulated: s; wall: wall-clock s spent in
-    :meth:`Engine.step`; achieved_realtime_factor: simulated / wall.
-    """
-
-    contacts: int
-    min_body_distance: float
-    min_footprint_gap: float
-    steps: int
-    simulated: float
-    wall: float
-    achieved_realtime_factor: float
 
 
 class Engine:
@@ -207,27 +191,25 @@ class Engine:
         return self.time_ns / NS_PER_S
 
     def apply(self, commands: ArrayLike, stamps_ns: Optional[ArrayLike] = None,
-              robots: Optional[Sequence[int]] = None) -> NDArray[np.bool_]:
+              robots: Optional[Sequence[int]] = None) -> None:
         """
         Take commands (K, width) of ``robots`` (K 0-based indices; default all N, in order).
 
-        stamps_ns: (K,) the stamp of each command, ns of simulated time (default: now).
-        Returns which rows were refused (not finite), (K,); the others replace the robots'
-        commands.
+        stamps_ns: (K,) the stamp of each command, ns of simulated time (default: now). The
+        commands replace the robots' own. They are admitted ones (finite: the intake refused the
+        others, ``core.rules.admission.command_refusal``); ValueError if one is not.
         """
         rows = (np.arange(self.num_robots) if robots is None
                 else np.asarray(robots, dtype=np.intp))
         given = np.asarray(commands, dtype=float).reshape(len(rows), self.model.command_width)
+        if not np.all(np.isfinite(given)):
+            raise ValueError('Engine.apply takes admitted (finite) commands only')
         stamps = (np.full(len(rows), self.time_ns, dtype=np.int64) if stamps_ns is None
                   else np.asarray(stamps_ns, dtype=np.int64).reshape(len(rows)))
-        finite = np.all(np.isfinite(given), axis=1)
-        kept = rows[finite]
-        self.command[kept] = given[finite]
-        self.stamp_ns[kept] = stamps[finite]
-        self.present[kept] = True
+        self.command[rows] = given
+        self.stamp_ns[rows] = stamps
+        self.present[rows] = True
         self._changed = True
-        refused: NDArray[np.bool_] = ~finite
-        return refused
 
     def live(self) -> NDArray[np.bool_]:
         """Tell which robots' commands drive their motors now: given, not stale (N,)."""
@@ -346,11 +328,31 @@ class Engine:
                                      int(body), result[row], 0)
         return result[:, 3:]
 
-    def stats(self) -> WorldStats:
-        """Return what the run did so far."""
+    def stats(self, wall_time: float, pacer: Optional[Pacer] = None,
+              stale: Optional[Dict[int, int]] = None,
+              refused: Optional[Dict[str, Dict[int, int]]] = None) -> WorldRunStats:
+        """
+        Return what the run did so far (``world_stats.json``).
+
+        wall_time: wall-clock s since the first step; pacer: the world node's (the factor asked
+        for, the ticks behind and the time let go), None for a run as fast as it can; stale:
+        {robot (1-based): commands already stale when applied}; refused: {reason: {robot:
+        cmd_vel refused}}.
+        """
         simulated = self.time_s
-        return WorldStats(
+        failure = self.failure
+        return WorldRunStats(
             contacts=self.contacts.count, min_body_distance=self.closest.distance,
             min_footprint_gap=self.closest.distance - 2.0 * self.model.footprint,
-            steps=self.steps, simulated=simulated, wall=self.wall,
-            achieved_realtime_factor=simulated / self.wall if self.wall > 0.0 else 0.0)
+            steps=self.steps, engine_realtime_factor=ratio(simulated, self.wall),
+            achieved_realtime_factor=ratio(simulated, wall_time),
+            realtime_factor=None if pacer is None else pacer.factor, wall_time=wall_time,
+            simulated_time=simulated, steps_per_second=ratio(self.steps, wall_time),
+            ticks_behind=0 if pacer is None else pacer.falls,
+            simulated_time_let_go=0.0 if pacer is None else pacer.dropped_s,
+            contact_events=[Contact(event.i, event.j, event.t) for event in self.contacts.events],
+            stale_command_messages=dict(stale or {}), model=self.model.kind.value,
+            timestep=self.world.timestep,
+            unstable=None if failure is None else BlowUp(failure.robot, failure.t, failure.what),
+            refused_command_messages=dict(refused or {}), engine_wall_time=self.wall,
+            mujoco_version=self.version)

@@ -5,8 +5,9 @@
 What a world takes of the commands it hears, before the engine applies them (no ROS).
 
 A world node reads each robot's ``cmd_vel`` bytes (``ros.cdr``) and hands the message's frame,
-velocities and stamp to :meth:`CommandInbox.take`, which refuses it by the one rule of
-``core.rules.admission`` (the robot's command frame, then finite values: those the body uses) or as
+velocities and stamp to :meth:`CommandInbox.take`, which refuses it by the plant's rule
+(``core.rules.admission.command_refusal``: the robot's command frame, then finite values: those
+the body uses) or as
 stamped on another clock (more than ``world.cmd_timeout`` after the world's time: a wall-clock
 stamp, or a sender on another ``/clock``), and otherwise keeps it as the robot's latest until
 the node's step timer drains the inbox into :meth:`formation_ros.physics.engine.Engine.apply`.
@@ -16,10 +17,9 @@ taken at the world's time when it arrives. A command beyond the motors is not re
 engine's motors limit it. What is refused is counted by the node (``ros.once.RefusalLog``).
 """
 
-import math
 from typing import Optional, Sequence, Tuple
 
-from formation_ros.core.rules.admission import Reason, refusal
+from formation_ros.core.rules.admission import command_refusal, Reason
 from formation_ros.core.rules.transport import command_of
 import numpy as np
 from numpy.typing import NDArray
@@ -61,9 +61,8 @@ class CommandInbox:
         not looked at); now_ns: the world's simulated time, ns.
         """
         values = command_of(linear, angular, self.dim, self.unicycles)
-        finite = all(math.isfinite(value) for value in values)
         expected = self.command_frames[index]
-        reason = refusal(frame_id if self.stamped else expected, expected, finite)
+        reason = command_refusal(frame_id if self.stamped else expected, expected, values)
         if reason is not None:
             return reason
         if self.stamped and stamp_ns > now_ns + self.ahead_ns:

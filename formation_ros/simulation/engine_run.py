@@ -11,27 +11,28 @@ command it stands for ((v, w) of a unicycle, u itself or turned into the body's 
 point) is applied to the engine, stamped, and held over the period (zero-order hold) while the
 engine steps. The samples are those of every other run (``trajectory.npz``: the control points,
 the commands as sent, the headings, axle centres and (v, w) of unicycles); the engine's own
-counts (contacts between robots, the closest approach of the bodies, steps, real-time factor)
-go into ``world_stats.json`` beside ``world.xml``.
+counts (contacts between robots, the closest approach of the bodies, steps, real-time factors)
+go into ``world_stats.json`` beside ``world.xml``, in the world node's schema
+(``core.runs.world_stats``).
 """
 
-from dataclasses import asdict, dataclass, replace
-import math
+from dataclasses import dataclass, replace
+import time
 from typing import Any, Dict, List, Optional
 
 from formation_ros.core.maths.frames import FrameSample
 from formation_ros.core.maths.law import team_command
-from formation_ros.core.maths.units import NS_PER_S
 from formation_ros.core.model.bodies import make_bodies
+from formation_ros.core.runs.output import finite_record
 from formation_ros.core.runs.timeline import Shape, Timeline
 from formation_ros.core.runs.trajectory import Trajectory
+from formation_ros.core.runs.world_stats import WorldRunStats
 from formation_ros.core.settings.declarations import CommandFrame
 from formation_ros.core.settings.params import FormationConfig, world_size_problem, WorldSettings
 import numpy as np
 
 DEFAULT_CONTROL_DT = 0.02
 """The control period of an engine run without ``--dt``, s (the robots' default 50 Hz)."""
-WORLD_STATS_FILE = 'world_stats.json'
 STEP_TOLERANCE = 1e-9
 """A control period is a whole number of engine steps when within this fraction of one."""
 
@@ -39,17 +40,15 @@ STEP_TOLERANCE = 1e-9
 @dataclass(frozen=True)
 class EngineRun:
     """
-    A run on the engine: its samples, the engine's counts and its contact events.
+    A run on the engine: its samples and what the engine did.
 
-    trajectory: the samples; stats: :class:`formation_ros.physics.engine.WorldStats` as a dict;
-    events: the contact events, each {i, j, t}; version: MuJoCo's; failure: the one line of an
-    engine that blew up (``physics.engine.unstable_line``: the run stops there), None if none.
+    trajectory: the samples; stats: what the run did (``world_stats.json``; its wall_time is
+    the loop of law and engine); failure: the one line of an engine that blew up
+    (``physics.engine.unstable_line``: the run stops there), None if none.
     """
 
     trajectory: Trajectory
-    stats: Dict[str, Any]
-    events: List[Dict[str, Any]]
-    version: str
+    stats: WorldRunStats
     failure: Optional[str] = None
 
 
@@ -84,6 +83,7 @@ def run_on_engine(config: FormationConfig, duration: float, control_dt: float,
     """
     from formation_ros.physics.engine import Engine, Unstable, unstable_line
     engine = Engine(config)
+    begun = time.perf_counter()
     failure: Optional[str] = None
     law, reference = config.law(), config.reference()
     bodies = make_bodies(config.body, body_frame=config.command.frame is CommandFrame.BODY
@@ -129,33 +129,21 @@ def run_on_engine(config: FormationConfig, duration: float, control_dt: float,
     if bodies.has_heading:
         trajectory = replace(trajectory, heading=np.array(headings), q_body=np.array(q_body),
                              body_command=np.array(held))
-    stats = asdict(engine.stats())
-    events = [{'i': event.i, 'j': event.j, 't': event.t_ns / NS_PER_S}
-              for event in engine.contacts.events]
-    return EngineRun(trajectory, stats, events, engine.version, failure)
-
-
-def _finite(stats: Dict[str, Any]) -> Dict[str, Any]:
-    """Return ``stats`` with non-finite numbers as None (JSON has no infinity)."""
-    return {name: (value if not isinstance(value, float) or math.isfinite(value) else None)
-            for name, value in stats.items()}
+    return EngineRun(trajectory, engine.stats(time.perf_counter() - begun), failure)
 
 
 def engine_metrics(run: EngineRun) -> Dict[str, Any]:
-    """Return the metrics.json keys of an engine run (its counts under ``world``)."""
-    return {'engine': 'mujoco', 'mujoco_version': run.version, 'world': _finite(run.stats)}
+    """Return the metrics.json keys of an engine run: world_stats.json's under ``world``."""
+    world = finite_record(run.stats.record())
+    world.pop('contact_events')
+    return {'engine': 'mujoco', 'mujoco_version': run.stats.mujoco_version, 'world': world}
 
 
-def world_stats(run: EngineRun) -> Dict[str, Any]:
-    """Return the content of ``world_stats.json``: the engine's counts and contact events."""
-    return {**_finite(run.stats), 'contact_events': run.events, 'mujoco_version': run.version}
-
-
-def engine_summary(metrics: Dict[str, Any]) -> str:
+def engine_summary(run: EngineRun) -> str:
     """Return the summary line of the engine's counts."""
-    world = metrics['world']
-    return (f"  physics (MuJoCo {metrics['mujoco_version']}): {world['contacts']} contact "
+    stats = run.stats
+    return (f'  physics (MuJoCo {stats.mujoco_version}): {stats.contacts} contact '
             'event(s) between robots, closest approach of two bodies '
-            f"{world['min_body_distance']:.4g} m (footprints "
-            f"{world['min_footprint_gap']:+.4g} m apart), {world['steps']} steps at "
-            f"{world['achieved_realtime_factor']:.1f}x real time")
+            f'{stats.min_body_distance:.4g} m (footprints '
+            f'{stats.min_footprint_gap:+.4g} m apart), {stats.steps} steps at '
+            f'{stats.achieved_realtime_factor:.1f}x real time')

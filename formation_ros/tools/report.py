@@ -25,7 +25,6 @@ that says what is wrong.
 """
 
 import argparse
-from dataclasses import replace
 import json
 import math
 import os
@@ -36,8 +35,8 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple
 from formation_ros.core.maths.frames import FrameSample
 from formation_ros.core.model.plant import PLANT_STATS_FILE
 from formation_ros.core.runs.events import Event, events_from_records
-from formation_ros.core.runs.trajectory import (CHUNKS_DIR, read_body_chunks, read_chunks,
-                                                read_held_chunks, Trajectory, TRAJECTORY_FILE)
+from formation_ros.core.runs.output import ChunkShapeError, FixedShape, trajectory_from_chunks
+from formation_ros.core.runs.trajectory import CHUNKS_DIR, Trajectory, TRAJECTORY_FILE
 from formation_ros.core.settings.declarations import ParamError
 from formation_ros.core.settings.file_guard import ParamsFileError
 from formation_ros.core.settings.params import FormationConfig, load_config, validate
@@ -114,27 +113,21 @@ def _load_chunks(path: str, params: str, chunks: str, notes: Optional[List[str]]
     """Load a run whose plant was cut short: its trajectory from the chunks it wrote."""
     try:
         config = load_config(params)
-        t, q, u = read_chunks(chunks)
+        trajectory = trajectory_from_chunks(
+            chunks, config.reference().sample, FixedShape(config.vertices),
+            config.body.is_unicycle, (config.num_robots, config.dim))
     except ParamError as exc:
         raise ReportError(_param_problem(exc)) from None
+    except ChunkShapeError as exc:
+        raise ReportError(f'{exc}, but params.yaml says {config.num_robots} in '
+                          f'{config.dim}D') from None
     except ValueError as exc:
         raise ReportError(_one_line(str(exc))) from None
-    if q.shape[1:] != (config.num_robots, config.dim):
-        raise ReportError(f'{chunks}: {q.shape[1]} robots in {q.shape[2]}D, but params.yaml '
-                          f'says {config.num_robots} in {config.dim}D')
-    reference = config.reference()
-    frames = [reference.sample(s) for s in t]
-    trajectory = Trajectory.from_frames(t, q, u, frames, config.vertices)
-    body = read_body_chunks(chunks) if config.body.is_unicycle else None
-    if body is not None:
-        trajectory = replace(trajectory, **body)
-    held = read_held_chunks(chunks)
-    if held is not None:
-        trajectory = trajectory.with_held(held, frames)
+    samples = len(trajectory.t)
     if notes is not None:
         notes.append(f'{path}: no trajectory.npz (the plant did not finish): rebuilt '
-                     f'{len(t)} samples up to t = {t[-1]:.2f} s from {CHUNKS_DIR}/')
-    return trajectory, config, {'recovered_samples': int(len(t))}
+                     f'{samples} samples up to t = {trajectory.t[-1]:.2f} s from {CHUNKS_DIR}/')
+    return trajectory, config, {'recovered_samples': int(samples)}
 
 
 def load_run(path: str, notes: Optional[List[str]] = None) -> Loaded:

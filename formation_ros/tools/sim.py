@@ -34,7 +34,9 @@ import sys
 import tempfile
 from typing import Optional, Sequence, Tuple
 
+from formation_ros.core.runs.output import stats_text
 from formation_ros.core.runs.trajectory import TRAJECTORY_FILE
+from formation_ros.core.runs.world_stats import WORLD_STATS_FILE
 from formation_ros.core.settings.declarations import Exe, ParamError
 from formation_ros.core.settings.exits import ENGINE_FAILED
 from formation_ros.core.settings.file_guard import ParamsFileError
@@ -42,8 +44,7 @@ from formation_ros.core.settings.params import (FormationConfig, load_config,
                                                 validate_for_every_executable)
 from formation_ros.core.settings.params_file import load_params_file
 from formation_ros.simulation.engine_run import (DEFAULT_CONTROL_DT, engine_metrics,
-                                                 engine_problem, engine_summary, run_on_engine,
-                                                 world_stats, WORLD_STATS_FILE)
+                                                 engine_problem, engine_summary, run_on_engine)
 from formation_ros.simulation.simulate import (continuous_time_problem, DEFAULT_SAMPLE_DT,
                                                format_summary, MAX_ROBOT_SAMPLES, MAX_STEPS,
                                                METRICS_FILE, PARAMS_COPY, plant_metrics, Progress,
@@ -252,8 +253,8 @@ def run_engine_command(args: argparse.Namespace, config: FormationConfig,
                         progress)
     world = config.world
     assert world is not None
-    integrator = (f'MuJoCo {run.version}, timestep {world.timestep:g} s, the law every '
-                  f'{dt:g} s held (zero-order hold)')
+    integrator = (f'MuJoCo {run.stats.mujoco_version}, timestep {world.timestep:g} s, '
+                  f'the law every {dt:g} s held (zero-order hold)')
     metrics = run_metrics(run.trajectory, config, integrator, schedule_events(config))
     metrics.update(engine_metrics(run))
     metrics.update(sampling)
@@ -261,17 +262,18 @@ def run_engine_command(args: argparse.Namespace, config: FormationConfig,
     run.trajectory.save(os.path.join(args.out, TRAJECTORY_FILE))
     _copy_params(args.params, args.out)
     build_scene(config).write(args.out)
-    for name, content in ((METRICS_FILE, metrics), (WORLD_STATS_FILE, world_stats(run))):
-        with open(os.path.join(args.out, name), 'w', encoding='utf-8') as stream:
-            json.dump(content, stream, indent=2)
-            stream.write('\n')
+    with open(os.path.join(args.out, METRICS_FILE), 'w', encoding='utf-8') as stream:
+        json.dump(metrics, stream, indent=2)
+        stream.write('\n')
+    with open(os.path.join(args.out, WORLD_STATS_FILE), 'wb') as binary:
+        binary.write(stats_text(run.stats.record()))
     if not args.no_plots:
         from formation_ros.figures import plots
         plots.write_figures(run.trajectory, config.law(), metrics, args.out)
     simulated = duration if run.failure is None else float(run.trajectory.t[-1])
     print(f'formation_sim: {integrator}, {simulated:g} s simulated in {progress.elapsed:.1f} s')
     print(format_summary(metrics, args.out))
-    print(engine_summary(metrics))
+    print(engine_summary(run))
     if run.failure is not None:
         print(f'formation_sim: {run.failure}; wrote the run up to there to {args.out}',
               file=sys.stderr)

@@ -35,6 +35,27 @@ def test_a_command_in_a_foreign_frame_is_refused_and_not_stored():
                     "'robot_2/base_link' (logged once, counted in diagnostics)")
 
 
+def test_a_non_finite_command_is_refused_and_the_last_one_still_holds():
+    """The one rule of the plant and the world (core.rules.admission.command_refusal)."""
+    taken = intake()
+    assert taken.take(0, WORLD, (0.5, 0.0, 0.0), (0.0, 0.0, 0.0), 40, 1) is None
+    nan = float('nan')
+    assert taken.take(0, WORLD, (nan, 0.0, 0.0), (0.0, 0.0, 0.0), 60, 2) is Reason.NON_FINITE
+    assert taken.take(0, WORLD, (0.1, 0.0, nan), (0.0, 0.0, 0.0), 60, 3) is None
+    assert taken.commands.u[0].tolist() == [0.1, 0.0] and taken.arrived_ns[0] == 3
+    assert taken.take(0, 'map', (nan, 0.0, 0.0), (0, 0, 0), 60, 4) is Reason.FRAME
+    unstamped = intake(stamped=False)
+    assert unstamped.take(1, '', (0.0, float('inf')), (0, 0, 0), 0, 5) is Reason.NON_FINITE
+    team = intake()
+    assert team.take_team([0, 2], WORLD, [[0.1, 0.0, 0.0], [nan, 0.0, 0.0]], np.zeros((2, 3)),
+                          80, 6) is Reason.NON_FINITE
+    assert not team.commands.present.any()
+    assert taken.line(0, Reason.NON_FINITE, 'linear (nan, 0.0, 0.0), angular (0, 0, 0)') == (
+        'robot 1: ignoring a non-finite command on cmd_vel (linear (nan, 0.0, 0.0), angular '
+        '(0, 0, 0); its last one holds until it is stale; logged once, counted in diagnostics)')
+    assert 'non-finite' in team.line(TEAM, Reason.NON_FINITE, WORLD)
+
+
 def test_a_twist_answers_the_latest_state_published_and_a_unicycle_keeps_v_and_w():
     taken = intake(stamped=False, unicycles=True)
     taken.state_stamp_ns = 70

@@ -4,16 +4,15 @@
 """The plant's run statistics (plant_stats.py): latency, the record, plant_stats.json."""
 
 import json
-import os
 
 from formation_ros.core.maths.law import make_law
 from formation_ros.core.maths.reference import Reference
-from formation_ros.core.model.plant import Commands, PLANT_STATS_FILE, PlantModel
+from formation_ros.core.model.plant import Commands, PlantModel
 from formation_ros.core.rules.admission import Reason, Refusals
 from formation_ros.core.rules.plant_intake import TEAM
 from formation_ros.core.rules.plant_stats import (AnswerTimes, DurationHistogram, PUBLISHES_TIMED,
-                                                  RunOutput, RunStats, stats_text)
-from formation_ros.core.runs.trajectory import CHUNKS_DIR, Trajectory, TRAJECTORY_FILE
+                                                  RunStats)
+from formation_ros.core.runs.output import stats_text
 import numpy as np
 import pytest
 
@@ -25,7 +24,7 @@ KEYS = ['integrator', 'simulated_time', 'wall_time', 'achieved_step_rate', 'step
         'future_command_steps', 'saturated_command_steps', 'held_steps', 'shape_changes',
         'events', 'imperfections', 'state_delay_steps', 'oldest_command_counted',
         'command_age_steps', 'answer_latency', 'by_robot', 'wrong_frame_command_messages',
-        'malformed_command_messages', 'transport']
+        'malformed_command_messages', 'non_finite_command_messages', 'transport']
 """The keys of plant_stats.json, in order, as tools/report.py, bench/ and the tests read them."""
 
 
@@ -96,7 +95,8 @@ def test_the_record_keeps_the_keys_and_round_trips_through_json():
     assert read['malformed_command_messages'] == {'1': 1}
     assert read['by_robot']['missing'] == {} and read['answer_latency']['count'] == 0
     team = stats.record(plant, 0.0, refusals, 0, [], {}, 'team')
-    assert list(team) == KEYS + ['malformed_team_command_messages']
+    assert list(team) == KEYS + ['malformed_team_command_messages',
+                                 'non_finite_team_command_messages']
     assert team['malformed_team_command_messages'] == 1 and team['achieved_step_rate'] is None
 
 
@@ -116,34 +116,3 @@ def test_the_closest_pair_is_sampled_on_published_states_and_u_hat_kept():
     line = stats.summary(plant, 1.0, plant.points, LAW.u_bound)
     assert line.startswith('plant: 4 steps (0.04 s simulated in 1.0 s), final max error 0 m, '
                            'min pair distance 2.96 m, max |u_hat| 1 m/s')
-
-
-def test_run_output_writes_both_files_then_drops_the_chunks(tmp_path):
-    plant = model()
-    output = RunOutput(str(tmp_path), unicycles=False)
-    stats = RunStats(plant, 1, False, False)
-    commands = Commands.empty(3, 2)
-    for _ in range(3):
-        commands.store_all(np.zeros((3, 2)), plant.t_ns)
-        output.append(plant.advance(commands))
-    assert output.flush(plant.t) is None and output.chunks.count == 1
-    record = stats.record(plant, 1.0, Refusals(), 0, [], {}, 'robot')
-    wrote, line = output.write(record, FIXED.sample, lambda t_ns: np.zeros((3, 2)), plant.t)
-    assert wrote and line == f'plant: wrote {TRAJECTORY_FILE} and {PLANT_STATS_FILE} to {tmp_path}'
-    assert json.loads((tmp_path / PLANT_STATS_FILE).read_text()) == json.loads(stats_text(record))
-    assert len(Trajectory.load(str(tmp_path / TRAJECTORY_FILE)).t) == 3
-    assert not os.path.exists(tmp_path / CHUNKS_DIR)
-
-
-def test_run_output_that_cannot_write_says_so_once_and_keeps_the_chunks(tmp_path):
-    plant = model()
-    output = RunOutput(str(tmp_path), unicycles=False)
-    commands = Commands.empty(3, 2)
-    commands.store_all(np.zeros((3, 2)), 0)
-    output.append(plant.advance(commands))
-    (tmp_path / PLANT_STATS_FILE).mkdir()
-    wrote, line = output.write({}, FIXED.sample, lambda t_ns: np.zeros((3, 2)), 0.01)
-    assert not wrote and output.failure is not None
-    assert line.startswith('plant: output stopped at t = 0.01 s: cannot write to ')
-    assert 'keeps the trajectory up to t = 0.00 s in 1 chunks' in line
-    assert os.path.exists(tmp_path / CHUNKS_DIR)

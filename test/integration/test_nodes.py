@@ -60,7 +60,8 @@ def test_robot_publishes_the_core_command_and_survives_bad_poses(processes, inst
     assert processes.log('robot_1').count('non-finite') == 1
 
 
-def test_plant_treats_a_non_finite_command_as_zero(processes, install, probe, tmp_path):
+def test_plant_refuses_a_non_finite_command_and_counts_it(processes, install, probe, tmp_path):
+    """The rule of the plant and the world: dropped at intake, counted; nothing moves."""
     out = tmp_path / 'plant'
     processes.start(node(install, 'plant', SQUARE, '-p', 'plant.wait_for_robots:=false',
                          '-p', f'plant.output_dir:={out}'))
@@ -79,7 +80,7 @@ def test_plant_treats_a_non_finite_command_as_zero(processes, install, probe, tm
     [info] = processes.stop(['plant'])
     assert info.returncode == 0, processes.log('plant')
     stats = json.loads((out / 'plant_stats.json').read_text())
-    assert stats['bad_command_steps'] > 0
+    assert stats['non_finite_command_messages']['1'] > 0 and stats['bad_command_steps'] == 0
     trajectory = Trajectory.load(str(out / 'trajectory.npz'))
     assert np.ptp(trajectory.q[:, 0, :], axis=0).max() == 0.0
     log = processes.log('plant')

@@ -27,11 +27,11 @@ def test_two_bases_driven_into_each_other_make_one_contact_and_do_not_pass_throu
     assert 0.5 < event.t < 1.2
     assert event.t == pytest.approx((0.6 - footprints) / 0.4, abs=0.2)
     assert min(gaps) > footprints - 0.01
-    stats = engine.stats()
+    stats = engine.stats(engine.wall)
     assert stats.contacts == 1
     assert stats.min_body_distance == pytest.approx(min(gaps), abs=0.01)
     assert -0.01 < stats.min_footprint_gap < 0.001
-    assert stats.steps == 1500 and stats.simulated == pytest.approx(3.0)
+    assert stats.steps == 1500 and stats.simulated_time == pytest.approx(3.0)
 
 
 def test_bases_that_part_and_meet_again_make_two_contacts():

@@ -129,11 +129,12 @@ def test_a_command_refreshed_within_the_timeout_keeps_the_base_going():
     assert engine.live()[0] and forward_speed(engine)[0] > 0.18
 
 
-def test_a_non_finite_command_is_refused_and_the_last_one_held():
+def test_the_engine_takes_admitted_commands_only_and_keeps_the_last_one():
+    """A non-finite command is the intakes' to refuse (core.rules.admission.command_refusal)."""
     engine = lone_base()
     engine.apply([[0.1, 0.0], [0.0, 0.0]])
-    refused = engine.apply([[math.nan, 0.0], [0.0, math.inf]])
-    assert refused.tolist() == [True, True]
+    with pytest.raises(ValueError):
+        engine.apply([[math.nan, 0.0], [0.0, math.inf]])
     run(engine, 0.4)
     assert abs(forward_speed(engine)[0] - 0.1) < 0.005
 

@@ -4,14 +4,16 @@
 """
 What a node admits of what it hears: the reasons for a refusal, the rule, the count.
 
-One :class:`Reason` enum for every node that refuses input (robot, relay, plant), the rule
-that a pose, a set of poses or a command breaks first (:func:`refusal`, :func:`poses_refusal`)
-and the counter of refusals (:class:`Refusals`). What each node refuses and why:
+One :class:`Reason` enum for every node that refuses input (robot, relay, plant, world), the
+rule that a pose, a set of poses or a command breaks first (:func:`refusal`,
+:func:`poses_refusal`, :func:`command_refusal`) and the counter of refusals
+(:class:`Refusals`). What each node refuses and why:
 docs/faults.md. Logging a refusal once while it lasts is the ROS adapter's
 (``ros.once.RefusalLog``); nothing here decides by what was logged.
 """
 
 import enum
+import math
 from typing import Dict, Generic, Hashable, List, Optional, Tuple, TypeVar
 
 from formation_ros.core.maths.frames import valid_quaternions
@@ -67,6 +69,22 @@ def poses_refusal(frame_id: str, world_frame: str, positions: ArrayLike,
                   and (not needs_orientation or np.all(np.isfinite(orientations))))
     oriented = not needs_orientation or bool(np.all(valid_quaternions(orientations)))
     return refusal(frame_id, world_frame, finite, oriented)
+
+
+def command_refusal(frame_id: str, command_frame: str, values: ArrayLike) -> Optional[Reason]:
+    """
+    Return the first rule a command heard on the wire breaks, or None: the one rule of both.
+
+    The plant and the world admit a command (a robot's ``cmd_vel``, a team message's rows) only
+    in its command frame and with finite values; a refused one is dropped and counted, and the
+    robot's last admitted command holds until it ages out, as after a malformed message.
+    frame_id: the message's (the command frame itself for a Twist, which has none);
+    command_frame: the one it must be in; values: the components the body uses, (width,) or
+    (K, width), m/s and rad/s. Nothing non-finite reaches a model or the engine.
+    """
+    finite = (all(map(math.isfinite, values)) if isinstance(values, tuple)
+              else bool(np.all(np.isfinite(values))))
+    return refusal(frame_id, command_frame, finite)
 
 
 class Refusals(Generic[Source]):

@@ -4,8 +4,9 @@
 """
 The plant's intake of commands, without ROS: a robot's cmd_vel or a team message, once read.
 
-The node reads the bytes (``ros.cdr``); :class:`CommandIntake` checks the frame
-(``core.rules.admission.refusal``) and stores what it admits in ``core.model.plant.Commands`` with
+The node reads the bytes (``ros.cdr``); :class:`CommandIntake` checks the frame and the values
+(``core.rules.admission.command_refusal``, the world's rule too) and stores what it admits in
+``core.model.plant.Commands`` with
 its stamp and arrival. What is refused is counted by the node's ``ros.once.RefusalLog`` under the
 sources robot index (cmd_vel), :data:`TEAM` and 'shape' / 'status'. The faults:
 docs/faults.md; the layouts: docs/ros_interface.md ("Transports").
@@ -14,7 +15,7 @@ docs/faults.md; the layouts: docs/ros_interface.md ("Transports").
 from typing import Dict, List, Optional, Sequence, Union
 
 from formation_ros.core.model.plant import Commands
-from formation_ros.core.rules.admission import Reason, refusal, Refusals
+from formation_ros.core.rules.admission import command_refusal, Reason, Refusals
 from formation_ros.core.rules.transport import command_of, commands_of
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -57,14 +58,14 @@ class CommandIntake:
         linear, angular: (3,) m/s and rad/s; frame_id, stamp_ns: its header's (a Twist's are
         not looked at); arrived_ns: now, ns.
         """
-        if self.stamped:
-            reason = refusal(frame_id, self.command_frames[index], True)
-            if reason is not None:
-                return reason
-        else:
+        expected = self.command_frames[index]
+        values = command_of(linear, angular, self.dim, self.unicycles)
+        reason = command_refusal(frame_id if self.stamped else expected, expected, values)
+        if reason is not None:
+            return reason
+        if not self.stamped:
             stamp_ns = self.state_stamp_ns
-        self.commands.store(index, command_of(linear, angular, self.dim, self.unicycles),
-                            stamp_ns)
+        self.commands.store(index, values, stamp_ns)
         self.arrived_ns[index] = arrived_ns
         return None
 
@@ -77,11 +78,12 @@ class CommandIntake:
         rad/s, in each robot's command frame; frame_id, stamp_ns: its header's, in world_frame
         and stamped with the state the commands answer; arrived_ns: now, ns.
         """
-        reason = refusal(frame_id, self.world_frame, True)
+        values = commands_of(linear, angular, self.dim, self.unicycles)
+        reason = command_refusal(frame_id, self.world_frame, values)
         if reason is not None:
             return reason
         rows = np.asarray(indices, dtype=np.intp)
-        self.commands.u[rows] = commands_of(linear, angular, self.dim, self.unicycles)
+        self.commands.u[rows] = values
         self.commands.stamp_ns[rows] = stamp_ns
         self.commands.present[rows] = True
         self.arrived_ns[rows] = arrived_ns
@@ -117,12 +119,15 @@ class CommandIntake:
         """
         Return the log line of a refusal (``ros.once.RefusalLog``'s line).
 
-        detail: a malformed message's error, the frame of one in another frame, or what is
-        wrong with a change.
+        detail: a malformed message's error, the frame of one in another frame, the values of a
+        non-finite one, or what is wrong with a change.
         """
         if reason is Reason.CHANGE:
             return f'ignoring a {source} with {detail} (logged once; counted in diagnostics)'
         if source == TEAM:
+            if reason is Reason.NON_FINITE:
+                return ('ignoring /formation/commands with a non-finite command (logged once, '
+                        'counted in diagnostics)')
             if reason is Reason.MALFORMED:
                 return ('ignoring /formation/commands bytes that are not a team command '
                         f'({detail}; logged once, counted in diagnostics)')
@@ -133,6 +138,9 @@ class CommandIntake:
             kind = 'TwistStamped' if self.stamped else 'Twist'
             return (f'robot {source + 1}: ignoring cmd_vel bytes that are not a {kind} '
                     f'({detail}; logged once, counted in diagnostics)')
+        if reason is Reason.NON_FINITE:
+            return (f'robot {source + 1}: ignoring a non-finite command on cmd_vel ({detail}; '
+                    'its last one holds until it is stale; logged once, counted in diagnostics)')
         return (f'robot {source + 1}: ignoring cmd_vel in frame {detail!r}: its commands are '
                 f'in {self.command_frames[source]!r} (logged once, counted in diagnostics)')
 

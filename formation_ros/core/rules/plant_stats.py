@@ -7,27 +7,18 @@ The plant's run statistics, without ROS: what a run gathers and ``plant_stats.js
 :class:`RunStats` follows the steps (closest pair, largest u_hat, held steps, answer latency
 by :class:`AnswerTimes`) and makes the record of ``plant_stats.json`` (:meth:`RunStats.record`;
 its keys: docs/ros_interface.md, "Behaviour of the nodes", Shutdown, and docs/faults.md) and
-the summary line. The model's own counters are ``core.model.plant.PlantCounts``. :class:`RunOutput`
-writes the run into ``plant.output_dir`` (docs/faults.md: the disk fills under the plant's
-output directory).
+the summary line. The model's own counters are ``core.model.plant.PlantCounts``.
+:func:`trajectory_sample` is what a step gives ``core.runs.output.RunOutput``, which writes the
+run into ``plant.output_dir``.
 """
 
 from collections import OrderedDict
-from dataclasses import replace
-import json
-import os
-import shutil
-from typing import Any, Callable, Dict, List, Optional, Tuple
+from typing import Any, Dict, List, Optional, Tuple
 
-from formation_ros.core.maths.frames import FrameSample
 from formation_ros.core.maths.units import NS_PER_S
-from formation_ros.core.model.plant import (Commands, CommandStatus, PLANT_STATS_FILE, PlantModel,
-                                            StepReport)
+from formation_ros.core.model.plant import Commands, CommandStatus, PlantModel, StepReport
 from formation_ros.core.rules.admission import Reason, Refusals
 from formation_ros.core.rules.plant_intake import refused_by_robot, Source, TEAM
-from formation_ros.core.runs.trajectory import (CHUNKS_DIR, ChunkWriter, read_body_chunks,
-                                                read_chunks, save_atomically, Trajectory,
-                                                TRAJECTORY_FILE)
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -128,8 +119,6 @@ class RunStats:
         self.held_steps = 0
         """Steps run while the team was stopped (``/formation/status``)."""
         self.answers = AnswerTimes(model.num_robots)
-        self.started: Optional[float] = None
-        """When the first state was published (steady clock, s); None before."""
 
     def stepped(self, model: PlantModel, report: StepReport, held: bool) -> bool:
         """
@@ -196,99 +185,25 @@ class RunStats:
             stats['min_body_distance'] = self.closest_body
         stats['wrong_frame_command_messages'] = refused_by_robot(refusals, Reason.FRAME)
         stats['malformed_command_messages'] = refused_by_robot(refusals, Reason.MALFORMED)
+        stats['non_finite_command_messages'] = refused_by_robot(refusals, Reason.NON_FINITE)
         stats['transport'] = transport
         if transport == 'team':
             stats['malformed_team_command_messages'] = refusals.count(TEAM, Reason.MALFORMED)
+            stats['non_finite_team_command_messages'] = refusals.count(TEAM, Reason.NON_FINITE)
         return stats
 
 
-def stats_text(record: Dict[str, Any]) -> bytes:
-    """Return ``record`` as the bytes of ``plant_stats.json``."""
-    return (json.dumps(record, indent=2) + '\n').encode()
-
-
-class RunOutput:
+def trajectory_sample(report: StepReport, unicycles: bool) -> Tuple[
+        float, NDArray[np.float64], NDArray[np.float64], Dict[str, NDArray[np.float64]]]:
     """
-    The run written into ``output_dir``.
+    Return the sample of ``trajectory.npz`` a step starts from: (t, q, u, extras).
 
-    A chunk of samples at a time, then ``trajectory.npz`` and ``plant_stats.json``. A write that
-    fails stops the output (:attr:`failure`); what was written is kept.
+    t: s; q: (N, dim) control points, m (hand points of unicycles); u: (N, dim) the velocity
+    applied, m/s; extras, for unicycles: heading (N,) rad, q_body (N, 2) m and body_command
+    (N, 2) the (v, w) applied (``core.runs.trajectory.CHUNK_EXTRAS``).
     """
-
-    def __init__(self, output_dir: str, unicycles: bool) -> None:
-        """Write into ``output_dir`` (its chunk folder is made now)."""
-        self.output_dir = output_dir
-        self.unicycles = unicycles
-        self.chunks = ChunkWriter(os.path.join(output_dir, CHUNKS_DIR))
-        self.failure: Optional[str] = None
-        """Why the output stopped: 'cannot write to WHERE (REASON)'; None while it runs."""
-
-    def append(self, report: StepReport) -> None:
-        """Keep the state a step started from as the next sample."""
-        t = report.t_ns / NS_PER_S
-        if self.unicycles:
-            self.chunks.append(t, report.points, report.admission.velocity,
-                               heading=report.heading, q_body=report.q,
-                               body_command=report.admission.u)
-        else:
-            self.chunks.append(t, report.q, report.admission.velocity)
-
-    def flush(self, t: float) -> Optional[str]:
-        """Write the samples kept as a chunk; return the line of a failure (t: now, s)."""
-        try:
-            self.chunks.flush()
-        except OSError as exc:
-            return self._failed(exc, self.chunks.folder, t)
-        return None
-
-    def _failed(self, exc: OSError, where: str, t: float) -> str:
-        """Note that the output stopped at ``t`` (s) writing ``where``; return the line."""
-        until = self.chunks.written_until
-        kept = ('nothing of the trajectory' if until is None else
-                f'the trajectory up to t = {until:.2f} s in {self.chunks.count} chunks '
-                f'({CHUNKS_DIR}/, which formation_report reads)')
-        reason = exc.strerror or ' '.join(str(exc).split()) or type(exc).__name__
-        self.failure = f'cannot write to {where} ({reason})'
-        return (f'plant: output stopped at t = {t:.2f} s: {self.failure}; {self.output_dir} '
-                f'keeps {kept}; the plant goes on controlling and writes nothing more there')
-
-    def trajectory(self, frame_at: Callable[[float], FrameSample],
-                   shape_at: Callable[[int], NDArray[np.float64]]) -> Optional[Trajectory]:
-        """
-        Return the run in the chunks written: a sample per published state (None if none).
-
-        frame_at(t): the reference frame at t s; shape_at(t_ns): the shape in force (N, dim), m.
-        """
-        try:
-            t, q, u = read_chunks(self.chunks.folder)
-        except ValueError:
-            return None
-        frames = [frame_at(time_s) for time_s in t]
-        shapes = [shape_at(int(round(time_s * NS_PER_S))) for time_s in t]
-        trajectory = Trajectory.from_frames(t, q, u, frames, shapes)
-        body = read_body_chunks(self.chunks.folder) if self.unicycles else None
-        return trajectory if body is None else replace(trajectory, **body)
-
-    def write(self, record: Dict[str, Any], frame_at: Callable[[float], FrameSample],
-              shape_at: Callable[[int], NDArray[np.float64]], t: float) -> Tuple[bool, str]:
-        """
-        Write ``plant_stats.json`` (``record``) and ``trajectory.npz``, then drop the chunks.
-
-        Returns (whether it wrote them, the line to log); t: now, s. The files are written
-        whole or not at all (``core.runs.trajectory.save_atomically``).
-        """
-        failed = self.flush(t)
-        if failed is not None:
-            return False, failed
-        where = os.path.join(self.output_dir, PLANT_STATS_FILE)
-        try:
-            save_atomically(where, lambda stream: stream.write(stats_text(record)))
-            trajectory = self.trajectory(frame_at, shape_at)
-            where = os.path.join(self.output_dir, TRAJECTORY_FILE)
-            if trajectory is not None:
-                trajectory.save(where)
-        except OSError as exc:
-            return False, self._failed(exc, where, t)
-        if trajectory is not None:
-            shutil.rmtree(self.chunks.folder, ignore_errors=True)
-        return True, f'plant: wrote {TRAJECTORY_FILE} and {PLANT_STATS_FILE} to {self.output_dir}'
+    t = report.t_ns / NS_PER_S
+    if not unicycles:
+        return t, report.q, report.admission.velocity, {}
+    return t, report.points, report.admission.velocity, {
+        'heading': report.heading, 'q_body': report.q, 'body_command': report.admission.u}

@@ -140,12 +140,16 @@ class PlantStatus:
         malformed = refused_by_robot(refusals, Reason.MALFORMED)
         if malformed:
             values['robots with malformed cmd_vel messages'] = _counts(malformed)
+        non_finite = refused_by_robot(refusals, Reason.NON_FINITE)
+        if non_finite:
+            values['robots with non-finite cmd_vel messages'] = _counts(non_finite)
         if self.team_transport:
             listened = np.zeros(0, bool) if heard.listened is None else heard.listened
             values['transport'] = 'team'
             values['malformed team command messages'] = refusals.count(TEAM, Reason.MALFORMED)
             values['team command messages in another frame'] = refusals.count(
                 TEAM, Reason.FRAME)
+            values['non-finite team command messages'] = refusals.count(TEAM, Reason.NON_FINITE)
             values['team command publishers'] = heard.team_publishers
             values['robots with pose and neighbors published'] = ', '.join(
                 str(i + 1) for i in np.flatnonzero(listened).tolist()) or 'none'

@@ -1,9 +1,9 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""The world's pace: steps due at wall time x factor, a world too slow lets time go, counted."""
+"""The pace of a plant and a world: steps due at wall time x factor; a slow world lets time go."""
 
-from formation_ros.physics.pacing import Pacer
+from formation_ros.core.rules.pacing import Pacer
 import pytest
 
 STEP_NS = 2_000_000
@@ -45,3 +45,14 @@ def test_pacing_needs_a_start():
     with pytest.raises(RuntimeError):
         Pacer(STEP_NS, 1.0, 100 * MS).due(0, 0)
     assert Pacer(STEP_NS, 1.0, 100 * MS).achieved(5, 0) == 0.0
+
+
+def test_a_lockstep_run_ahead_of_the_wall_clock_waits_the_difference():
+    pacer = Pacer(STEP_NS, 0.5, 100 * MS)
+    pacer.start(10 * MS, 3)
+    assert pacer.ahead_ns(10 * MS, 3) == 0.0
+    assert pacer.ahead_ns(12 * MS, 4) == 2 * MS
+    assert pacer.ahead_ns(15 * MS, 4) == -1 * MS
+    assert pacer.wall_s(1010 * MS) == pytest.approx(1.0) and pacer.step_period_s == 0.004
+    with pytest.raises(RuntimeError):
+        Pacer(STEP_NS, 1.0, 100 * MS).ahead_ns(0, 0)
