@@ -22,8 +22,9 @@ import time
 from typing import Any, Dict, List, Optional
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros.core.maths.unicycle import hand_points, quaternions_from_headings
+from formation_ros.core.maths.unicycle import quaternions_from_headings
 from formation_ros.core.maths.units import NS_PER_S
+from formation_ros.core.model.bodies import make_bodies
 from formation_ros.core.model.commanded import (commanded_velocity, HeardOrientations,
                                                 needs_orientation)
 from formation_ros.core.rules.admission import Reason
@@ -94,6 +95,7 @@ class WorldNode(Node):
         self.engine = Engine(config, config.world)
         self.n, self.dim = config.num_robots, config.dim
         self.unicycles = config.body.is_unicycle
+        self.bodies = make_bodies(config.body)
         self.body_frame = config.command.frame is CommandFrame.BODY
         self.stamped = config.command.stamped
         self.once = OnceLog(self.get_logger())
@@ -332,7 +334,7 @@ class WorldNode(Node):
             commanded_velocity(held, orientations, self.unicycles, distance, self.body_frame)
             for orientations in (answered, quaternions_from_headings(headings)))
         if self.unicycles:
-            self.output.append(t, hand_points(positions, headings, distance), commanded,
+            self.output.append(t, self.bodies.control_points(positions, headings), commanded,
                                heading=headings, q_body=positions, body_command=held,
                                u_held=at_truth)
             return

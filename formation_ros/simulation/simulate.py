@@ -21,9 +21,9 @@ from typing import Callable, Optional, Sequence, TextIO, Tuple
 from formation_ros.core.maths.frames import desired_positions, FrameSample
 from formation_ros.core.maths.law import team_command
 from formation_ros.core.maths.safety import body_clearance, guaranteed_min_distance
-from formation_ros.core.maths.unicycle import hand_points, unicycle_commands, unicycle_rates
+from formation_ros.core.maths.unicycle import unicycle_rates
 from formation_ros.core.maths.units import NS_PER_S
-from formation_ros.core.model.bodies import make_bodies
+from formation_ros.core.model.bodies import make_bodies, UnicycleBodies
 from formation_ros.core.model.plant import Commands, PlantCounts, PlantModel
 from formation_ros.core.runs.events import Event, EventKind, timeline_events, with_shapes
 from formation_ros.core.runs.metrics import (body_metrics, compute_metrics, held_metrics,
@@ -242,32 +242,33 @@ def simulate_unicycles(config: FormationConfig, duration: float, sample_dt: floa
     """
     Integrate the unicycles (U1) with RK45, each commanded through its hand point (U4).
 
-    The state is every axle centre and heading; the law sees the hand points (U2). In
+    The state is every axle centre and heading; the law sees the hand points (U2), mapped
+    by ``core.model.bodies`` without the actuator caps (the ideal system). In
     continuous time the hand points then move exactly as the paper's points, p' = u (U3).
     """
     law = config.law()
     reference = config.reference()
     shapes = shapes_of(config)
     n = config.num_robots
-    l_value = config.body.hand_distance
+    bodies = UnicycleBodies(config.body.hand_distance)
     assert config.start is not None and config.start_headings is not None
 
     def rhs(t: float, y: np.ndarray, vertices: np.ndarray) -> np.ndarray:
         progress.update(t)
         q, heading = y[:2 * n].reshape(n, 2), y[2 * n:]
-        u = team_command(hand_points(q, heading, l_value), vertices, config.sensing_radii,
+        u = team_command(bodies.control_points(q, heading), vertices, config.sensing_radii,
                          law, reference.sample(t)).u
-        q_rate, heading_rate = unicycle_rates(heading, unicycle_commands(u, heading, l_value))
+        q_rate, heading_rate = unicycle_rates(heading, bodies.body_command(u, heading))
         return np.concatenate([q_rate.ravel(), heading_rate])
 
     start = np.concatenate([config.start.ravel(), config.start_headings])
     times, y = integrate_segments(rhs, start, sample_times(duration, sample_dt), shapes)
     q_body = y[:, :2 * n].reshape(-1, n, 2)
     heading = y[:, 2 * n:]
-    trajectory = _assemble(times, hand_points(q_body, heading, l_value), config, law,
+    trajectory = _assemble(times, bodies.control_points(q_body, heading), config, law,
                            reference, shapes)
     return replace(trajectory, heading=heading, q_body=q_body,
-                   body_command=unicycle_commands(trajectory.u, heading, l_value))
+                   body_command=bodies.body_command(trajectory.u, heading))
 
 
 def continuous_time_problem(config: FormationConfig) -> Optional[str]:

@@ -26,8 +26,9 @@ import tempfile
 from typing import Any, Dict, List, Optional, Tuple
 
 from formation_ros.core.maths.frames import advance, FrameSample
-from formation_ros.core.maths.unicycle import hand_points, headings_from_quaternions
+from formation_ros.core.maths.unicycle import headings_from_quaternions
 from formation_ros.core.maths.units import NS_PER_S
+from formation_ros.core.model.bodies import UnicycleBodies
 from formation_ros.core.model.commanded import (commanded_velocity, needs_orientation,
                                                 UNKNOWN_ORIENTATION)
 from formation_ros.core.runs.events import timeline_events
@@ -546,8 +547,8 @@ def trajectory_from_topics(recorded: Recorded,
     if not unicycles:
         return Trajectory.from_frames(t, q, u, frames, vertices).with_held(u_held, frames), info
     heading = headings_from_quaternions(sampled)
-    trajectory = Trajectory.from_frames(t, hand_points(q, heading, l_value), u, frames,
-                                        vertices).with_held(u_held, frames)
+    points = UnicycleBodies(l_value).control_points(q, heading)
+    trajectory = Trajectory.from_frames(t, points, u, frames, vertices).with_held(u_held, frames)
     return replace(trajectory, heading=heading, q_body=q, body_command=held), info
 
 

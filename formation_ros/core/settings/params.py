@@ -25,9 +25,10 @@ from formation_ros.core.maths.law import LawParams, make_law, PSI_FUNCTIONS, Psi
 from formation_ros.core.maths.pairs import closest_pair
 from formation_ros.core.maths.reference import dimension_problem, PERIODIC, Reference
 from formation_ros.core.maths.reference import ReferenceKind
-from formation_ros.core.maths.unicycle import command_bounds, hand_points
+from formation_ros.core.maths.unicycle import command_bounds
 from formation_ros.core.maths.units import NS_PER_S
-from formation_ros.core.model.bodies import BodyKind, BodySettings, POINT_BODY, random_headings
+from formation_ros.core.model.bodies import (BodyKind, BodySettings, make_bodies, POINT_BODY,
+                                             random_headings)
 from formation_ros.core.model.dynamics import IDEAL, Imperfections
 from formation_ros.core.model.plant import start_positions, StartSpec
 from formation_ros.core.settings.declarations import (BY_NAME, check_values, CommandFrame,
@@ -603,7 +604,7 @@ def _body_geometry(body: BodySettings, start: NDArray[np.float64],
                                         f'start: robots {i} and {j} are {gap:g} m apart '
                                         f'(< 2 x {body.radius:g} m)'))
     if headings is not None and body.is_unicycle:
-        gap, i, j = _closest_pair(hand_points(start, headings, body.hand_distance))
+        gap, i, j = _closest_pair(make_bodies(body).control_points(start, headings))
         if gap < HAND_POINTS_APART:
             problems.append(('start.headings', f'robots {i} and {j} start with their hand '
                                                f'points at the same point ({gap:.3g} m apart)'))
