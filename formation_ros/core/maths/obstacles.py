@@ -102,6 +102,29 @@ class Obstacles:
         """Return the number of obstacles M: circles, then walls, then spheres."""
         return len(self.circles) + len(self.walls) + len(self.spheres)
 
+    def grown(self, margin: float) -> 'Obstacles':
+        """
+        Return these obstacles grown by ``margin`` m: every radius and half-thickness.
+
+        A robot's footprint of radius ``margin`` about its control point touches an obstacle
+        exactly when the point touches the grown one (the configuration space of a disc among
+        convex obstacles; grown obstacles are still convex). Nothing else changes.
+        """
+        if margin < 0.0 or not math.isfinite(margin):
+            raise ValueError(f'margin must be a finite number >= 0, got {margin!r}')
+        circles, walls, spheres = (np.array(rows) for rows in (self.circles, self.walls,
+                                                               self.spheres))
+        circles[:, 2] += margin
+        walls[:, 4] += margin
+        spheres[:, 3] += margin
+        return Obstacles(circles, walls, spheres, self.clearance, self.dim)
+
+    def labels(self) -> Tuple[str, ...]:
+        """Return a name for every obstacle, in :attr:`count` order: 'circle 1', 'wall 1' ..."""
+        return tuple([f'circle {k + 1}' for k in range(len(self.circles))]
+                     + [f'wall {k + 1}' for k in range(len(self.walls))]
+                     + [f'sphere {k + 1}' for k in range(len(self.spheres))])
+
     def surface(self, q: ArrayLike) -> Surface:
         """
         Return the :class:`Surface` of every obstacle as every robot sees it.

@@ -74,6 +74,18 @@ class BodySettings:
         """Tell whether the robots are unicycles."""
         return self.kind is BodyKind.UNICYCLE
 
+    @property
+    def footprint(self) -> float:
+        """
+        Return the radius about the control point that holds the whole body, m.
+
+        A point body: ``radius``. A unicycle's control point is its hand point, l ahead of the
+        body's centre, so the disc of radius l + ``radius`` about it holds the body's disc
+        whatever its heading: the law keeps that disc off obstacles (docs/equations.md,
+        "Obstacles").
+        """
+        return self.radius + (self.hand_distance if self.is_unicycle else 0.0)
+
 
 POINT_BODY = BodySettings()
 

@@ -133,6 +133,9 @@ SCHEDULE = frozenset({Exe.SIM, Exe.REFERENCE, Exe.RECORD})
 PHYSICS = frozenset({Exe.SIM, Exe.WORLD})
 """The readers of ``world.*``: ``formation_sim --engine mujoco`` and the ``world`` node
 (formation_ros/physics)."""
+MAPPED = frozenset({Exe.SIM, Exe.PLANT, Exe.RECORD, Exe.RELAY, Exe.WORLD})
+"""The readers of the obstacle map (``obstacles.*``): whoever places bodies or tells robots
+their obstacles; a robot hears its obstacles (and reads only ``obstacles.clearance``)."""
 SHAPE_VERTICES = 'formations.<name>.vertices'
 """The declaration of every named shape's vertices: ``formations.line.vertices`` and so on."""
 SHAPE_NAME = re.compile(r'[A-Za-z][A-Za-z0-9_]*')
@@ -277,6 +280,22 @@ DECLARATIONS = (
           high=at_least(10000.0), users=frozenset({Exe.REFERENCE, Exe.RECORD})),
     Param('duration', Kind.DOUBLE, 20.0, 'Length of a run, s.', low=above(0.0),
           high=at_least(1e7)),
+    Param('obstacles.circles', Kind.DOUBLE_ARRAY, None,
+          'Static obstacles: flat list [x, y, r, ...] in world_frame, m: discs in 2D, vertical '
+          'pillars of radius r (unbounded in z) in 3D (beyond the paper: docs/equations.md, '
+          '"Obstacles").', low=at_least(-LENGTH_LIMIT), high=at_least(LENGTH_LIMIT),
+          users=MAPPED),
+    Param('obstacles.walls', Kind.DOUBLE_ARRAY, None,
+          'Static obstacles: flat list [x1, y1, x2, y2, t, ...] in world_frame, m: the points '
+          'within t of the segment from (x1, y1) to (x2, y2); in 3D vertical walls, unbounded '
+          'in z.', low=at_least(-LENGTH_LIMIT), high=at_least(LENGTH_LIMIT), users=MAPPED),
+    Param('obstacles.spheres', Kind.DOUBLE_ARRAY, None,
+          'Static obstacles, 3D only: flat list [x, y, z, r, ...] in world_frame, m.',
+          low=at_least(-LENGTH_LIMIT), high=at_least(LENGTH_LIMIT), users=MAPPED),
+    Param('obstacles.clearance', Kind.DOUBLE, None,
+          'b_o, m: an obstacle repels a robot whose footprint is nearer than this to its '
+          'surface; required with obstacles, at most every R_i.', low=above(0.0),
+          high=at_least(LENGTH_LIMIT), users=MAPPED | {Exe.ROBOT}),
     Param('robot_id', Kind.INT, REQUIRED, 'This robot: 1..num_robots (robot node only).',
           low=at_least(1), users=frozenset({Exe.ROBOT})),
     Param('control_rate', Kind.DOUBLE, 50.0,

@@ -22,6 +22,7 @@ from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 from formation_ros.core.maths.frames import desired_positions, from_frame_velocity
 from formation_ros.core.maths.jump import JumpKind
 from formation_ros.core.maths.law import LawParams, make_law, PSI_FUNCTIONS, PsiKind
+from formation_ros.core.maths.obstacles import Obstacles
 from formation_ros.core.maths.pairs import closest_pair
 from formation_ros.core.maths.reference import dimension_problem, PERIODIC, Reference
 from formation_ros.core.maths.reference import ReferenceKind
@@ -299,7 +300,10 @@ class FormationConfig:
     the executables that do not step bodies); relay: the relay's settings (None for the others);
     transport: per-robot topics or team messages (``transport``; robot for the executables that
     do not read it); world: the physics world's settings (``world.*``; None for the
-    executables that do not read them).
+    executables that do not read them). obstacles: the static obstacles as they are
+    (``obstacles.*``; None without any, and for the executables that do not read the map: a
+    robot hears its obstacles); obstacle_clearance: b_o in m (``obstacles.clearance``, None if
+    not given).
     """
 
     num_robots: int
@@ -337,6 +341,8 @@ class FormationConfig:
     relay: Optional[RelaySettings] = None
     transport: Transport = Transport.ROBOT
     world: Optional[WorldSettings] = None
+    obstacles: Optional[Obstacles] = None
+    obstacle_clearance: Optional[float] = None
 
     @property
     def team_transport(self) -> bool:
@@ -347,6 +353,17 @@ class FormationConfig:
         """Return the control law constants (``core.maths.law.LawParams``)."""
         return make_law(self.gain, self.kappa, self.psi, self.jump_kind,
                         self.jump_order, self.repulsion_radius)
+
+    def law_obstacles(self) -> Optional[Obstacles]:
+        """
+        Return the obstacles as the law sees them: grown by the bodies' footprint, or None.
+
+        The law keeps a robot's control point off the obstacles grown by
+        ``body.footprint`` (``Obstacles.grown``), which keeps its whole body off the real ones.
+        """
+        if self.obstacles is None:
+            return None
+        return self.obstacles.grown(self.body.footprint)
 
     def reference(self) -> Reference:
         """Build the moving desired trajectory (``core.maths.reference.Reference``)."""
@@ -610,6 +627,85 @@ def _body_geometry(body: BodySettings, start: NDArray[np.float64],
                                                f'points at the same point ({gap:.3g} m apart)'))
 
 
+OBSTACLE_LISTS = ('obstacles.circles', 'obstacles.walls', 'obstacles.spheres')
+
+
+def _obstacle_map(values: Mapping[str, Any], dim: int, radii: NDArray[np.float64],
+                  problems: Problems) -> Optional[Obstacles]:
+    """``obstacles.*``: the map, b_o within every R_i; None when no obstacle is given."""
+    clearance = values.get('obstacles.clearance')
+    smallest = float(np.min(radii))
+    if clearance is not None and clearance > smallest:
+        problems.append(('obstacles.clearance', f'b_o = {clearance:g} m must not exceed any '
+                                                f'sensing radius (smallest R_i = {smallest:g} '
+                                                'm): a robot must sense every obstacle that '
+                                                'repels it'))
+        return None
+    given = [values.get(name) or [] for name in OBSTACLE_LISTS]
+    if not any(given):
+        return None
+    if clearance is None:
+        problems.append(('obstacles.clearance', 'is required with obstacles: b_o > 0, m, the '
+                                                "distance from an obstacle's surface within "
+                                                'which it repels'))
+        return None
+    for name, flat, columns in zip(OBSTACLE_LISTS, given, (3, 5, 4)):
+        if len(flat) % columns:
+            problems.append((name, f'takes {columns} numbers an obstacle, got {len(flat)} '
+                                   f'(not a multiple of {columns})'))
+    if len(given[2]) and dim != 3:
+        problems.append(('obstacles.spheres', f'spheres are 3D obstacles; dim is {dim} (use '
+                                              'obstacles.circles)'))
+    for name, flat, columns in zip(OBSTACLE_LISTS, given, (3, 5, 4)):
+        sizes = flat[columns - 1::columns]
+        if any(size <= 0.0 for size in sizes):
+            what = 'half-thickness t' if columns == 5 else 'radius r'
+            problems.append((name, f'every {what} must be > 0, got {min(sizes):g}'))
+    if problems:
+        return None
+    circles, walls, spheres = given
+    return Obstacles(np.asarray(circles, dtype=float), np.asarray(walls, dtype=float),
+                     np.asarray(spheres, dtype=float), clearance=clearance, dim=dim)
+
+
+def _obstacle_places(obstacles: Obstacles, body: BodySettings,
+                     start: Optional[NDArray[np.float64]],
+                     headings: Optional[NDArray[np.float64]],
+                     rest: Optional[NDArray[np.float64]], problems: Problems) -> None:
+    """
+    Refuse a start that touches an obstacle and a resting place within b_o of one.
+
+    start: (N, dim) body positions; rest: (N, dim) the desired positions where the formation
+    comes to rest (a fixed reference, or a moving one at the end of the run), or None. A body
+    touches an obstacle when its footprint does (``BodySettings.footprint`` about the control
+    point, ``FormationConfig.law_obstacles``): the law is not defined there.
+    """
+    grown = obstacles.grown(body.footprint)
+    labels = obstacles.labels()
+    where = (f'its footprint, {body.footprint:g} m about its control point,'
+             if body.footprint > 0.0 else 'its position')
+    if start is not None:
+        points = start
+        if body.is_unicycle and headings is not None:
+            points = make_bodies(body).control_points(start, headings)
+        distances = grown.surface(points).distances
+        i, o = np.unravel_index(int(np.argmin(distances)), distances.shape)
+        if distances[i, o] <= 0.0:
+            problems.append(('start.positions', f'robot {i + 1} starts touching {labels[o]} '
+                                                f'({where} {distances[i, o]:.4g} m from its '
+                                                'surface)'))
+    if rest is not None:
+        distances = grown.surface(rest).distances
+        i, o = np.unravel_index(int(np.argmin(distances)), distances.shape)
+        if distances[i, o] < obstacles.clearance:
+            problems.append(('obstacles.clearance', f"robot {i + 1}'s place in the formation "
+                                                    f'comes within b_o = '
+                                                    f'{obstacles.clearance:g} m of {labels[o]} '
+                                                    f'({where} {distances[i, o]:.4g} m from '
+                                                    'its surface): '
+                                                    'the formation could never be reached'))
+
+
 def _own_settings(values: Mapping[str, Any], exe: Exe, n: int,
                   problems: Problems) -> Dict[str, Any]:
     """Build the executable's own settings object, as keyword arguments of FormationConfig."""
@@ -853,6 +949,14 @@ def validate(raw: Mapping[str, Any], executable: Union[Exe, str] = Exe.SIM) -> F
     headings = _headings(values, body, n, problems) if start is not None else None
     if start is not None and not problems:
         _body_geometry(body, start, headings, problems)
+    mapped = _obstacle_map(values, dim, radii, problems)
+    if mapped is not None and mapped.count and vertices is not None and not problems:
+        reference = Reference(values['reference.kind'], dim, origin, velocity,
+                              values['reference.radius'], values['reference.speed'],
+                              values['reference.pitch'])
+        rest = desired_positions(vertices, reference.sample(
+            0.0 if reference.is_stationary else values['duration']))
+        _obstacle_places(mapped, body, start, headings, rest, problems)
     if body.is_unicycle and vertices is not None and not problems:
         _tracking_problems(body, vertices, Reference(
             values['reference.kind'], dim, origin, velocity, values['reference.radius'],
@@ -871,7 +975,8 @@ def validate(raw: Mapping[str, Any], executable: Union[Exe, str] = Exe.SIM) -> F
         values=values, body=body, start_headings=headings, world_frame=world_frame,
         shapes=shapes, shape_name=values.get('formation.name', ''), schedule=schedule,
         command=command, imperfections=imperfections, relay=relay,
-        transport=Transport(values.get('transport', Transport.ROBOT.value)), **own)
+        transport=Transport(values.get('transport', Transport.ROBOT.value)), obstacles=mapped,
+        obstacle_clearance=values.get('obstacles.clearance'), **own)
 
 
 def load_config(path: PathText,
