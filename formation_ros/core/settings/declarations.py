@@ -234,8 +234,9 @@ DECLARATIONS = (
           'on the hand points).', low=above(0.0), high=at_least(LENGTH_LIMIT)),
     Param('body.radius', Kind.DOUBLE, 0.0,
           'Radius of a body about its position (the axle centre of a unicycle), m: two bodies '
-          'closer than twice this are logged as a collision.', low=at_least(0.0),
-          high=at_least(LENGTH_LIMIT), users=PLACED),
+          'closer than twice this are logged as a collision; with obstacles, part of the '
+          'footprint the law keeps off them.', low=at_least(0.0), high=at_least(LENGTH_LIMIT),
+          users=PLACED | {Exe.ROBOT, Exe.RELAY}),
     Param('body.max_linear', Kind.DOUBLE, None,
           'Unicycles: actuator limit on |v|, m/s; a file whose bound sqrt(2) c M1 '
           'exceeds it is refused, and the plant clips |v| to it; the reference refuses a '
