@@ -644,11 +644,13 @@ def world_summary(out: str) -> str:
     try:
         with open(where, encoding='utf-8') as stream:
             stats = json.load(stream)
-        return (f"world: {stats['contacts']} contacts between robots, closest approach of two "
-                f"bodies {stats['min_body_distance']:.4g} m (footprints "
-                f"{stats['min_footprint_gap']:+.4g} m apart), {stats['simulated_time']:.2f} s "
-                f"simulated at {stats['achieved_realtime_factor']:.3g} x real time "
-                f'({where})')
+        closest = stats['min_body_distance']
+        approach = ('no two bodies measured' if closest is None else
+                    f'closest approach of two bodies {closest:.4g} m (footprints '
+                    f"{stats['min_footprint_gap']:+.4g} m apart)")
+        return (f"world: {stats['contacts']} contacts between robots, {approach}, "
+                f"{stats['simulated_time']:.2f} s simulated at "
+                f"{stats['achieved_realtime_factor']:.3g} x real time ({where})")
     except (OSError, ValueError, KeyError, TypeError) as exc:
         return f'world: no statistics in {where} ({exc})'
 
