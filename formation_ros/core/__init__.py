@@ -4,7 +4,8 @@
 """
 The ROS-free core, in rooms by concern, arrows pointing down only (``test/test_layers.py``).
 
-``maths`` (the paper) <- ``model`` (the bodies) and ``runs`` (sampled runs) <- ``settings``
-(parameters and files) <- ``rules`` (the nodes' rules). Nothing here imports ROS, MuJoCo or
+``maths`` (the paper) <- ``model`` (the bodies) <- ``settings`` (parameters and files);
+``maths`` <- ``runs`` (sampled runs); ``rules`` (the nodes' rules) may import all four.
+``test/test_layers.py`` (``CORE_ROOMS``) states the same. Nothing here imports ROS, MuJoCo or
 matplotlib.
 """
