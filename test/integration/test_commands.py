@@ -68,7 +68,13 @@ def test_points_taking_twists_in_their_own_frames_reach_the_formation(
     assert from_bag['unknown_commands_reason'] == ('unstamped commands do not say which state '
                                                    'they answered')
     assert from_bag['bound_violations'] == 0
-    assert 0.5 < from_bag['max_abs_u_hat_held_component'] <= math.sqrt(2.0) * bound + 1e-9
+    # An unstamped command is paired with the pose the recorder heard last: on a loaded host it
+    # hears poses late, the commands of a stretch fall on one pose and only its last is held at a
+    # sample (a CI run read 0.15 m/s where the robots had sent 2.7). So the bag bounds what it
+    # holds; the commands sent, heard by the probe, show the transient.
+    held = from_bag['max_abs_u_hat_held_component']
+    assert 0.0 < held <= math.sqrt(2.0) * bound + 1e-9
+    assert max(math.hypot(x, y) for _, x, y in moving) > 0.5
 
 
 def test_a_robot_refuses_states_in_another_world_frame(processes, install, probe, tmp_path):
