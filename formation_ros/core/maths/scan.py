@@ -1,0 +1,132 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+A planar laser scan as obstacle points: returns in the world frame, neighbours left out, thinned.
+
+Beyond the paper (issue 37, groundwork: no node reads scans yet). A robot that senses obstacles
+with its own scanner turns each return into a point in the world frame with its pose at the
+scan's stamp; returns on a known neighbour's body are the pair terms' business and are left
+out; the rest within R_i become the surface points p_io of ``core.maths.obstacles``, at most
+one per sector of directions about the robot (the nearest), so that the law's cost stays
+bounded whatever the scanner's resolution.
+
+Angles in rad, counter-clockwise from the scanner's +x; ranges and positions in m. Nothing here
+modifies its arguments.
+"""
+
+from dataclasses import dataclass
+import math
+from typing import Optional, Tuple
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+DEFAULT_SECTORS = 72
+"""Sectors of directions about a robot that keep one scan point each (5 degrees wide)."""
+
+
+@dataclass(frozen=True)
+class ScanShape:
+    """
+    The fixed fields of a scan (``sensor_msgs/LaserScan``), and where the scanner sits.
+
+    angle_min, angle_increment: the first ray's angle and the step between rays, rad (> 0 step);
+    range_min, range_max: the valid returns, m (a return outside them is no return); mount: the
+    scanner's (x, y) in the base's frame, m; mount_yaw: its rotation about +z there, rad.
+    """
+
+    angle_min: float
+    angle_increment: float
+    range_min: float
+    range_max: float
+    mount: Tuple[float, float] = (0.0, 0.0)
+    mount_yaw: float = 0.0
+
+
+def scan_problem(ranges: ArrayLike, shape: ScanShape) -> Optional[str]:
+    """
+    Return why a scan cannot be read, or None.
+
+    ranges: (K,) m. A range may be +inf (nothing within range_max, REP 117) but not NaN nor
+    -inf; the shape's numbers must be finite with a positive angle step and
+    0 <= range_min < range_max.
+    """
+    fields = (shape.angle_min, shape.angle_increment, shape.range_min, shape.range_max,
+              shape.mount_yaw, *shape.mount)
+    if not all(math.isfinite(value) for value in fields):
+        return 'non-finite angle, range limit or mount'
+    if shape.angle_increment <= 0.0:
+        return f'angle_increment must be > 0, got {shape.angle_increment:g}'
+    if not 0.0 <= shape.range_min < shape.range_max:
+        return (f'needs 0 <= range_min < range_max, got {shape.range_min:g} and '
+                f'{shape.range_max:g}')
+    values = np.asarray(ranges, dtype=float)
+    if np.any(np.isnan(values)) or np.any(values == -np.inf):
+        return 'a range is NaN or -inf (only +inf means no return)'
+    return None
+
+
+def scan_points(ranges: ArrayLike, shape: ScanShape, position: ArrayLike,
+                heading: float) -> NDArray[np.float64]:
+    """
+    Return the returns of a scan as points in the world frame: (K, 2), m.
+
+    ranges: (R,) m, ray k at ``angle_min + k * angle_increment`` in the scanner's frame;
+    position: (2,) the base's position and heading its yaw, rad, at the scan's stamp. Rays
+    without a return (+inf, or outside [range_min, range_max]) give no point. The scan must have
+    passed :func:`scan_problem`.
+    """
+    values = np.asarray(ranges, dtype=float).reshape(-1)
+    valid = np.isfinite(values) & (values >= shape.range_min) & (values <= shape.range_max)
+    rays = np.flatnonzero(valid)
+    angles = shape.angle_min + rays * shape.angle_increment + shape.mount_yaw + heading
+    c, s = math.cos(heading), math.sin(heading)
+    mount_x, mount_y = shape.mount
+    origin = np.asarray(position, dtype=float)[:2] + (c * mount_x - s * mount_y,
+                                                      s * mount_x + c * mount_y)
+    points: NDArray[np.float64] = origin + values[rays, None] * np.column_stack(
+        [np.cos(angles), np.sin(angles)])
+    return points
+
+
+def off_neighbours(points: ArrayLike, neighbours: ArrayLike, reach: float) -> NDArray[np.bool_]:
+    """
+    Tell which points are not on a known neighbour's body: (K,) bools.
+
+    points: (K, 2); neighbours: (M, 2) the neighbours' positions, m; reach: a return within
+    this distance of a neighbour's position is that neighbour (its footprint plus a margin for
+    the pose's age and noise), m.
+    """
+    p = np.asarray(points, dtype=float).reshape(-1, 2)
+    others = np.asarray(neighbours, dtype=float).reshape(-1, 2)
+    if len(others) == 0:
+        return np.ones(len(p), dtype=bool)
+    gaps = np.linalg.norm(p[:, None, :] - others[None, :, :], axis=2)
+    kept: NDArray[np.bool_] = np.all(gaps > reach, axis=1)
+    return kept
+
+
+def nearest_by_sector(points: ArrayLike, centre: ArrayLike, radius: float,
+                      sectors: int = DEFAULT_SECTORS) -> NDArray[np.float64]:
+    """
+    Return the nearest point of each sector of directions about ``centre`` within ``radius``.
+
+    points: (K, 2); centre: (2,) m; radius: R_i, m (a point at or beyond it is dropped);
+    sectors: how many equal sectors the circle is cut into. Returns (at most ``sectors``, 2),
+    ordered by sector from -pi: the points a robot's law uses (one surface point per direction).
+    """
+    p = np.asarray(points, dtype=float).reshape(-1, 2)
+    offset = p - np.asarray(centre, dtype=float)[:2]
+    distance = np.linalg.norm(offset, axis=1)
+    near = distance < radius
+    p, offset, distance = p[near], offset[near], distance[near]
+    if len(p) == 0:
+        return np.zeros((0, 2))
+    angle = np.arctan2(offset[:, 1], offset[:, 0])
+    sector = np.minimum((angle + math.pi) / (2.0 * math.pi) * sectors, sectors - 1).astype(int)
+    order = np.lexsort((distance, sector))
+    first = np.ones(len(order), dtype=bool)
+    first[1:] = sector[order][1:] != sector[order][:-1]
+    nearest: NDArray[np.float64] = p[order[first]]
+    return nearest
