@@ -3,10 +3,14 @@
 
 """Obstacles in the physics world: geoms where the map says, bodies that stop at them, counts."""
 
+import json
 import math
+import os
 from xml.etree import ElementTree
 
 from formation_ros.core.maths.obstacles import Obstacles
+from formation_ros.core.runs.trajectory import Trajectory
+from formation_ros.core.settings.params import load_config
 import numpy as np
 import pytest
 
@@ -16,9 +20,12 @@ from formation_ros.physics.contacts import ObstacleApproach, ObstacleContactLog 
 from formation_ros.physics.engine import Engine  # noqa: E402, I100
 from formation_ros.physics.obstacles import obstacle_of_geom  # noqa: E402, I100
 from formation_ros.physics.scene import build_scene, CEILING_ABOVE  # noqa: E402, I100
+from formation_ros.tools.sim import main as sim_main  # noqa: E402, I100
 from physics_helpers import bases, run, team  # noqa: E402, I100
 
 LIVE = {'world.cmd_timeout': 10.0}
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+OBSTACLE_CONFIG = os.path.join(ROOT, 'config', 'world_turtlebot3_obstacles.yaml')
 
 
 def floats(*values):
@@ -186,3 +193,22 @@ def test_the_obstacle_log_holds_a_pair_until_it_parts_and_the_approach_is_exact_
     approach.update(np.array([[3.0, 0.0], [0.0, 1.75]]), 7)
     approach.update(np.array([[3.0, 0.0], [0.0, 1.5]]), 8)
     assert approach.gap == pytest.approx(0.4) and approach.t_ns == 8
+
+
+def test_the_turtlebot3_config_among_obstacles_crosses_them_without_contact(tmp_path, capsys):
+    out = tmp_path / 'run'
+    assert sim_main([OBSTACLE_CONFIG, '--engine', 'mujoco', '--out', str(out), '--duration',
+                     '20', '--no-plots', '--quiet']) == 0
+    assert 'with obstacles (closest body +' in capsys.readouterr().out
+    stats = json.loads((out / 'world_stats.json').read_text())
+    assert stats['obstacle_contacts'] == 0 and stats['contacts'] == 0
+    assert stats['obstacle_contact_events'] == [] and stats['min_obstacle_gap'] > 0.0
+    trajectory = Trajectory.load(str(out / 'trajectory.npz'))
+    config = load_config(OBSTACLE_CONFIG)
+    pillar_x, _, pillar_r = config.obstacles.circles[0]
+    assert np.all(trajectory.q_body[0, :, 0] < pillar_x - pillar_r)
+    assert np.all(trajectory.q_body[-1, :, 0] > pillar_x + pillar_r), 'the team got past it'
+    gaps = config.obstacles.surface(trajectory.q_body.reshape(-1, 2)).distances - 0.105
+    assert stats['min_obstacle_gap'] == pytest.approx(gaps.min(), abs=0.01)
+    model = mujoco.MjModel.from_xml_path(str(out / 'world.xml'))
+    assert model.geom('obstacle_wall_2').pos[1] == pytest.approx(-1.3)
