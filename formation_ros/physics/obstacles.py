@@ -10,8 +10,8 @@ never move:
 
 * a circle (x, y, r) is a vertical cylinder of radius r about (x, y);
 * a wall (x1, y1, x2, y2, t), the points within t of the segment, is a box as long as the
-  segment and 2 t thick, plus a cylinder of radius t at each end (the rounded ends); a wall
-  whose ends coincide is that one cylinder;
+  segment and 2 t thick, plus a cylinder of radius t at each end (the rounded ends, their
+  tops :data:`END_INSET` below the box's); a wall whose ends coincide is that one cylinder;
 * a sphere (x, y, z, r) is a sphere.
 
 Circles and walls stand between the heights ``bottom`` and ``top`` (m; the scene chooses them:
@@ -36,6 +36,9 @@ OBSTACLE_RGBA = '0.55 0.5 0.45 1'
 """The obstacles' colour: stone grey."""
 PREFIX = 'obstacle_'
 """Every obstacle geom's name starts so."""
+END_INSET = 0.001
+"""A wall's rounded ends stop this far below its top, m, so that their tops and the box's are
+not drawn in one plane (which flickers); the bodies never reach that high."""
 
 
 def geom_name(label: str, part: str = '') -> str:
@@ -86,9 +89,10 @@ def add_obstacles(worldbody: ElementTree.Element, obstacles: Obstacles, bottom: 
             _static(worldbody, geom_name(label), 'box', numbers((0.5 * length, t, half)),
                     numbers((0.5 * (x1 + x2), 0.5 * (y1 + y2), middle)),
                     euler=numbers((0.0, 0.0, math.atan2(y2 - y1, x2 - x1))))
+        inset = min(END_INSET, half) if length > 0.0 else 0.0
         for end, (x, y) in enumerate(ends, start=1):
             _static(worldbody, geom_name(label, f'_end_{end}'), 'cylinder',
-                    numbers((t, half)), numbers((x, y, middle)))
+                    numbers((t, half - 0.5 * inset)), numbers((x, y, middle - 0.5 * inset)))
     first_sphere = len(obstacles.circles) + len(obstacles.walls)
     for label, (x, y, z, r) in zip(labels[first_sphere:], obstacles.spheres):
         _static(worldbody, geom_name(label), 'sphere', number(r), numbers((x, y, z)))
