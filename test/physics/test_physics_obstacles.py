@@ -212,3 +212,20 @@ def test_the_turtlebot3_config_among_obstacles_crosses_them_without_contact(tmp_
     assert stats['min_obstacle_gap'] == pytest.approx(gaps.min(), abs=0.01)
     model = mujoco.MjModel.from_xml_path(str(out / 'world.xml'))
     assert model.geom('obstacle_wall_2').pos[1] == pytest.approx(-1.3)
+
+
+def test_a_flyer_driven_into_a_sphere_and_one_into_a_pillar_stop_at_them():
+    config = team([[0.0, 0.0, 1.0], [0.0, 3.0, 1.0]], 3, None,
+                  {'body.radius': 0.1, 'obstacles.spheres': floats(1.0, 0.0, 1.0, 0.3),
+                   'obstacles.circles': floats(1.0, 3.0, 0.2), 'obstacles.clearance': 0.3,
+                   'formation.vertices': far_places(2, 3), **LIVE})
+    engine = Engine(config)
+    engine.apply([[0.3, 0.0, 0.0], [0.3, 0.0, 0.0]])
+    run(engine, 5.0, every=10)
+    positions = engine.poses().positions
+    assert positions[0, 0] == pytest.approx(1.0 - 0.3 - 0.1, abs=0.005)
+    assert positions[1, 0] == pytest.approx(1.0 - 0.2 - 0.1, abs=0.005)
+    stats = engine.stats(engine.wall)
+    assert sorted((e.robot, e.obstacle) for e in stats.obstacle_contact_events) == [
+        (1, 'sphere 1'), (2, 'circle 1')]
+    assert stats.contacts == 0 and -0.005 < stats.min_obstacle_gap < 0.001
