@@ -35,7 +35,7 @@ def world_install(tmp_path):
 def test_the_world_relay_reference_and_robots_run_on_the_worlds_clock(config):
     from formation_ros.core.settings.declarations import BY_NAME as schema, Exe
     views = launcher_views(config, ['--world', '--out', '/nonexistent/w', '--record',
-                                   '/nonexistent/w_bag'])
+                                    '/nonexistent/w_bag'])
     assert [view['executable'] for view in views] == ['record', 'world', 'relay',
                                                       'reference'] + ['robot'] * 4
     record, world, relay, reference, *robots = views
