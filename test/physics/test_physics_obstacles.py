@@ -10,7 +10,7 @@ from xml.etree import ElementTree
 
 from formation_ros.core.maths.obstacles import Obstacles
 from formation_ros.core.runs.trajectory import Trajectory
-from formation_ros.core.settings.params import load_config
+from formation_ros.core.settings.params import FormationConfig, load_config
 import numpy as np
 import pytest
 
@@ -20,6 +20,8 @@ from formation_ros.physics.contacts import ObstacleApproach, ObstacleContactLog 
 from formation_ros.physics.engine import Engine  # noqa: E402, I100
 from formation_ros.physics.obstacles import obstacle_of_geom  # noqa: E402, I100
 from formation_ros.physics.scene import build_scene, CEILING_ABOVE  # noqa: E402, I100
+from formation_ros.simulation.engine_run import run_on_engine  # noqa: E402, I100
+from formation_ros.simulation.simulate import shapes_of  # noqa: E402, I100
 from formation_ros.tools.sim import main as sim_main  # noqa: E402, I100
 from physics_helpers import bases, run, team  # noqa: E402, I100
 
@@ -37,6 +39,13 @@ MAP = {'obstacles.circles': floats(1.0, 0.0, 0.3),
        'obstacles.walls': floats(-1.0, -1.0, 0.5, 0.5, 0.1, 2.0, 2.0, 2.0, 2.0, 0.15),
        'obstacles.clearance': 0.2}
 """A pillar, a diagonal wall and a wall whose ends coincide (a disc of radius t)."""
+
+
+class Quiet:
+    """A progress that says nothing."""
+
+    def update(self, t):
+        """Take the time reached, s."""
 
 
 def free_points(obstacles, count, low, high, clearance, seed, dim):
@@ -229,3 +238,17 @@ def test_a_flyer_driven_into_a_sphere_and_one_into_a_pillar_stop_at_them():
     assert sorted((e.robot, e.obstacle) for e in stats.obstacle_contact_events) == [
         (1, 'sphere 1'), (2, 'circle 1')]
     assert stats.contacts == 0 and -0.005 < stats.min_obstacle_gap < 0.001
+
+
+def test_the_engine_run_s_law_keeps_a_base_off_a_pillar_it_would_hit_without(monkeypatch):
+    config = bases([[-1.0, 0.0], [0.0, 3.0]], [0.0, 0.0],
+                   {'obstacles.circles': floats(0.0, 0.02, 0.15), 'obstacles.clearance': 0.3,
+                    'formation.vertices': floats(1.0, 0.0, 0.0, 3.0), 'controller.gain': 0.15,
+                    'controller.psi': 'tanh', 'controller.kappa': 10.0,
+                    'repulsion_radius': 0.8, 'sensing_radius': 1.5})
+    runs = {'among': run_on_engine(config, 10.0, 0.02, 0.1, shapes_of(config), Quiet())}
+    monkeypatch.setattr(FormationConfig, 'law_obstacles', lambda self: None)
+    runs['blind'] = run_on_engine(config, 10.0, 0.02, 0.1, shapes_of(config), Quiet())
+    assert runs['blind'].stats.obstacle_contacts == 1, 'the pillar is in its way'
+    assert runs['among'].stats.obstacle_contacts == 0
+    assert runs['among'].stats.min_obstacle_gap > 0.1
