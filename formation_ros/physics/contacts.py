@@ -215,9 +215,12 @@ class ObstacleApproach:
     The smallest gap of a body to an obstacle's surface over a run, m, its pair and time.
 
     The gap is :func:`obstacle_gaps`'s (footprint subtracted; < 0: the body overlapped the
-    obstacle). Every step looks only at the candidate pairs, those with a gap below ``skin``
-    when the list was made; the list is remade (every pair) once some body has moved ``skin``
-    / 2 since. So the result is exact whenever the smallest gap is below ``skin`` / 2 (m);
+    obstacle). Only the candidate pairs are looked at, those with a gap below ``skin`` when the
+    list was made; the list is remade (every pair) once some body has moved ``skin`` / 2 since.
+    A candidate's gap is computed again only when it could have fallen below the smallest so
+    far: a gap changes by at most as much as the body moves (a distance to a convex set), so a
+    pair whose last gap less the body's move since is still above the smallest cannot be
+    below it. So the result is exact whenever the smallest gap is below ``skin`` / 2 (m);
     above that it is the smallest of the exact values at the remakes.
     """
 
@@ -231,6 +234,10 @@ class ObstacleApproach:
         self.pair = (-1, -1)
         self.t_ns = 0
         self.candidates: NDArray[np.intp] = np.zeros((0, 2), dtype=np.intp)
+        self.known: NDArray[np.float64] = np.zeros(0)
+        """(K,) each candidate's gap when last computed, m."""
+        self.seen: NDArray[np.float64] = np.zeros((0, np.shape(points)[1]))
+        """(K, dim) where its body was then, m."""
         self._remake(np.asarray(points, dtype=float), 0)
 
     def _remake(self, points: NDArray[np.float64], t_ns: int) -> None:
@@ -239,6 +246,8 @@ class ObstacleApproach:
             return
         gaps = obstacle_gaps(self.obstacles, points, self.footprint)
         self.candidates = np.argwhere(gaps < self.skin)
+        self.known = gaps[self.candidates[:, 0], self.candidates[:, 1]]
+        self.seen = points[self.candidates[:, 0]]
         robot, obstacle = np.unravel_index(int(np.argmin(gaps)), gaps.shape)
         self._keep(float(gaps[robot, obstacle]), int(robot), int(obstacle), t_ns)
 
@@ -254,9 +263,14 @@ class ObstacleApproach:
             return
         if not len(self.candidates):
             return
-        robots, rows = np.unique(self.candidates[:, 0], return_inverse=True)
+        here = points[self.candidates[:, 0]]
+        due = np.flatnonzero(self.known - np.sqrt(squared_norms(here - self.seen)) < self.gap)
+        if not len(due):
+            return
+        pairs = self.candidates[due]
+        robots, rows = np.unique(pairs[:, 0], return_inverse=True)
         gaps = obstacle_gaps(self.obstacles, points[robots], self.footprint)
-        pair_gaps = gaps[rows, self.candidates[:, 1]]
+        pair_gaps = gaps[rows, pairs[:, 1]]
+        self.known[due], self.seen[due] = pair_gaps, here[due]
         k = int(np.argmin(pair_gaps))
-        self._keep(float(pair_gaps[k]), int(self.candidates[k, 0]),
-                   int(self.candidates[k, 1]), t_ns)
+        self._keep(float(pair_gaps[k]), int(pairs[k, 0]), int(pairs[k, 1]), t_ns)

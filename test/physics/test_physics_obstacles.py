@@ -252,3 +252,22 @@ def test_the_engine_run_s_law_keeps_a_base_off_a_pillar_it_would_hit_without(mon
     assert runs['blind'].stats.obstacle_contacts == 1, 'the pillar is in its way'
     assert runs['among'].stats.obstacle_contacts == 0
     assert runs['among'].stats.min_obstacle_gap > 0.1
+
+
+def test_the_closest_approach_to_obstacles_is_the_exact_minimum_over_a_random_walk():
+    obstacles = Obstacles([0.0, 0.0, 0.5, 3.0, 1.0, 0.3], [-2.0, 2.0, 2.0, 2.5, 0.1], [], 0.2,
+                          2)
+    rng = np.random.default_rng(4)
+    points = np.array([[0.9, 0.0], [-1.5, -1.0], [0.0, 1.5], [3.0, 1.6]])
+    approach = ObstacleApproach(obstacles, 0.1, points)
+    smallest = (obstacles.surface(points).distances - 0.1).min()
+    for step in range(1, 600):
+        points = points + rng.normal(0.0, 0.01, points.shape)
+        approach.update(points, step)
+        gaps = obstacles.surface(points).distances - 0.1
+        if gaps.min() < smallest:
+            smallest, when = gaps.min(), step
+            pair = np.unravel_index(np.argmin(gaps), gaps.shape)
+    assert smallest < 0.25
+    assert approach.gap == pytest.approx(smallest, abs=1e-12)
+    assert approach.t_ns == when and approach.pair == tuple(int(k) for k in pair)
