@@ -88,12 +88,14 @@ def flight_ceiling(config: FormationConfig, start: NDArray[np.float64]) -> float
     """
     Return the top of a flying team's pillars and walls, m: :data:`CEILING_ABOVE` over its flight.
 
-    The flight: the starts (N, 3) and the places of the formation (``config.vertices`` about
-    the reference) at :data:`FLIGHT_SAMPLES` times over ``config.duration``.
+    The flight: the starts (N, 3) and the places of every shape the team may take
+    (``config.vertices`` and the named ``formations.*``) about the reference at
+    :data:`FLIGHT_SAMPLES` times over ``config.duration``.
     """
     reference = config.reference()
+    shapes = np.concatenate([config.vertices, *config.shapes.values()])
     times = np.linspace(0.0, config.duration, FLIGHT_SAMPLES)
-    highest = max(float(np.max(desired_positions(config.vertices, reference.sample(t))[:, 2]))
+    highest = max(float(np.max(desired_positions(shapes, reference.sample(t))[:, 2]))
                   for t in times)
     return max(highest, float(np.max(start[:, 2]))) + CEILING_ABOVE
 

@@ -271,3 +271,15 @@ def test_the_closest_approach_to_obstacles_is_the_exact_minimum_over_a_random_wa
     assert smallest < 0.25
     assert approach.gap == pytest.approx(smallest, abs=1e-12)
     assert approach.t_ns == when and approach.pair == tuple(int(k) for k in pair)
+
+
+def test_a_flying_team_s_pillars_cover_every_shape_it_may_take():
+    config = team([[0.0, 0.0, 1.0], [1.0, 0.0, 1.0]], 3, None, {
+        'obstacles.circles': floats(3.0, 3.0, 0.2), 'obstacles.clearance': 0.2,
+        'formation.vertices': floats(-2.0, 0.0, 1.0, -2.0, 1.0, 1.0),
+        'formations.names': ['high'],
+        'formations.high.vertices': floats(-2.0, 0.0, 4.0, -2.0, 1.0, 6.5)})
+    pillar = ElementTree.fromstring(build_scene(config).xml).find(
+        ".//geom[@name='obstacle_circle_1']")
+    z, half = float(pillar.get('pos').split()[2]), float(pillar.get('size').split()[1])
+    assert z + half == pytest.approx(6.5 + CEILING_ABOVE)
