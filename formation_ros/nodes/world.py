@@ -40,6 +40,7 @@ from formation_ros.core.settings.exits import ENGINE_FAILED, REFUSED
 from formation_ros.core.settings.params import world_size_problem
 from formation_ros.physics.engine import Engine, Unstable, unstable_line
 from formation_ros.physics.intake import CommandInbox
+from formation_ros.physics.obstacles import footprint_note
 from formation_ros.physics.scene import WORLD_FILE
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import (CdrError, encode_clock, encode_odometry, encode_pose_stamped,
@@ -163,6 +164,11 @@ class WorldNode(Node):
             + (f', {self.engine.obstacles.count} obstacles' if self.engine.obstacles.count
                else '')
             + (f', writing to {self.output_dir}' if self.output_dir else ''))
+
+        note = footprint_note(self.engine.obstacles, config.body.radius,
+                              self.engine.model.footprint)
+        if note is not None:
+            self.get_logger().warning(f'world: {note}')
 
     def _start_output(self) -> None:
         """

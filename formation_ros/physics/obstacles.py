@@ -96,3 +96,19 @@ def add_obstacles(worldbody: ElementTree.Element, obstacles: Obstacles, bottom: 
     first_sphere = len(obstacles.circles) + len(obstacles.walls)
     for label, (x, y, z, r) in zip(labels[first_sphere:], obstacles.spheres):
         _static(worldbody, geom_name(label), 'sphere', number(r), numbers((x, y, z)))
+
+
+def footprint_note(obstacles: Obstacles, body_radius: float, footprint: float) -> Optional[str]:
+    """
+    Say in one line that the law keeps a smaller body off the obstacles than the world has.
+
+    body_radius: ``body.radius``, m, the radius the law keeps off the obstacles about the body's
+    centre; footprint: the radius of the world's bodies, m (a point without ``body.radius``
+    gets a default one, a base one that holds its wheels). None when the law covers the
+    bodies or there is no obstacle.
+    """
+    if obstacles.count == 0 or body_radius >= footprint:
+        return None
+    return (f'the bodies in the world are {footprint:g} m in radius but body.radius is '
+            f'{body_radius:g} m, all the law keeps off the obstacles: a body may touch one '
+            f'(body.radius: {footprint:g} would cover it)')

@@ -47,12 +47,15 @@ class EngineRun:
 
     trajectory: the samples; stats: what the run did (``world_stats.json``; its wall_time is
     the loop of law and engine); failure: the one line of an engine that blew up
-    (``physics.engine.unstable_line``: the run stops there), None if none.
+    (``physics.engine.unstable_line``: the run stops there), None if none; note: a line on
+    bodies larger than the law keeps off the obstacles (``physics.obstacles.footprint_note``),
+    None if none.
     """
 
     trajectory: Trajectory
     stats: WorldRunStats
     failure: Optional[str] = None
+    note: Optional[str] = None
 
 
 def engine_problem(config: FormationConfig, control_dt: float) -> Optional[str]:
@@ -85,6 +88,7 @@ def run_on_engine(config: FormationConfig, duration: float, control_dt: float,
     ``simulate.Progress``. The engine's ``world.output_dir`` is not used.
     """
     from formation_ros.physics.engine import Engine, Unstable, unstable_line
+    from formation_ros.physics.obstacles import footprint_note
     engine = Engine(config)
     begun = time.perf_counter()
     failure: Optional[str] = None
@@ -134,7 +138,9 @@ def run_on_engine(config: FormationConfig, duration: float, control_dt: float,
     if bodies.has_heading:
         trajectory = replace(trajectory, heading=np.array(headings), q_body=np.array(q_body),
                              body_command=np.array(held))
-    return EngineRun(trajectory, engine.stats(time.perf_counter() - begun), failure)
+    return EngineRun(trajectory, engine.stats(time.perf_counter() - begun), failure,
+                     footprint_note(engine.obstacles, config.body.radius,
+                                    engine.model.footprint))
 
 
 def engine_metrics(run: EngineRun) -> Dict[str, Any]:
@@ -155,4 +161,5 @@ def engine_summary(run: EngineRun) -> str:
             'event(s) between robots, closest approach of two bodies '
             f'{stats.min_body_distance:.4g} m (footprints '
             f'{stats.min_footprint_gap:+.4g} m apart){obstacles}, {stats.steps} steps at '
-            f'{stats.achieved_realtime_factor:.1f}x real time')
+            f'{stats.achieved_realtime_factor:.1f}x real time'
+            + (f'\n  note: {run.note}' if run.note else ''))

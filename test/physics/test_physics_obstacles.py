@@ -18,9 +18,9 @@ mujoco = pytest.importorskip('mujoco')
 
 from formation_ros.physics.contacts import ObstacleApproach, ObstacleContactLog  # noqa: E402, I100
 from formation_ros.physics.engine import Engine  # noqa: E402, I100
-from formation_ros.physics.obstacles import obstacle_of_geom  # noqa: E402, I100
+from formation_ros.physics.obstacles import footprint_note, obstacle_of_geom  # noqa: E402, I100
 from formation_ros.physics.scene import build_scene, CEILING_ABOVE  # noqa: E402, I100
-from formation_ros.simulation.engine_run import run_on_engine  # noqa: E402, I100
+from formation_ros.simulation.engine_run import engine_summary, run_on_engine  # noqa: E402, I100
 from formation_ros.simulation.simulate import shapes_of  # noqa: E402, I100
 from formation_ros.tools.sim import main as sim_main  # noqa: E402, I100
 from physics_helpers import bases, run, team  # noqa: E402, I100
@@ -283,3 +283,20 @@ def test_a_flying_team_s_pillars_cover_every_shape_it_may_take():
         ".//geom[@name='obstacle_circle_1']")
     z, half = float(pillar.get('pos').split()[2]), float(pillar.get('size').split()[1])
     assert z + half == pytest.approx(6.5 + CEILING_ABOVE)
+
+
+def test_bodies_larger_than_the_law_keeps_off_the_obstacles_are_said_once():
+    pillar = {'obstacles.circles': floats(3.0, 3.0, 0.2), 'obstacles.clearance': 0.2,
+              'formation.vertices': far_places(2, 2)}
+    bare = team([[0.0, 0.0], [1.0, 0.0]], 2, None, pillar)
+    run = run_on_engine(bare, 0.04, 0.02, 0.02, shapes_of(bare), Quiet())
+    assert run.note == ('the bodies in the world are 0.1 m in radius but body.radius is 0 m, '
+                        'all the law keeps off the obstacles: a body may touch one '
+                        '(body.radius: 0.1 would cover it)')
+    assert engine_summary(run).endswith(f'\n  note: {run.note}')
+    sized = Engine(team([[0.0, 0.0], [1.0, 0.0]], 2, None, {**pillar, 'body.radius': 0.1}))
+    assert footprint_note(sized.obstacles, 0.1, sized.model.footprint) is None
+    base = Engine(bases([[0.0, 0.0], [1.0, 0.0]], [0.0, 0.0], pillar))
+    assert footprint_note(base.obstacles, 0.11, base.model.footprint) is None
+    free = Engine(team([[0.0, 0.0], [1.0, 0.0]]))
+    assert footprint_note(free.obstacles, 0.0, free.model.footprint) is None
