@@ -161,7 +161,7 @@ class WorldNode(Node):
             f'world: {self.n} {self.engine.model.kind.value} robots in {self.dim}D, timestep '
             f'{self.world.timestep:g} s, realtime factor {self.world.realtime_factor:g}, '
             f'poses at {self.world.pose_rate:g} Hz'
-            + (f', {self.engine.obstacles.count} obstacles' if self.engine.obstacles.count
+            + (f', obstacles: {self.engine.obstacles.count}' if self.engine.obstacles.count
                else '')
             + (f', writing to {self.output_dir}' if self.output_dir else ''))
 
