@@ -3,6 +3,7 @@
 
 """formation_render: a run replayed in its MuJoCo world by the offscreen renderer, as a GIF."""
 
+from dataclasses import replace
 import math
 import os
 import sys
@@ -12,7 +13,8 @@ import pytest
 
 mujoco = pytest.importorskip('mujoco')
 
-from formation_ros.core.runs.trajectory import Trajectory, TRAJECTORY_FILE  # noqa: E402, I100
+from formation_ros.core.maths.obstacles import Obstacles  # noqa: E402, I100
+from formation_ros.core.runs.trajectory import Trajectory, TRAJECTORY_FILE  # noqa: E402
 from formation_ros.core.settings.params import load_config, validate  # noqa: E402
 from formation_ros.core.settings.params_file import parse_params_text  # noqa: E402
 from formation_ros.physics.scene import build_scene  # noqa: E402
@@ -240,3 +242,38 @@ def test_the_camera_keeps_every_point_it_frames_in_the_picture(mode):
         assert np.all(np.abs(relative @ right) / depth <= tan_y * aspect)
     if mode == 'follow':
         assert distance[0] < 0.5 * distance[-1], 'the camera does not follow the team'
+
+
+def test_the_obstacles_of_the_parameters_are_drawn(backend, unicycle_run, tmp_path):
+    config = load_config(os.path.join(unicycle_run, 'params.yaml'))
+    trajectory = Trajectory.load(os.path.join(unicycle_run, TRAJECTORY_FILE))
+    among = replace(config, obstacles=Obstacles([0.3, -0.5, 0.15],
+                                                [-0.6, -0.3, -0.6, 0.4, 0.05], [], 0.2, 2))
+    options = render.RenderOptions(width=96, height=72, max_frames=2, camera='fixed',
+                                   shadows=False)
+    pictures = {}
+    for name, each in (('bare', config), ('among', among)):
+        out = str(tmp_path / f'{name}.gif')
+        render.render_run(trajectory, each, out, options, quiet=True, backend=backend)
+        pictures[name] = frames_of(out)[0][0].astype(int)
+    changed = np.abs(pictures['among'] - pictures['bare']).max(axis=2) > 30
+    assert changed.sum() > 40, 'no obstacle drawn'
+    with render.Frames(trajectory, among, options, backend, trajectory.t[:1]) as drawer:
+        names = [mujoco.mj_id2name(drawer.model, mujoco.mjtObj.mjOBJ_GEOM, k)
+                 for k in range(drawer.model.ngeom)]
+        assert {'obstacle_circle_1', 'obstacle_wall_1'} <= set(names)
+        pillar = drawer.model.geom('obstacle_circle_1')
+        assert np.allclose(pillar.pos[:2], [0.3, -0.5]) and pillar.rgba[3] == 1.0
+
+
+def test_a_flying_team_s_obstacles_are_see_through(backend, tmp_path):
+    run = simulate(tmp_path / 'flyers', POINTS.format(
+        dim=3, vertices='[1.0, 0.0, 0.0, -0.5, 0.866, 0.5, -0.5, -0.866, -0.5]',
+        start='[0.0, 0.0, 0.0, 0.5, 0.0, 0.0, 0.0, 0.5, 0.0]'))
+    config = replace(load_config(os.path.join(run, 'params.yaml')),
+                     obstacles=Obstacles([2.0, 2.0, 0.2], [], [-2.0, -2.0, 0.0, 0.3], 0.2, 3))
+    trajectory = Trajectory.load(os.path.join(run, TRAJECTORY_FILE))
+    options = render.RenderOptions(width=32, height=24, max_frames=1, shadows=False)
+    with render.Frames(trajectory, config, options, backend, trajectory.t[:1]) as drawer:
+        for name in ('obstacle_circle_1', 'obstacle_sphere_1'):
+            assert drawer.model.geom(name).rgba[3] == render.OBSTACLE_ALPHA_3D

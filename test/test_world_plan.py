@@ -13,6 +13,7 @@ from test_system_plan import launcher_views, node_view
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 WORLD = os.path.join(ROOT, 'config', 'world_turtlebot3.yaml')
+WORLD_OBSTACLES = os.path.join(ROOT, 'config', 'world_turtlebot3_obstacles.yaml')
 LAB = os.path.join(ROOT, 'config', 'lab_turtlebot3.yaml')
 
 
@@ -30,10 +31,11 @@ def world_install(tmp_path):
                                         'record', 'fleet'))
 
 
-def test_the_world_relay_reference_and_robots_run_on_the_worlds_clock():
+@pytest.mark.parametrize('config', [WORLD, WORLD_OBSTACLES])
+def test_the_world_relay_reference_and_robots_run_on_the_worlds_clock(config):
     from formation_ros.core.settings.declarations import BY_NAME as schema, Exe
-    views = launcher_views(WORLD, ['--world', '--out', '/nonexistent/w', '--record',
-                                   '/nonexistent/w_bag'])
+    views = launcher_views(config, ['--world', '--out', '/nonexistent/w', '--record',
+                                    '/nonexistent/w_bag'])
     assert [view['executable'] for view in views] == ['record', 'world', 'relay',
                                                       'reference'] + ['robot'] * 4
     record, world, relay, reference, *robots = views
@@ -41,7 +43,7 @@ def test_the_world_relay_reference_and_robots_run_on_the_worlds_clock():
     assert world['parameters'] == {'world.output_dir': '/nonexistent/w'}
     assert relay['parameters'] == {'use_sim_time': True}
     assert reference['parameters'] == {'use_sim_time': True}
-    rate = load_params_file(WORLD)['relay.rate']
+    rate = load_params_file(config)['relay.rate']
     for i, robot in enumerate(robots, start=1):
         assert robot['parameters'] == {'robot_id': i, 'wait_for_subscribers': 2,
                                        'use_sim_time': True, 'plant.rate': rate,

@@ -9,7 +9,8 @@ It steps :class:`formation_ros.physics.engine.Engine` (MuJoCo) on the steady clo
 ROS bridge give a lab (Gazebo with ros_gz_bridge): ``/clock``, each robot's ground truth on
 ``/robot_<i>/measured_pose`` (the relay's default source) and, for wheeled bases, wheel
 odometry on ``/robot_<i>/odom``; it drives the bodies from ``/robot_<i>/cmd_vel``, whose
-callbacks only store (``physics.intake``). It counts contacts between robots and, with
+callbacks only store (``physics.intake``). It builds the obstacle map (``obstacles.*``) as static
+geoms the bodies collide with, counts contacts between robots and, apart, with obstacles, and, with
 ``world.output_dir``, writes ``world.xml``, ``trajectory.npz`` and ``world_stats.json``
 (``core.runs.output``, ``core.runs.world_stats``).
 Before its first step it looks at the domain through the plant's start gate
@@ -39,6 +40,7 @@ from formation_ros.core.settings.exits import ENGINE_FAILED, REFUSED
 from formation_ros.core.settings.params import world_size_problem
 from formation_ros.physics.engine import Engine, Unstable, unstable_line
 from formation_ros.physics.intake import CommandInbox
+from formation_ros.physics.obstacles import footprint_note
 from formation_ros.physics.scene import WORLD_FILE
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import (CdrError, encode_clock, encode_odometry, encode_pose_stamped,
@@ -109,6 +111,7 @@ class WorldNode(Node):
                            int(CATCH_UP * self.world.realtime_factor * NS_PER_S))
         self.steady = Clock(clock_type=ClockType.STEADY_TIME)
         self.contacts_logged = 0
+        self.obstacle_contacts_logged = 0
         self.late = np.zeros(self.n, dtype=np.int64)
         """(N,) commands of each robot already stale when the step timer applied them."""
         self.rate_window = (time.monotonic_ns(), 0)
@@ -158,7 +161,14 @@ class WorldNode(Node):
             f'world: {self.n} {self.engine.model.kind.value} robots in {self.dim}D, timestep '
             f'{self.world.timestep:g} s, realtime factor {self.world.realtime_factor:g}, '
             f'poses at {self.world.pose_rate:g} Hz'
+            + (f', obstacles: {self.engine.obstacles.count}' if self.engine.obstacles.count
+               else '')
             + (f', writing to {self.output_dir}' if self.output_dir else ''))
+
+        note = footprint_note(self.engine.obstacles, config.body.radius,
+                              self.engine.model.footprint)
+        if note is not None:
+            self.get_logger().warning(f'world: {note}')
 
     def _start_output(self) -> None:
         """
@@ -341,7 +351,7 @@ class WorldNode(Node):
         self.output.append(t, positions, commanded, u_held=at_truth)
 
     def _log_contacts(self) -> None:
-        """Log each new contact between two robots once: the pair and the simulated time."""
+        """Log each new contact (two robots; a robot and an obstacle) once, with its time."""
         events = self.engine.contacts.events
         for number in range(self.contacts_logged + 1, min(len(events), CONTACT_LINES) + 1):
             event = events[number - 1]
@@ -350,6 +360,16 @@ class WorldNode(Node):
             self.get_logger().error(f'contact {number}: robots {event.i} and {event.j} '
                                     f'touched at t = {event.t:.3f} s{last}')
         self.contacts_logged = len(events)
+        hits = self.engine.obstacle_contacts.events
+        labels = self.engine.labels
+        for number in range(self.obstacle_contacts_logged + 1,
+                            min(len(hits), CONTACT_LINES) + 1):
+            hit = hits[number - 1]
+            last = ('; further contacts with obstacles are counted in /diagnostics only'
+                    if number == CONTACT_LINES else '')
+            self.get_logger().error(f'obstacle contact {number}: robot {hit.robot} touched '
+                                    f'{labels[hit.obstacle]} at t = {hit.t:.3f} s{last}')
+        self.obstacle_contacts_logged = len(hits)
 
     def on_diagnostics(self) -> None:
         """Publish the world's status: time, step rate, real-time factor, contacts, refusals."""
@@ -387,11 +407,15 @@ class WorldNode(Node):
             'robots with stale cmd_vel on arrival': ', '.join(
                 f'{i + 1}: {count}' for i, count in enumerate(self.late.tolist()) if count)
             or 'none'}
+        if self.engine.obstacles.count:
+            values.update({'obstacle contacts': self.engine.obstacle_contacts.count,
+                           'min obstacle gap [m]': self.engine.obstacle_approach.gap})
         values.update({f'robot {index + 1}: refused cmd_vel messages ({reason.name.lower()})':
                        count for (index, reason), count in self.refusals.refusals.items()})
         contacts = self.engine.contacts.count
-        if contacts or behind or self.refusals.refusals.count():
-            level, message = 'warn', (f'{contacts} contacts, '
+        hits = self.engine.obstacle_contacts.count
+        if contacts or hits or behind or self.refusals.refusals.count():
+            level, message = 'warn', (f'{contacts} contacts, {hits} with obstacles, '
                                       f'{self.refusals.refusals.count()} refused commands, '
                                       f'{factor:.2f} x real time of {target:g}')
         elif self.refusal is not None:
@@ -427,7 +451,9 @@ class WorldNode(Node):
             f'{wall:.1f} s, {stats.achieved_realtime_factor:.3g} x real time of '
             f'{self.world.realtime_factor:g}), {stats.contacts} contacts between robots, '
             f'min body distance {stats.min_body_distance:.4g} m, '
-            f'{self.refusals.refusals.count()} cmd_vel messages refused'
+            + (f'{stats.obstacle_contacts} contacts with obstacles, min obstacle gap '
+               f'{stats.min_obstacle_gap:.4g} m, ' if self.engine.obstacles.count else '')
+            + f'{self.refusals.refusals.count()} cmd_vel messages refused'
             + (f'; output stopped early: {failure}' if failure else '')
             + ('; the engine blew up' if self.engine.failure is not None else ''))
         if not self.output.running:

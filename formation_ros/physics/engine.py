@@ -21,7 +21,10 @@ crazyswarm2's simulator backends share one. It builds the scene of a validated c
   :meth:`Engine.odometry` the wheel-encoder odometry of differential-drive bases (updated
   every ``odometry.ODOMETRY_PERIOD``);
 * :attr:`Engine.contacts` counts contact events between robots from MuJoCo's contact list and
-  :attr:`Engine.closest` keeps the closest approach of two robots' positions;
+  :attr:`Engine.closest` keeps the closest approach of two robots' positions; with obstacles
+  (``obstacles.*``, static geoms: ``physics.obstacles``) :attr:`Engine.obstacle_contacts`
+  counts a robot's contacts with them apart and :attr:`Engine.obstacle_approach` keeps the
+  smallest gap of a body to an obstacle's surface (ground truth, footprint subtracted);
 * :meth:`Engine.stats` is what the run did (``core.runs.world_stats.WorldRunStats``).
 
 A step that makes a body's pose non-finite or absurd (MuJoCo's own check of the state, which
@@ -34,14 +37,18 @@ from dataclasses import dataclass
 import time
 from typing import Dict, Optional, Sequence, Tuple
 
+from formation_ros.core.maths.obstacles import Obstacles
 from formation_ros.core.maths.unicycle import headings_from_quaternions
 from formation_ros.core.maths.units import NS_PER_S
 from formation_ros.core.model.dynamics import NOISE_SEED_OFFSET
 from formation_ros.core.rules.pacing import Pacer
-from formation_ros.core.runs.world_stats import BlowUp, Contact, ratio, WorldRunStats
+from formation_ros.core.runs.world_stats import (BlowUp, Contact, ObstacleContact, ratio,
+                                                 WorldRunStats)
 from formation_ros.core.settings.params import FormationConfig, WorldSettings
-from formation_ros.physics.contacts import ClosestApproach, ContactLog, RELEASE_GAP
+from formation_ros.physics.contacts import (ClosestApproach, ContactLog, ObstacleApproach,
+                                            ObstacleContactLog, RELEASE_GAP)
 from formation_ros.physics.diff_drive import DiffDrive
+from formation_ros.physics.obstacles import obstacle_of_geom
 from formation_ros.physics.odometry import ODOMETRY_PERIOD, WheelOdometry
 from formation_ros.physics.scene import build_scene, Scene
 import mujoco
@@ -138,6 +145,16 @@ class Engine:
         self.contacts = ContactLog(n, 2.0 * self.model.footprint + RELEASE_GAP)
         self.closest = ClosestApproach(start.positions[:, :self.dim],
                                        2.0 * self.model.footprint)
+        self.obstacles = config.obstacles or Obstacles(
+            np.zeros((0, 3)), np.zeros((0, 5)), np.zeros((0, 4)), 1.0, self.dim)
+        self.labels = self.obstacles.labels()
+        self._geom_obstacle = np.array([
+            obstacle_of_geom(mujoco.mj_id2name(self.mj_model, mujoco.mjtObj.mjOBJ_GEOM, geom),
+                             self.obstacles) for geom in range(self.mj_model.ngeom)],
+            dtype=np.intp)
+        self.obstacle_contacts = ObstacleContactLog(self.obstacles, self.model.footprint)
+        self.obstacle_approach = ObstacleApproach(self.obstacles, self.model.footprint,
+                                                  start.positions[:, :self.dim])
         self._last_positions = start.positions[:, :self.dim].copy()
         self._max_move = ABSURD_SPEED * self.world.timestep
         self._no_yaw = np.zeros(n)
@@ -280,19 +297,29 @@ class Engine:
         return int(self._body_robot[body]) + 1
 
     def _observe(self) -> None:
-        """After a step: odometry, contacts between robots, the closest approach."""
+        """After a step: odometry, contacts, the closest approaches (robots, obstacles)."""
         if self.odometer is not None and self.steps % self._odometry_steps == 0:
             self.odometer.advance(self.data.qpos[self._wheel_angles],
                                   self._odometry_steps * self.world.timestep)
         contact = self.data.contact
         robots = self._geom_robot[contact.geom]
+        touching = contact.dist <= 0.0
         between = ((robots[:, 0] >= 0) & (robots[:, 1] >= 0) & (robots[:, 0] != robots[:, 1])
-                   & (contact.dist <= 0.0))
+                   & touching)
         positions = self.data.xpos[self._pose_bodies, :self.dim]
         if np.any(between) or len(self.contacts.touching):
             self.contacts.update(robots[between, 0], robots[between, 1], positions,
                                  self.time_ns)
         self.closest.update(positions, self.time_ns)
+        if not self.obstacles.count:
+            return
+        obstacles = self._geom_obstacle[contact.geom]
+        robot = np.max(robots, axis=1)
+        obstacle = np.max(obstacles, axis=1)
+        hit = touching & (robot >= 0) & (obstacle >= 0)
+        if np.any(hit) or len(self.obstacle_contacts.touching):
+            self.obstacle_contacts.update(robot[hit], obstacle[hit], positions, self.time_ns)
+        self.obstacle_approach.update(positions, self.time_ns)
 
     def poses(self) -> Poses:
         """Return the ground truth: every robot's pose body (the axle centre of a base)."""
@@ -344,6 +371,8 @@ class Engine:
         return WorldRunStats(
             contacts=self.contacts.count, min_body_distance=self.closest.distance,
             min_footprint_gap=self.closest.distance - 2.0 * self.model.footprint,
+            obstacle_contacts=self.obstacle_contacts.count,
+            min_obstacle_gap=self.obstacle_approach.gap,
             steps=self.steps, engine_realtime_factor=ratio(simulated, self.wall),
             achieved_realtime_factor=ratio(simulated, wall_time),
             realtime_factor=None if pacer is None else pacer.factor, wall_time=wall_time,
@@ -351,6 +380,9 @@ class Engine:
             ticks_behind=0 if pacer is None else pacer.falls,
             simulated_time_let_go=0.0 if pacer is None else pacer.dropped_s,
             contact_events=[Contact(event.i, event.j, event.t) for event in self.contacts.events],
+            obstacle_contact_events=[ObstacleContact(event.robot, self.labels[event.obstacle],
+                                                     event.t)
+                                     for event in self.obstacle_contacts.events],
             stale_command_messages=dict(stale or {}), model=self.model.kind.value,
             timestep=self.world.timestep,
             unstable=None if failure is None else BlowUp(failure.robot, failure.t, failure.what),

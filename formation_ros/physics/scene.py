@@ -6,7 +6,8 @@ The MJCF world of a formation: a floor and one body per robot at its start, with
 
 :func:`build_scene` takes a validated :class:`~formation_ros.core.settings.params.FormationConfig`
 (its ``num_robots``, ``dim``, ``start`` positions and ``start_headings``, ``body.*``,
-``command.frame`` and ``world_frame``) and the world's settings (``world.*``) and returns a
+``command.frame``, ``world_frame`` and the obstacle map ``obstacles``: static geoms,
+``physics.obstacles``) and the world's settings (``world.*``) and returns a
 :class:`Scene`: the MJCF text, which ``mujoco.MjModel.from_xml_string`` (or, written as
 ``world.xml``, ``from_xml_path`` and ``python -m mujoco.viewer --mjcf world.xml``) loads as it is,
 and the body model of :mod:`formation_ros.physics.models`. Robot i (1-based) is the body
@@ -19,16 +20,24 @@ import os
 from typing import Optional, Tuple
 from xml.etree import ElementTree
 
+from formation_ros.core.maths.frames import desired_positions
 from formation_ros.core.settings.names import robot_name
 from formation_ros.core.settings.params import FormationConfig, WorldSettings
 from formation_ros.physics.contacts import closest_distance
 from formation_ros.physics.models import make_model, Model
+from formation_ros.physics.obstacles import add_obstacles
 from formation_ros.physics.parts import FLOOR_GROUP, GRAVITY, number, numbers
 import numpy as np
+from numpy.typing import NDArray
 
 WORLD_FILE = 'world.xml'
 FLOOR_BELOW = 1.0
 """A flying team's floor (drawn only) is this far below its lowest start, m."""
+CEILING_ABOVE = 1.0
+"""A flying team's pillars and walls rise this far above the highest point of its flight, m
+(the law takes them as unbounded in z; the geoms cover the volume the team flies in)."""
+FLIGHT_SAMPLES = 200
+"""The times at which :func:`flight_ceiling` looks at the formation's places."""
 
 
 @dataclass(frozen=True)
@@ -75,6 +84,22 @@ def _header(root: ElementTree.Element, world: WorldSettings, world_frame: str) -
                            texuniform='true')
 
 
+def flight_ceiling(config: FormationConfig, start: NDArray[np.float64]) -> float:
+    """
+    Return the top of a flying team's pillars and walls, m: :data:`CEILING_ABOVE` over its flight.
+
+    The flight: the starts (N, 3) and the places of every shape the team may take
+    (``config.vertices`` and the named ``formations.*``) about the reference at
+    :data:`FLIGHT_SAMPLES` times over ``config.duration``.
+    """
+    reference = config.reference()
+    shapes = np.concatenate([config.vertices, *config.shapes.values()])
+    times = np.linspace(0.0, config.duration, FLIGHT_SAMPLES)
+    highest = max(float(np.max(desired_positions(shapes, reference.sample(t))[:, 2]))
+                  for t in times)
+    return max(highest, float(np.max(start[:, 2]))) + CEILING_ABOVE
+
+
 def build_scene(config: FormationConfig, world: Optional[WorldSettings] = None) -> Scene:
     """
     Return the :class:`Scene` of ``config`` (which needs its start) with ``world``'s settings.
@@ -103,6 +128,10 @@ def build_scene(config: FormationConfig, world: Optional[WorldSettings] = None) 
         friction=numbers((world.floor_friction, 0.005, 0.0001)))
     actuators = ElementTree.Element('actuator')
     names = []
+    if config.obstacles is not None:
+        top = (world.obstacle_height if config.dim == 2
+               else flight_ceiling(config, start))
+        add_obstacles(worldbody, config.obstacles, floor_z, top)
     for index, (position, heading) in enumerate(zip(start, headings)):
         name = body_name(index)
         names.append(model.add_body(worldbody, name, position, float(heading)))

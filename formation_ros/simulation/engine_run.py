@@ -5,18 +5,21 @@
 ``formation_sim --engine mujoco``: the law at the control rate on the physics engine, no ROS.
 
 Every control period (``--dt``, a whole number of ``world.timestep``) each robot senses the
-measured poses (ground truth with ``world.pose_noise``) of the others within its R_i, the law
-gives its control point's velocity u (eq. 14, 25; the hand point of a unicycle), and the
-command it stands for ((v, w) of a unicycle, u itself or turned into the body's frame for a
-point) is applied to the engine, stamped, and held over the period (zero-order hold) while the
-engine steps. The samples are those of every other run (``trajectory.npz``: the control points,
-the commands as sent, the headings, axle centres and (v, w) of unicycles); the engine's own
-counts (contacts between robots, the closest approach of the bodies, steps, real-time factors)
-go into ``world_stats.json`` beside ``world.xml``, in the world node's schema
+measured poses (ground truth with ``world.pose_noise``) of the others within its R_i and the
+obstacles (``FormationConfig.law_obstacles``: grown by the footprint, as every run's law sees
+them; the world builds the real ones as geoms), the law gives its control point's velocity u
+(eq. 14, 25; the hand point of a unicycle), and the command it stands for ((v, w) of a
+unicycle, u itself or turned into the body's frame for a point) is applied to the engine,
+stamped, and held over the period (zero-order hold) while the engine steps. The samples are
+those of every other run (``trajectory.npz``: the control points, the commands as sent, the
+headings, axle centres and (v, w) of unicycles); the engine's own counts (contacts between
+robots and, apart, with obstacles, the closest approaches, steps, real-time factors) go into
+``world_stats.json`` beside ``world.xml``, in the world node's schema
 (``core.runs.world_stats``).
 """
 
 from dataclasses import dataclass, replace
+import math
 import time
 from typing import Any, Dict, List, Optional
 
@@ -44,12 +47,15 @@ class EngineRun:
 
     trajectory: the samples; stats: what the run did (``world_stats.json``; its wall_time is
     the loop of law and engine); failure: the one line of an engine that blew up
-    (``physics.engine.unstable_line``: the run stops there), None if none.
+    (``physics.engine.unstable_line``: the run stops there), None if none; note: a line on
+    bodies larger than the law keeps off the obstacles (``physics.obstacles.footprint_note``),
+    None if none.
     """
 
     trajectory: Trajectory
     stats: WorldRunStats
     failure: Optional[str] = None
+    note: Optional[str] = None
 
 
 def engine_problem(config: FormationConfig, control_dt: float) -> Optional[str]:
@@ -82,10 +88,12 @@ def run_on_engine(config: FormationConfig, duration: float, control_dt: float,
     ``simulate.Progress``. The engine's ``world.output_dir`` is not used.
     """
     from formation_ros.physics.engine import Engine, Unstable, unstable_line
+    from formation_ros.physics.obstacles import footprint_note
     engine = Engine(config)
     begun = time.perf_counter()
     failure: Optional[str] = None
     law, reference = config.law(), config.reference()
+    obstacles = config.law_obstacles()
     bodies = make_bodies(config.body, body_frame=config.command.frame is CommandFrame.BODY
                          and not config.body.is_unicycle)
     steps_per_control = int(round(control_dt / engine.world.timestep))
@@ -103,7 +111,8 @@ def run_on_engine(config: FormationConfig, duration: float, control_dt: float,
         points = bodies.control_points(measured.positions[:, :dim], heading)
         frame = reference.sample(t)
         vertices = shapes.at(engine.time_ns).vertices
-        u = team_command(points, vertices, config.sensing_radii, law, frame).u
+        u = team_command(points, vertices, config.sensing_radii, law, frame,
+                         obstacles=obstacles).u
         command = bodies.body_command(u, heading)
         if k % stride == 0 or k == controls:
             truth = engine.poses()
@@ -129,21 +138,28 @@ def run_on_engine(config: FormationConfig, duration: float, control_dt: float,
     if bodies.has_heading:
         trajectory = replace(trajectory, heading=np.array(headings), q_body=np.array(q_body),
                              body_command=np.array(held))
-    return EngineRun(trajectory, engine.stats(time.perf_counter() - begun), failure)
+    return EngineRun(trajectory, engine.stats(time.perf_counter() - begun), failure,
+                     footprint_note(engine.obstacles, config.body.radius,
+                                    engine.model.footprint))
 
 
 def engine_metrics(run: EngineRun) -> Dict[str, Any]:
     """Return the metrics.json keys of an engine run: world_stats.json's under ``world``."""
     world = finite_record(run.stats.record())
     world.pop('contact_events')
+    world.pop('obstacle_contact_events')
     return {'engine': 'mujoco', 'mujoco_version': run.stats.mujoco_version, 'world': world}
 
 
 def engine_summary(run: EngineRun) -> str:
     """Return the summary line of the engine's counts."""
     stats = run.stats
+    obstacles = ('' if not math.isfinite(stats.min_obstacle_gap) else
+                 f', {stats.obstacle_contacts} with obstacles (closest body '
+                 f'{stats.min_obstacle_gap:+.4g} m from an obstacle)')
     return (f'  physics (MuJoCo {stats.mujoco_version}): {stats.contacts} contact '
             'event(s) between robots, closest approach of two bodies '
             f'{stats.min_body_distance:.4g} m (footprints '
-            f'{stats.min_footprint_gap:+.4g} m apart), {stats.steps} steps at '
-            f'{stats.achieved_realtime_factor:.1f}x real time')
+            f'{stats.min_footprint_gap:+.4g} m apart){obstacles}, {stats.steps} steps at '
+            f'{stats.achieved_realtime_factor:.1f}x real time'
+            + (f'\n  note: {run.note}' if run.note else ''))

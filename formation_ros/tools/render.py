@@ -14,7 +14,10 @@ is, zooming out as it spreads; ``fixed``: everything the run visits). Each robot
 of its own, and beside its body are drawn, as extra geoms of the frame: its desired position
 in force (a flat disc of its colour), its recent path and, with ``--sensing``, its sensing
 circle (radius R_i about its control point; paths and circles for teams of up to
-:data:`MAX_LINED_ROBOTS`). Nothing is simulated: the picture is the run as it was recorded.
+:data:`MAX_LINED_ROBOTS`). The obstacles of the parameters (``obstacles.*``) are the scene's own
+static geoms (``physics.obstacles``): pillars and walls of ``world.obstacle_height`` in 2D; a
+flying team's, which span its flight, are drawn see-through (:data:`OBSTACLE_ALPHA_3D`) so
+that they hide no robot. Nothing is simulated: the picture is the run as it was recorded.
 
 Rendering needs an OpenGL backend that draws without a display: OSMesa (the Debian package
 ``libosmesa6``, which ``scripts/setup_env.sh`` installs) or EGL. ``MUJOCO_GL=osmesa`` or
@@ -91,6 +94,8 @@ COLORS = ((0.12, 0.47, 0.71), (1.0, 0.5, 0.05), (0.17, 0.63, 0.17), (0.84, 0.15,
 """Robot i's colour is entry (i - 1) mod 10 (matplotlib's tab10, its grey made navy)."""
 FORMATION_COLOR = np.array((0.35, 0.2, 0.5, 0.7), dtype=np.float32)
 """The desired formation's outline."""
+OBSTACLE_ALPHA_3D = 0.35
+"""The opacity of a flying team's obstacles in the picture."""
 
 
 class RenderError(Exception):
@@ -342,6 +347,8 @@ class Frames:
         self.floor = float(self.model.geom_pos[mujoco.mj_name2id(
             self.model, mujoco.mjtObj.mjOBJ_GEOM, 'floor')][2])
         self._color_robots()
+        if self.dim == 3:
+            self._fade_obstacles()
         self.height = float(scene.model.height)
         self.radii = np.asarray(config.sensing_radii, dtype=float)
         n = trajectory.num_robots
@@ -382,6 +389,15 @@ class Frames:
             found = self.mujoco.mj_name2id(self.model, geom, f'{name}_footprint')
             if found >= 0:
                 self.model.geom_rgba[found] = robot_color(index)
+
+    def _fade_obstacles(self) -> None:
+        """Make the obstacles' geoms see-through (:data:`OBSTACLE_ALPHA_3D`)."""
+        from formation_ros.physics.obstacles import PREFIX
+        geom = self.mujoco.mjtObj.mjOBJ_GEOM
+        for index in range(self.model.ngeom):
+            name = self.mujoco.mj_id2name(self.model, geom, index) or ''
+            if name.startswith(PREFIX):
+                self.model.geom_rgba[index, 3] = OBSTACLE_ALPHA_3D
 
     def _frame_cameras(self, times: NDArray[np.float64]) -> None:
         """Plan the camera of every frame: look-at points and distances."""

@@ -15,7 +15,8 @@ from formation_ros.core.rules.plant_stats import RunStats, trajectory_sample
 from formation_ros.core.runs.output import (ChunkShapeError, FixedShape, RunOutput, stats_text,
                                             trajectory_from_chunks)
 from formation_ros.core.runs.trajectory import CHUNKS_DIR, ChunkWriter, Trajectory, TRAJECTORY_FILE
-from formation_ros.core.runs.world_stats import BlowUp, Contact, WorldRunStats
+from formation_ros.core.runs.world_stats import (BlowUp, Contact, ObstacleContact,
+                                                 WorldRunStats)
 import numpy as np
 import pytest
 
@@ -102,22 +103,27 @@ def test_the_trajectory_from_chunks_checks_the_robots_and_reads_held_commands(tm
 
 def test_world_stats_record_every_field_once_and_no_infinity():
     stats = WorldRunStats(
-        contacts=1, min_body_distance=math.inf, min_footprint_gap=-math.inf, steps=10,
+        contacts=1, min_body_distance=math.inf, min_footprint_gap=-math.inf,
+        obstacle_contacts=1, min_obstacle_gap=-0.002, steps=10,
         engine_realtime_factor=40.0, achieved_realtime_factor=1.0, realtime_factor=None,
         wall_time=0.02, simulated_time=0.02, steps_per_second=500.0, ticks_behind=0,
         simulated_time_let_go=0.0, contact_events=[Contact(1, 2, 0.01)],
+        obstacle_contact_events=[ObstacleContact(2, 'wall 1', 0.004)],
         stale_command_messages={3: 1, 1: 2}, model='diff_drive', timestep=0.002,
         unstable=BlowUp(2, 0.02, 'its pose moved'), refused_command_messages={'frame': {2: 5}},
         engine_wall_time=0.0005, mujoco_version='3')
     record = json.loads(stats_text(stats.record()))
     assert list(record) == [
-        'contacts', 'min_body_distance', 'min_footprint_gap', 'steps', 'engine_realtime_factor',
-        'achieved_realtime_factor', 'realtime_factor', 'wall_time', 'simulated_time',
-        'steps_per_second', 'ticks_behind', 'simulated_time_let_go', 'contact_events',
+        'contacts', 'min_body_distance', 'min_footprint_gap', 'obstacle_contacts',
+        'min_obstacle_gap', 'steps', 'engine_realtime_factor', 'achieved_realtime_factor',
+        'realtime_factor', 'wall_time', 'simulated_time', 'steps_per_second', 'ticks_behind',
+        'simulated_time_let_go', 'contact_events', 'obstacle_contact_events',
         'stale_command_messages', 'model', 'timestep', 'unstable', 'refused_command_messages',
         'engine_wall_time', 'mujoco_version']
     assert record['min_body_distance'] is None and record['realtime_factor'] is None
     assert record['contact_events'] == [{'i': 1, 'j': 2, 't': 0.01}]
+    assert record['obstacle_contact_events'] == [{'robot': 2, 'obstacle': 'wall 1', 't': 0.004}]
+    assert record['obstacle_contacts'] == 1 and record['min_obstacle_gap'] == -0.002
     assert record['stale_command_messages'] == {'1': 2, '3': 1}
     assert record['refused_command_messages'] == {'frame': {'2': 5}}
     assert record['unstable'] == {'robot': 2, 't': 0.02, 'what': 'its pose moved'}

@@ -27,6 +27,15 @@ class Contact:
 
 
 @dataclass(frozen=True)
+class ObstacleContact:
+    """Robot ``robot`` (1-based) touched ``obstacle`` ('circle 1', 'wall 2'...) at ``t`` s."""
+
+    robot: int
+    obstacle: str
+    t: float
+
+
+@dataclass(frozen=True)
 class BlowUp:
     """The engine blew up: robot ``robot`` (1-based) got an absurd pose at ``t`` s; ``what``."""
 
@@ -42,13 +51,17 @@ class WorldRunStats:
 
     contacts: contact events between robots; min_body_distance: the closest approach of two
     robots' positions, m; min_footprint_gap: that less twice the footprint radius, m (< 0: they
-    overlapped); steps: engine steps; engine_realtime_factor: simulated_time over
+    overlapped); obstacle_contacts: contact events between a robot and an obstacle (counted
+    apart from ``contacts``); min_obstacle_gap: the smallest gap of a body to an obstacle's
+    surface, m, its footprint radius subtracted (< 0: it overlapped; inf, written null, without
+    obstacles); steps: engine steps; engine_realtime_factor: simulated_time over
     engine_wall_time; achieved_realtime_factor: simulated_time over wall_time; realtime_factor:
     the factor asked for (None: as fast as it can, offline); wall_time: wall-clock s from the
     first step to the end (the node's whole run, or the offline loop of law and engine);
     simulated_time: s; steps_per_second: steps over wall_time; ticks_behind: times the world fell
     further behind than it may catch up at once; simulated_time_let_go: simulated s let go
-    then; contact_events: each new contact; stale_command_messages: {robot: commands already
+    then; contact_events: each new contact; obstacle_contact_events: each new contact with an
+    obstacle; stale_command_messages: {robot: commands already
     older than world.cmd_timeout when applied}; model: the engine's body model; timestep: s;
     unstable: where the engine blew up, None if it did not; refused_command_messages: {reason:
     {robot: cmd_vel refused}}; engine_wall_time: wall-clock s spent in the engine's steps;
@@ -58,6 +71,8 @@ class WorldRunStats:
     contacts: int
     min_body_distance: float
     min_footprint_gap: float
+    obstacle_contacts: int
+    min_obstacle_gap: float
     steps: int
     engine_realtime_factor: float
     achieved_realtime_factor: float
@@ -68,6 +83,7 @@ class WorldRunStats:
     ticks_behind: int
     simulated_time_let_go: float
     contact_events: List[Contact]
+    obstacle_contact_events: List[ObstacleContact]
     stale_command_messages: Dict[int, int]
     model: str
     timestep: float

@@ -469,6 +469,11 @@ DECLARATIONS = (
           "A robot's command older than this (by its stamp), or none for this long, stops its "
           "motors, s of simulated time (diff_drive_controller's cmd_vel_timeout).",
           low=above(0.0), high=at_least(1e7), users=PHYSICS),
+    Param('world.obstacle_height', Kind.DOUBLE, 0.5,
+          'Height of the pillars (obstacles.circles) and walls (obstacles.walls) the world '
+          'builds in 2D, m: they stand on the floor and must rise above the bodies (the law '
+          'treats them as unbounded in z). In 3D they span the flight volume instead.',
+          low=above(0.0), high=at_least(LENGTH_LIMIT), users=PHYSICS),
     Param('world.output_dir', Kind.STRING, '',
           'If set, the world writes world.xml (and its results) there.', users=PHYSICS),
 )

@@ -210,7 +210,8 @@ class WorldSettings:
     base's wheels, m; wheel_torque: each wheel motor's torque limit, N m; force_limit: a point
     body's servo force limit per axis, N; torque_limit: its heading servo's, N m;
     floor_friction: sliding friction coefficient of the floor; cmd_timeout: a command older
-    than this stops the motors, s; output_dir: where world.xml and the results go ('' none).
+    than this stops the motors, s; obstacle_height: the height of 2D pillars and walls, m;
+    output_dir: where world.xml and the results go ('' none).
     """
 
     timestep: float = 0.002
@@ -226,6 +227,7 @@ class WorldSettings:
     torque_limit: float = 0.5
     floor_friction: float = 1.0
     cmd_timeout: float = 0.5
+    obstacle_height: float = 0.5
     output_dir: str = ''
 
     @property
@@ -246,7 +248,7 @@ class WorldSettings:
 
 WORLD_FIELDS = ('timestep', 'realtime_factor', 'pose_rate', 'pose_noise', 'mass',
                 'wheel_radius', 'wheel_track', 'wheel_torque', 'force_limit', 'torque_limit',
-                'floor_friction', 'cmd_timeout', 'output_dir')
+                'floor_friction', 'cmd_timeout', 'obstacle_height', 'output_dir')
 """The fields of :class:`WorldSettings` read from ``world.<field>``."""
 WORLD_MAX_ROBOTS = 1000
 """The most robots the physics engine takes (the world node, ``formation_sim --engine
