@@ -11,7 +11,8 @@ from formation_ros.tools.launcher import world_summary
 def write_stats(tmp_path, **fields):
     """Write a world_stats.json with the fields the line reads; return its folder."""
     stats = {'contacts': 0, 'min_body_distance': 0.5, 'min_footprint_gap': 0.28,
-             'simulated_time': 12.0, 'achieved_realtime_factor': 0.98, **fields}
+             'simulated_time': 12.0, 'achieved_realtime_factor': 0.98, 'obstacle_contacts': 0,
+             'min_obstacle_gap': None, **fields}
     (tmp_path / 'world_stats.json').write_text(json.dumps(stats), encoding='utf-8')
     return str(tmp_path)
 
@@ -29,3 +30,10 @@ def test_a_run_without_a_measured_pair_says_so(tmp_path):
 
 def test_a_missing_file_is_named(tmp_path):
     assert world_summary(str(tmp_path)).startswith('world: no statistics in ')
+
+
+def test_a_run_among_obstacles_states_their_contacts_and_closest_gap(tmp_path):
+    line = world_summary(write_stats(tmp_path, obstacle_contacts=1, min_obstacle_gap=-0.002))
+    assert '(footprints +0.28 m apart), 1 with obstacles (closest footprint -0.002 m from a ' \
+           'surface), 12.00 s' in line
+    assert 'with obstacles' not in world_summary(write_stats(tmp_path))

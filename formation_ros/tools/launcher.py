@@ -648,7 +648,11 @@ def world_summary(out: str) -> str:
         approach = ('no two bodies measured' if closest is None else
                     f'closest approach of two bodies {closest:.4g} m (footprints '
                     f"{stats['min_footprint_gap']:+.4g} m apart)")
-        return (f"world: {stats['contacts']} contacts between robots, {approach}, "
+        gap = stats.get('min_obstacle_gap')
+        obstacles = ('' if gap is None else
+                     f", {stats['obstacle_contacts']} with obstacles (closest footprint "
+                     f'{gap:+.4g} m from a surface)')
+        return (f"world: {stats['contacts']} contacts between robots, {approach}{obstacles}, "
                 f"{stats['simulated_time']:.2f} s simulated at "
                 f"{stats['achieved_realtime_factor']:.3g} x real time ({where})")
     except (OSError, ValueError, KeyError, TypeError) as exc:
