@@ -188,11 +188,13 @@ def integrate_segments(rhs: Callable[[float, np.ndarray, np.ndarray], np.ndarray
 
 
 def _assemble(times, states, config, law, reference, shapes):
+    obstacles = config.law_obstacles()
     commands, desired, centres = [], [], []
     for t, q in zip(times, states):
         frame = reference.sample(t)
         vertices = vertices_at(shapes, t)
-        commands.append(team_command(q, vertices, config.sensing_radii, law, frame))
+        commands.append(team_command(q, vertices, config.sensing_radii, law, frame,
+                                     obstacles=obstacles))
         desired.append(desired_positions(vertices, frame))
         centres.append(frame.q_od)
     return Trajectory(t=np.asarray(times, dtype=float), q=np.asarray(states),
@@ -224,13 +226,14 @@ def simulate(config: FormationConfig, duration: Optional[float] = None,
     reference = config.reference()
     shapes = shapes_of(config)
     n, dim = config.num_robots, config.dim
+    obstacles = config.law_obstacles()
     assert config.start is not None
 
     def rhs(t: float, y: np.ndarray, vertices: np.ndarray) -> np.ndarray:
         progress.update(t)
         frame = reference.sample(t)
         return team_command(y.reshape(n, dim), vertices, config.sensing_radii, law,
-                            frame).u.ravel()
+                            frame, obstacles=obstacles).u.ravel()
 
     times, y = integrate_segments(rhs, config.start.ravel(), sample_times(duration, sample_dt),
                                   shapes)
@@ -251,13 +254,14 @@ def simulate_unicycles(config: FormationConfig, duration: float, sample_dt: floa
     shapes = shapes_of(config)
     n = config.num_robots
     bodies = UnicycleBodies(config.body.hand_distance)
+    obstacles = config.law_obstacles()
     assert config.start is not None and config.start_headings is not None
 
     def rhs(t: float, y: np.ndarray, vertices: np.ndarray) -> np.ndarray:
         progress.update(t)
         q, heading = y[:2 * n].reshape(n, 2), y[2 * n:]
         u = team_command(bodies.control_points(q, heading), vertices, config.sensing_radii,
-                         law, reference.sample(t)).u
+                         law, reference.sample(t), obstacles=obstacles).u
         q_rate, heading_rate = unicycle_rates(heading, bodies.body_command(u, heading))
         return np.concatenate([q_rate.ravel(), heading_rate])
 
@@ -333,6 +337,7 @@ def run_fixed_step(config: FormationConfig, duration: float, dt: float, sample_d
                        pair_radius=law.repulsion_radius, imperfections=imperfections)
     commands = Commands.empty(config.num_robots, bodies.command_width(config.dim))
     shapes = shapes_of(config)
+    obstacles = config.law_obstacles()
     steps = int(round(duration / dt))
     stride = max(1, int(round(sample_dt / dt)))
     largest_u_hat = 0.0
@@ -344,7 +349,8 @@ def run_fixed_step(config: FormationConfig, duration: float, dt: float, sample_d
         seen_frame = (frame if sensed.stamp_ns == model.t_ns
                       else reference.sample(sensed.stamp_ns / NS_PER_S))
         u = team_command(sensed.points, shapes.at(sensed.stamp_ns).vertices,
-                         config.sensing_radii, law, seen_frame, sensed.tree, sensed.pairs).u
+                         config.sensing_radii, law, seen_frame, sensed.tree, sensed.pairs,
+                         obstacles).u
         commands.store_all(bodies.body_command(u, sensed.heading), sensed.stamp_ns)
         if k == steps:
             times.append(model.t)
