@@ -28,6 +28,8 @@ from formation_ros.core.model.plant import Commands, PlantCounts, PlantModel
 from formation_ros.core.runs.events import Event, EventKind, timeline_events, with_shapes
 from formation_ros.core.runs.metrics import (body_metrics, compute_metrics, held_metrics,
                                              segment_metrics)
+from formation_ros.core.runs.obstacle_metrics import (obstacle_metrics, STILL_SPEED, STILL_TIME,
+                                                      stuck_line, stuck_robots)
 from formation_ros.core.runs.timeline import Mode, scheduled_shapes, Shape, TeamState, Timeline
 from formation_ros.core.runs.trajectory import Trajectory
 from formation_ros.core.settings.declarations import CommandFrame, DEFAULT_COLLISION_DISTANCE
@@ -429,9 +431,33 @@ def run_metrics(trajectory: Trajectory, config: FormationConfig, integrator: str
         metrics['unknown_commands_reason'] = (
             'the states they answered were not heard' if config.command.stamped
             else 'unstamped commands do not say which state they answered')
+    metrics.update(obstacle_keys(trajectory, config))
     if events:
         metrics['segments'] = segment_metrics(trajectory, events)
     return metrics
+
+
+def obstacle_keys(trajectory: Trajectory, config: FormationConfig) -> dict:
+    """
+    metrics.json keys of the obstacles (``core.runs.obstacle_metrics``), with or without any.
+
+    ``min_obstacle_clearance`` (m, None without obstacles) and ``obstacle_contacts`` of the real
+    bodies (a unicycle's axle centre, ``body.radius`` subtracted) against the real obstacles;
+    ``stuck_robots``: the robots hardly moving at the end, far from their places (records of
+    ``Stuck``), with the rule's ``stuck_still_time`` (s) and ``stuck_still_speed`` (m/s).
+    """
+    bodies = trajectory.q if trajectory.q_body is None else trajectory.q_body
+    radius = config.body.radius
+    keys = obstacle_metrics(bodies, config.obstacles, radius)
+    stuck = stuck_robots(trajectory.t, trajectory.q, trajectory.q_desired, config.obstacles,
+                         bodies=bodies, body_radius=radius)
+    keys.update({'stuck_robots': [robot.record() for robot in stuck],
+                 'stuck_still_time': STILL_TIME, 'stuck_still_speed': STILL_SPEED})
+    if config.obstacles is not None:
+        keys.update({'obstacle_count': config.obstacles.count,
+                     'obstacle_clearance_b_o': config.obstacles.clearance,
+                     'body_footprint': config.body.footprint})
+    return keys
 
 
 def plant_metrics(run: FixedStepRun, config: FormationConfig) -> dict:
@@ -482,10 +508,33 @@ def _segment_line(segment: dict) -> str:
             f"{_measured(segment['final_max_error'], 'm')}")
 
 
+def _obstacle_lines(metrics: dict) -> list:
+    """Summary lines of the obstacles and of the stuck robots (:func:`obstacle_keys`)."""
+    lines = []
+    clearance = metrics.get('min_obstacle_clearance')
+    if clearance is not None:
+        contacts = metrics['obstacle_contacts']
+        what = 'no contact' if not contacts else f'{contacts} CONTACTS'
+        lines.append(f"  obstacles: {metrics.get('obstacle_count', '?')}, closest approach of a "
+                     f'body {clearance:.4g} m ({what}; footprint subtracted, b_o = '
+                     f"{metrics.get('obstacle_clearance_b_o', math.nan):g} m)")
+    stuck = metrics.get('stuck_robots') or ()
+    if stuck:
+        lines.append(f'  stuck ({len(stuck)}: moved less than '
+                     f"{metrics['stuck_still_speed'] * metrics['stuck_still_time']:g} m in the "
+                     f"last {metrics['stuck_still_time']:g} s, farther than "
+                     f"{metrics['settle_tolerance']:g} m from its place):")
+        lines += [f'    {stuck_line(robot)}' for robot in stuck]
+    return lines
+
+
 def format_summary(metrics: dict, out_dir: Optional[str] = None) -> str:
     """Human-readable summary lines of a metrics dictionary."""
     settle = metrics['settle_time']
-    settle_text = f'{settle:.2f} s' if settle is not None else 'not settled by the end'
+    stuck = len(metrics.get('stuck_robots') or ())
+    settle_text = (f'{settle:.2f} s' if settle is not None else 'not settled by the end'
+                   + (f': {stuck} robot{"s" if stuck > 1 else ""} stuck (below)' if stuck
+                      else ''))
     collision = 'no collision' if metrics['min_pair_distance'] > 0.0 else 'COLLISION'
     lines = [
         f"  robots: {metrics['num_robots']} in {metrics['dim']}D, "
@@ -519,6 +568,7 @@ def format_summary(metrics: dict, out_dir: Optional[str] = None) -> str:
             f"{metrics['omega_bound']:.4g} rad/s{_limit(metrics, 'max_angular', 'rad/s')})",
         ]
     lines += [_segment_line(segment) for segment in metrics.get('segments', ())]
+    lines += _obstacle_lines(metrics)
     if out_dir:
         lines.append(f'  results in {out_dir}')
     return '\n'.join(lines)
