@@ -19,7 +19,9 @@ import time
 from typing import Callable, Optional, Sequence, TextIO, Tuple
 
 from formation_ros.core.maths.frames import desired_positions, FrameSample
-from formation_ros.core.maths.law import team_command
+from formation_ros.core.maths.law import Command, LawParams, team_command
+from formation_ros.core.maths.obstacle_tracking import tracking_command
+from formation_ros.core.maths.obstacles import Obstacles
 from formation_ros.core.maths.safety import body_clearance, guaranteed_min_distance
 from formation_ros.core.maths.unicycle import unicycle_rates
 from formation_ros.core.maths.units import NS_PER_S
@@ -189,14 +191,27 @@ def integrate_segments(rhs: Callable[[float, np.ndarray, np.ndarray], np.ndarray
     return np.concatenate(t_out), np.concatenate(y_out)
 
 
+def law_command(q: np.ndarray, vertices: np.ndarray, sensing_radii: np.ndarray, law: LawParams,
+                frame: FrameSample, obstacles: Optional[Obstacles], tree=None,
+                pairs: Optional[np.ndarray] = None) -> Command:
+    """
+    Return the team's command at q: ``team_command`` with the obstacles, feed-forward guarded.
+
+    obstacles: as the law sees them (``FormationConfig.law_obstacles``) or None; near them a
+    moving reference's feed-forward loses its component into them
+    (``core.maths.obstacle_tracking``). Without obstacles exactly ``team_command``.
+    """
+    command = team_command(q, vertices, sensing_radii, law, frame, tree, pairs, obstacles)
+    return tracking_command(command, q, frame, law, obstacles, sensing_radii)
+
+
 def _assemble(times, states, config, law, reference, shapes):
     obstacles = config.law_obstacles()
     commands, desired, centres = [], [], []
     for t, q in zip(times, states):
         frame = reference.sample(t)
         vertices = vertices_at(shapes, t)
-        commands.append(team_command(q, vertices, config.sensing_radii, law, frame,
-                                     obstacles=obstacles))
+        commands.append(law_command(q, vertices, config.sensing_radii, law, frame, obstacles))
         desired.append(desired_positions(vertices, frame))
         centres.append(frame.q_od)
     return Trajectory(t=np.asarray(times, dtype=float), q=np.asarray(states),
@@ -234,8 +249,8 @@ def simulate(config: FormationConfig, duration: Optional[float] = None,
     def rhs(t: float, y: np.ndarray, vertices: np.ndarray) -> np.ndarray:
         progress.update(t)
         frame = reference.sample(t)
-        return team_command(y.reshape(n, dim), vertices, config.sensing_radii, law,
-                            frame, obstacles=obstacles).u.ravel()
+        return law_command(y.reshape(n, dim), vertices, config.sensing_radii, law, frame,
+                           obstacles).u.ravel()
 
     times, y = integrate_segments(rhs, config.start.ravel(), sample_times(duration, sample_dt),
                                   shapes)
@@ -262,8 +277,8 @@ def simulate_unicycles(config: FormationConfig, duration: float, sample_dt: floa
     def rhs(t: float, y: np.ndarray, vertices: np.ndarray) -> np.ndarray:
         progress.update(t)
         q, heading = y[:2 * n].reshape(n, 2), y[2 * n:]
-        u = team_command(bodies.control_points(q, heading), vertices, config.sensing_radii,
-                         law, reference.sample(t), obstacles=obstacles).u
+        u = law_command(bodies.control_points(q, heading), vertices, config.sensing_radii,
+                        law, reference.sample(t), obstacles).u
         q_rate, heading_rate = unicycle_rates(heading, bodies.body_command(u, heading))
         return np.concatenate([q_rate.ravel(), heading_rate])
 
@@ -350,9 +365,9 @@ def run_fixed_step(config: FormationConfig, duration: float, dt: float, sample_d
         sensed = model.sensed(trees=False)
         seen_frame = (frame if sensed.stamp_ns == model.t_ns
                       else reference.sample(sensed.stamp_ns / NS_PER_S))
-        u = team_command(sensed.points, shapes.at(sensed.stamp_ns).vertices,
-                         config.sensing_radii, law, seen_frame, sensed.tree, sensed.pairs,
-                         obstacles).u
+        u = law_command(sensed.points, shapes.at(sensed.stamp_ns).vertices,
+                        config.sensing_radii, law, seen_frame, obstacles, sensed.tree,
+                        sensed.pairs).u
         commands.store_all(bodies.body_command(u, sensed.heading), sensed.stamp_ns)
         if k == steps:
             times.append(model.t)
@@ -520,9 +535,9 @@ def _obstacle_lines(metrics: dict) -> list:
                      f"{metrics.get('obstacle_clearance_b_o', math.nan):g} m)")
     stuck = metrics.get('stuck_robots') or ()
     if stuck:
-        lines.append(f'  stuck ({len(stuck)}: moved less than '
-                     f"{metrics['stuck_still_speed'] * metrics['stuck_still_time']:g} m in the "
-                     f"last {metrics['stuck_still_time']:g} s, farther than "
+        lines.append(f'  stuck ({len(stuck)}: within '
+                     f"{metrics['stuck_still_speed'] * metrics['stuck_still_time']:g} m of where "
+                     f"it ended for the last {metrics['stuck_still_time']:g} s, farther than "
                      f"{metrics['settle_tolerance']:g} m from its place):")
         lines += [f'    {stuck_line(robot)}' for robot in stuck]
     return lines

@@ -86,3 +86,11 @@ def test_a_robot_still_moving_or_at_its_place_or_a_short_run_is_not_stuck():
     arrived = np.tile([[2.0, 0.0], [10.0, 10.0]], (len(t), 1, 1))
     assert stuck_robots(t, arrived, q_desired, PILLAR) == []
     assert stuck_robots(t[:10], arrived[:10] + 5.0, q_desired[:10], PILLAR) == []
+
+
+def test_a_robot_trembling_on_the_spot_is_stuck():
+    t = np.linspace(0.0, 20.0, 2001)
+    xs = -1.2 + 0.01 * np.where(np.arange(len(t)) % 2, 1.0, -1.0)  # 2 m/s back and forth
+    q = passing(xs, 0.0)
+    q_desired = np.tile([[2.0, 0.0], [10.0, 10.0]], (len(t), 1, 1))
+    assert [s.robot for s in stuck_robots(t, q, q_desired, PILLAR)] == [0]

@@ -21,7 +21,8 @@ from numpy.typing import ArrayLike, NDArray
 STILL_TIME = 5.0
 """Seconds at the end of a run over which a stuck robot has hardly moved."""
 STILL_SPEED = 0.01
-"""m/s: a robot whose mean speed over :data:`STILL_TIME` is below this has hardly moved."""
+"""m/s: a robot that stayed within this times :data:`STILL_TIME` of where it ended has hardly
+moved."""
 BLOCK_DISTANCES = 2_000_000
 """Robot-obstacle distances measured at once by :func:`obstacle_metrics` (about 50 MB)."""
 
@@ -129,20 +130,21 @@ def stuck_robots(t: ArrayLike, q: ArrayLike, q_desired: ArrayLike,
     Return the robots stuck at the end of a run, in index order.
 
     A robot is stuck when its control point ``q`` ends farther than ``tolerance`` (m) from its
-    place ``q_desired`` and its path over the last ``still_time`` seconds is shorter than
-    ``still_speed * still_time``. A run shorter than ``still_time`` has none. bodies: (T, N,
-    dim) the bodies' positions when they are not the control points (unicycles' axle centres),
-    whose footprint ``body_radius`` (m) is measured to the nearest obstacle.
+    place ``q_desired`` and stayed within ``still_speed * still_time`` of where it ended over
+    the last ``still_time`` seconds (a robot pressed against an obstacle may tremble on the
+    spot, which a path length would count as moving). A run shorter than ``still_time`` has
+    none. bodies: (T, N, dim) the bodies' positions when they are not the control points
+    (unicycles' axle centres), whose footprint ``body_radius`` (m) is measured to the nearest
+    obstacle.
     """
     times = np.asarray(t, dtype=float)
     q = np.asarray(q, dtype=float)
     if len(times) < 2 or times[-1] - times[0] < still_time:
         return []
     window = times >= times[-1] - still_time
-    steps = np.diff(q[window], axis=0)
-    paths = np.sqrt(np.einsum('tnd,tnd->tn', steps, steps)).sum(axis=0)
+    wander = formation_errors(q[window], q[-1][None]).max(axis=0)
     errors = formation_errors(q[-1], np.asarray(q_desired, dtype=float)[-1])
-    found = np.nonzero((errors > tolerance) & (paths < still_speed * still_time))[0]
+    found = np.nonzero((errors > tolerance) & (wander < still_speed * still_time))[0]
     places = q[-1] if bodies is None else np.asarray(bodies, dtype=float)[-1]
     gaps = (obstacle_clearances(places[None], obstacles, body_radius)[0]
             if obstacles is not None and obstacles.count and len(found) else None)
