@@ -4,12 +4,18 @@
 """Obstacles offline (issue 36): formation_sim, metrics.json, the summary and formation_report."""
 
 import json
+import os
 
-from formation_ros.core.settings.params import validate
+from formation_ros.core.runs.obstacle_metrics import obstacle_metrics
+from formation_ros.core.settings.params import load_config, validate
+from formation_ros.core.settings.params_file import load_params_file
 from formation_ros.simulation.simulate import run_metrics, simulate
 from formation_ros.tools import report, sim
+import numpy as np
 import pytest
 import yaml
+
+CONFIG = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), 'config')
 
 BEHIND_A_WALL = {
     'num_robots': 2, 'dim': 2, 'sensing_radius': 2.0, 'repulsion_radius': 1.0,
@@ -81,3 +87,53 @@ def test_unicycles_keep_their_bodies_off_a_pillar(dt):
     metrics = run_metrics(simulate(config, dt=dt), config, 'test')
     assert metrics['obstacle_contacts'] == 0 and metrics['min_obstacle_clearance'] > 0.0
     assert metrics['bound_violations'] == 0
+
+
+@pytest.mark.parametrize('name', ['pillars.yaml', 'doorway.yaml', 'helix_spheres.yaml'])
+def test_the_obstacle_configs_run_without_contact(name):
+    config = load_config(os.path.join(CONFIG, name))
+    metrics = run_metrics(simulate(config, dt=0.02), config, 'test')
+    assert metrics['obstacle_contacts'] == 0 and metrics['min_obstacle_clearance'] > 0.0
+    assert metrics['bound_violations'] == 0 and metrics['min_pair_distance'] > 0.0
+    if name == 'doorway.yaml':
+        stuck = metrics['stuck_robots']
+        assert stuck and all(robot['nearest_obstacle'].startswith('wall') for robot in stuck)
+        assert 1 not in [robot['robot'] for robot in stuck]
+    else:
+        assert metrics['settle_time'] is not None and metrics['stuck_robots'] == []
+
+
+def pillar_field(seed, count=12, radius=0.35, clearance=0.5):
+    """Random pillars among the Section 5 team: none within b_o of a start or a resting place."""
+    rng = np.random.default_rng(seed)
+    raw = load_params_file(os.path.join(CONFIG, 'paper_section5.yaml'))
+    raw.update({'obstacles.clearance': clearance, 'duration': 12.0})
+    config = validate(raw)
+    keep_off = np.vstack([config.start, config.vertices])
+    pillars = []
+    while len(pillars) < count:
+        centre = rng.uniform(-9.0, 9.0, 2)
+        if np.min(np.linalg.norm(keep_off - centre, axis=1)) > radius + clearance + 0.3:
+            pillars += [*centre, radius]
+    raw['obstacles.circles'] = pillars
+    return raw
+
+
+@pytest.mark.parametrize('seed', [0, 1, 2])
+def test_no_contact_among_random_pillars_when_stabilising(seed):
+    config = validate(pillar_field(seed))
+    trajectory = simulate(config, sample_dt=0.002)
+    metrics = obstacle_metrics(trajectory.q, config.obstacles)
+    assert metrics['obstacle_contacts'] == 0 and metrics['min_obstacle_clearance'] > 0.0
+
+
+@pytest.mark.parametrize('seed, speed', [(3, 1.0), (4, 4.0)])
+def test_no_contact_among_random_pillars_when_tracking_a_line(seed, speed):
+    """The team forms up while its place crosses the field, at 4 m/s faster than c M1."""
+    raw = pillar_field(seed)
+    raw.update({'reference.kind': 'line', 'reference.origin': [-6.0, 0.0],
+                'reference.velocity': [speed, 0.0], 'duration': 12.0 / speed})
+    config = validate(raw)
+    trajectory = simulate(config, sample_dt=0.002)
+    metrics = obstacle_metrics(trajectory.q, config.obstacles)
+    assert metrics['obstacle_contacts'] == 0 and metrics['min_obstacle_clearance'] > 0.0
