@@ -137,3 +137,15 @@ def test_no_contact_among_random_pillars_when_tracking_a_line(seed, speed):
     trajectory = simulate(config, sample_dt=0.002)
     metrics = obstacle_metrics(trajectory.q, config.obstacles)
     assert metrics['obstacle_contacts'] == 0 and metrics['min_obstacle_clearance'] > 0.0
+
+
+def test_rk45_does_not_step_over_a_thin_wall():
+    """Robots holding their places on a line move exactly linearly: RK45 would leap the wall."""
+    config = validate({**BEHIND_A_WALL, 'formation.vertices': [0.0, 0.0, 0.0, 3.0],
+                       'start.positions': [0.0, 0.0, 0.0, 3.0], 'reference.kind': 'line',
+                       'reference.velocity': [1.0, 0.0], 'duration': 8.0,
+                       'obstacles.walls': [5.0, -10.0, 5.0, 10.0, 0.05]})
+    trajectory = simulate(config)
+    metrics = obstacle_metrics(trajectory.q, config.obstacles)
+    assert metrics['obstacle_contacts'] == 0 and metrics['min_obstacle_clearance'] > 0.0
+    assert np.all(trajectory.q[-1, :, 0] < 5.0)  # held on their side, behind their places

@@ -18,7 +18,7 @@ import sys
 import time
 from typing import Callable, Optional, Sequence, TextIO, Tuple
 
-from formation_ros.core.maths.frames import desired_positions, FrameSample
+from formation_ros.core.maths.frames import desired_positions, FrameSample, from_frame_velocity
 from formation_ros.core.maths.law import Command, LawParams, team_command
 from formation_ros.core.maths.obstacle_tracking import tracking_command
 from formation_ros.core.maths.obstacles import Obstacles
@@ -163,13 +163,14 @@ def vertices_at(shapes: Timeline[Shape], t: float) -> np.ndarray:
 
 def integrate_segments(rhs: Callable[[float, np.ndarray, np.ndarray], np.ndarray],
                        start: np.ndarray, times: np.ndarray,
-                       shapes: Timeline[Shape]) -> Tuple[np.ndarray, np.ndarray]:
+                       shapes: Timeline[Shape],
+                       max_step: float = math.inf) -> Tuple[np.ndarray, np.ndarray]:
     """
     RK45 from one shape switch to the next, each segment with its shape's vertices.
 
     rhs(t, y, vertices); times: the sample times (T,). A switch makes the right-hand side jump,
-    so each segment is integrated on its own from where the last ended. Returns (t (T,),
-    y (T, len(start))).
+    so each segment is integrated on its own from where the last ended. max_step: the longest
+    step RK45 may take, s (:func:`obstacle_step`). Returns (t (T,), y (T, len(start))).
     """
     from scipy.integrate import solve_ivp  # RK45 only: a --dt run does not load it
     ends = [stamp / NS_PER_S for stamp, _ in shapes.changes() if 0.0 < stamp / NS_PER_S
@@ -181,7 +182,7 @@ def integrate_segments(rhs: Callable[[float, np.ndarray, np.ndarray], np.ndarray
         solution = solve_ivp(lambda t, y: rhs(t, y, vertices), (begin, end), y0,
                              method='RK45', t_eval=np.append(inside, end)
                              if not len(inside) or inside[-1] < end else inside,
-                             rtol=RTOL, atol=ATOL)
+                             rtol=RTOL, atol=ATOL, max_step=max_step)
         if not solution.success:
             raise RuntimeError(f'RK45 failed: {solution.message}')
         keep = np.isin(solution.t, inside)
@@ -189,6 +190,30 @@ def integrate_segments(rhs: Callable[[float, np.ndarray, np.ndarray], np.ndarray
         y_out.append(solution.y.T[keep])
         begin, y0 = end, solution.y[:, -1]
     return np.concatenate(t_out), np.concatenate(y_out)
+
+
+def obstacle_step(config: FormationConfig, times: np.ndarray) -> float:
+    """
+    Return the longest RK45 step of a run among obstacles, s (inf without obstacles).
+
+    Far from obstacles and neighbours the closed loop can be exactly linear (robots holding
+    their places on a line), RK45's error estimate vanishes and its steps grow until one jumps
+    over a wall. A step here moves no robot more than about a quarter of b_o: at most
+    sqrt(dim) c M1 from the bounded command plus twice the fastest feed-forward of eq. (25) at
+    the places of the formation, the reference sampled at up to 200 of ``times`` (T,) s.
+    """
+    obstacles = config.obstacles
+    if obstacles is None:
+        return math.inf
+    reference = config.reference()
+    fastest = 0.0
+    for t in times[::max(1, len(times) // 200)]:
+        frame = reference.sample(float(t))
+        places = desired_positions(config.vertices, frame)
+        feed_forward = from_frame_velocity(np.zeros_like(places), places, frame)
+        fastest = max(fastest, float(np.max(np.linalg.norm(feed_forward, axis=1))))
+    speed = math.sqrt(config.dim) * config.law().u_bound + 2.0 * fastest
+    return 0.25 * obstacles.clearance / speed
 
 
 def law_command(q: np.ndarray, vertices: np.ndarray, sensing_radii: np.ndarray, law: LawParams,
@@ -252,8 +277,9 @@ def simulate(config: FormationConfig, duration: Optional[float] = None,
         return law_command(y.reshape(n, dim), vertices, config.sensing_radii, law, frame,
                            obstacles).u.ravel()
 
-    times, y = integrate_segments(rhs, config.start.ravel(), sample_times(duration, sample_dt),
-                                  shapes)
+    times = sample_times(duration, sample_dt)
+    times, y = integrate_segments(rhs, config.start.ravel(), times, shapes,
+                                  obstacle_step(config, times))
     return _assemble(times, y.reshape(-1, n, dim), config, law, reference, shapes)
 
 
@@ -283,7 +309,8 @@ def simulate_unicycles(config: FormationConfig, duration: float, sample_dt: floa
         return np.concatenate([q_rate.ravel(), heading_rate])
 
     start = np.concatenate([config.start.ravel(), config.start_headings])
-    times, y = integrate_segments(rhs, start, sample_times(duration, sample_dt), shapes)
+    times = sample_times(duration, sample_dt)
+    times, y = integrate_segments(rhs, start, times, shapes, obstacle_step(config, times))
     q_body = y[:, :2 * n].reshape(-1, n, 2)
     heading = y[:, 2 * n:]
     trajectory = _assemble(times, bodies.control_points(q_body, heading), config, law,
