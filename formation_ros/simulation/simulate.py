@@ -8,8 +8,11 @@ The offline simulator: the closed loop q' = u of eqs. (1), (14), (25), without R
 unicycles' own equations with the law on their hand points); ``run_fixed_step`` steps the plant
 model every ``dt`` with the command held (zero-order hold), as the plant node does, including
 the bodies' imperfections (``core.model.dynamics``); ``run_metrics`` and ``format_summary`` make
-metrics.json and its summary. ``formation_sim`` (``tools.sim``) is the command line over it;
-the benches and the report use it too.
+metrics.json and its summary. With obstacles (beyond the paper) the law keeps the control points
+off the obstacles grown by the footprint, a moving reference's feed-forward is guarded near them
+(``core.maths.obstacle_tracking``), and RK45's step is capped (:func:`obstacle_step`).
+``formation_sim`` (``tools.sim``) is the command line over it; the benches and the report use
+it too.
 """
 
 from dataclasses import dataclass, replace
