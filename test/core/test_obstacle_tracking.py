@@ -7,9 +7,10 @@ from dataclasses import replace
 
 from formation_ros.core.maths.frames import stationary_frame
 from formation_ros.core.maths.law import make_law, team_command
-from formation_ros.core.maths.obstacle_tracking import (feed_forward_change,
+from formation_ros.core.maths.obstacle_tracking import (change_for, feed_forward_change,
                                                         guarded_feed_forward, tracking_command)
-from formation_ros.core.maths.obstacles import MAX_OBSTACLE_REPULSION, Obstacles
+from formation_ros.core.maths.obstacles import (MAX_OBSTACLE_REPULSION, obstacle_terms,
+                                                Obstacles)
 from formation_ros.core.maths.reference import Reference
 import numpy as np
 import pytest
@@ -52,6 +53,9 @@ def test_near_the_wall_u_hat_is_kept_and_only_u_changes():
     assert guarded.u[0, 0] < command.u[0, 0] and guarded.u[0, 1] == pytest.approx(command.u[0, 1])
     change = feed_forward_change(q, frame, LAW, WALL, [2.0])
     assert guarded.u == pytest.approx(command.u + change)
+    away = obstacle_terms(q, WALL.surface(q), LAW.jump, WALL.clearance, [2.0])
+    assert change_for(q, frame, away, WALL.clearance) == pytest.approx(change)
+    assert change_for(q, stationary_frame(2), away, WALL.clearance) is None
 
 
 def run_into_the_wall(guard, speed=4.0, dt=1e-3, duration=4.0):

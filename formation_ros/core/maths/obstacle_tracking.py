@@ -80,12 +80,28 @@ def feed_forward_change(q: ArrayLike, frame: Optional[FrameSample], law: LawPara
     if obstacles is None or obstacles.count == 0 or frame is None:
         return None
     q = np.asarray(q, dtype=float)
-    feed_forward = from_frame_velocity(np.zeros_like(q), q, frame)
-    if not np.any(feed_forward):
+    if not np.any(from_frame_velocity(np.zeros_like(q), q, frame)):
         return None
     radii = np.minimum(np.asarray(sensing_radii, dtype=float), RADIUS_MAX)
     away = obstacle_terms(q, obstacles.surface(q), law.jump, obstacles.clearance, radii)
-    change = guarded_feed_forward(feed_forward, away, 1.0 / obstacles.clearance) - feed_forward
+    return change_for(q, frame, away, obstacles.clearance)
+
+
+def change_for(q: ArrayLike, frame: Optional[FrameSample], away: ArrayLike,
+               clearance: float) -> Optional[NDArray[np.float64]]:
+    """
+    Return :func:`feed_forward_change` from the obstacles' repulsion already summed, or None.
+
+    q: (N, dim) world positions, m; away: (N, dim) a_i, ``obstacles.obstacle_terms`` of the
+    surface points each robot knows (a robot node: those it heard), 1/m; clearance: b_o, m.
+    """
+    if frame is None:
+        return None
+    q = np.asarray(q, dtype=float)
+    feed_forward = from_frame_velocity(np.zeros_like(q), q, frame)
+    if not np.any(feed_forward):
+        return None
+    change = guarded_feed_forward(feed_forward, away, 1.0 / clearance) - feed_forward
     return change if np.any(change) else None
 
 
