@@ -465,3 +465,20 @@ def test_robustness_benchmark_on_the_physics_engine_quick_run(tmp_path):
         assert info.value.code == 2
     assert robustness.parse_args(['--physics']).seeds == 1
     assert robustness.parse_args([]).seeds == 3
+
+
+def test_bench_obstacles_places_pillars_off_the_team_and_runs_without_contact(tmp_path):
+    bench = load_bench(os.path.join(ROOT, 'bench', 'bench_obstacles.py'))
+    params = bench.params_for(100)
+    pillars = np.array(bench.lattice_pillars(params, 10)).reshape(-1, 3)
+    assert len(pillars) == 10
+    places = np.array(params['formation.vertices']).reshape(-1, 2)
+    nearest = np.min(np.linalg.norm(places[:, None] - pillars[None, :, :2], axis=2), axis=0)
+    assert np.all(nearest - pillars[:, 2] > bench.CLEARANCE)
+    assert np.all(np.linalg.norm(pillars[:, :2], axis=1) > params['start.random_radius'])
+    bench.main(['--cost-sizes', '20', '--pillars', '6', '--repeats', '1', '--out',
+                str(tmp_path)])
+    with open(tmp_path / 'obstacles.json', encoding='utf-8') as stream:
+        rows = json.load(stream)['cost']
+    assert [row['pillars'] for row in rows] == [0, 6]
+    assert rows[1]['obstacle_contacts'] == 0 and rows[0]['min_obstacle_clearance'] is None

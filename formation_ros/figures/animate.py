@@ -7,8 +7,9 @@ An animation of a formation run: ``animation.mp4`` (ffmpeg on PATH) or ``animati
 Each frame shows the robots' control points (hand points of unicycles, whose axle centres,
 bodies and headings are drawn too), each one's sensing disc (radius R_i) and repulsion disc
 (radius b: another robot's centre inside it is repelled), the desired formation in force, the
-recent paths, the time, the shape in force and whether the team is stopped; a strip below marks
-the events (``core.runs.events``) along the run (drawn by ``figures.scene``).
+recent paths, the static obstacles (filled), the time, the shape in force and whether the team
+is stopped; a strip below marks the events (``core.runs.events``) along the run (drawn by
+``figures.scene``).
 
 The size is bounded: at most :data:`MAX_FRAMES` frames, never more than the run has samples,
 chosen evenly in time at a fixed frame rate. This module loads matplotlib only to write.
@@ -121,7 +122,7 @@ def write_animation(trajectory: Trajectory, config: FormationConfig, out_dir: st
     title = (f'{trajectory.num_robots} {config.body.kind.value} robots{dimension}, '
              f'{plan.speed:.3g} s of the run per second')
     scene = Scene(trajectory, config.sensing_radii, config.repulsion_radius, config.body.radius,
-                  events, title, FIGURE_WIDTH)
+                  events, title, FIGURE_WIDTH, config.obstacles)
     t = trajectory.t
     duration = float(t[-1] - t[0])
     trail = duration * TRAIL_FRACTION

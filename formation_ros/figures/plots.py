@@ -12,6 +12,7 @@ import os
 
 from formation_ros.core.maths.law import beta
 from formation_ros.core.runs.metrics import dis_all_series, dis_min_series, formation_errors
+from formation_ros.figures.obstacles import draw_3d, draw_plan
 import matplotlib
 import numpy as np
 
@@ -60,8 +61,20 @@ def heading_length(traj):
     return HEADING_SPAN * span
 
 
-def plot_trajectories(traj, path, title='Trajectories'):
+def plot_trajectories(traj, path, title='Trajectories', obstacles=None):
     """Paths, start (o) and end (x) points, the desired formation polygon, the reference path."""
+    fig = trajectories_figure(traj, title, obstacles)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def trajectories_figure(traj, title='Trajectories', obstacles=None):
+    """
+    Return the figure of :func:`plot_trajectories`, not saved.
+
+    obstacles: a ``core.maths.obstacles.Obstacles`` (world frame) drawn under the paths
+    (``figures.obstacles``), or None.
+    """
     q, desired = traj.q, traj.q_desired
     n = traj.num_robots
     shown = shown_robots(n)
@@ -70,6 +83,11 @@ def plot_trajectories(traj, path, title='Trajectories'):
     ax = fig.add_subplot(111, projection='3d' if three_d else None)
     coords = (lambda pts: (pts[..., 0], pts[..., 1], pts[..., 2])) if three_d else \
         (lambda pts: (pts[..., 0], pts[..., 1]))
+    if obstacles is not None and obstacles.count:
+        if three_d:
+            draw_3d(ax, obstacles, float(q[..., 2].min()), float(q[..., 2].max()))
+        else:
+            draw_plan(ax, obstacles)
     if is_moving(traj):
         ax.plot(*coords(traj.q_od), **REFERENCE_STYLE, label='reference path q_od')
     for i in shown:
@@ -94,8 +112,7 @@ def plot_trajectories(traj, path, title='Trajectories'):
     ax.set_title(f'{title}: N = {n}, {what}robot 1 thick')
     ax.legend(loc='best', fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    return fig
 
 
 def _draw_headings(ax, traj, shown):
@@ -217,10 +234,15 @@ def plot_formation_error(traj, metrics, path):
     plt.close(fig)
 
 
-def write_figures(traj, law, metrics, out_dir):
-    """Write the four figures of :data:`FIGURES` into ``out_dir``; returns their paths."""
+def write_figures(traj, law, metrics, out_dir, obstacles=None):
+    """
+    Write the four figures of :data:`FIGURES` into ``out_dir``; returns their paths.
+
+    obstacles: the run's static obstacles (``FormationConfig.obstacles``), drawn on the
+    trajectories, or None.
+    """
     paths = [os.path.join(out_dir, name) for name in FIGURES]
-    plot_trajectories(traj, paths[0])
+    plot_trajectories(traj, paths[0], obstacles=obstacles)
     plot_distances(traj, law, paths[1])
     if traj.body_command is not None and 'v_bound' in metrics:
         plot_unicycle_controls(traj, metrics, paths[2])

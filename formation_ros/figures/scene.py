@@ -7,18 +7,20 @@ The frames of a run's animation (``figures.animate``), with the colours and help
 The robots' control points (hand points of unicycles, whose axle centres, bodies and headings
 are drawn too), each one's sensing disc (radius R_i) and repulsion disc (radius b: another
 robot's centre inside it is repelled), the desired formation in force, the recent paths, the
-time, the shape in force and whether the team is stopped; a strip below marks the events along
-the run and the time. 3D runs are drawn in their x-y projection (a disc is then the outline of
-the sphere).
+static obstacles (``figures.obstacles``, drawn once), the time, the shape in force and whether
+the team is stopped; a strip below marks the events along the run and the time. 3D runs are
+drawn in their x-y projection (a disc is then the outline of the sphere).
 
 The axes, ticks, legend and events are drawn once; each frame redraws only what moves on a copy
 of that background (blitting), which makes a frame several times cheaper than a full draw.
 """
 
-from typing import List, Sequence, Tuple, Union
+from typing import List, Optional, Sequence, Tuple, Union
 
+from formation_ros.core.maths.obstacles import Obstacles
 from formation_ros.core.runs.events import Event, EventKind, ordered, shape_in_force, stopped_at
 from formation_ros.core.runs.trajectory import Trajectory
+from formation_ros.figures.obstacles import draw_plan, OBSTACLE_ALPHA, OBSTACLE_COLOR
 from formation_ros.figures.plots import (DESIRED_COLOR, HEADING_COLOR, heading_length, is_moving,
                                          polygon, REFERENCE_STYLE, REPULSION_COLOR, robot_color,
                                          shown_robots, THICK)
@@ -32,6 +34,7 @@ from matplotlib.artist import Artist  # noqa: E402
 from matplotlib.collections import EllipseCollection, LineCollection  # noqa: E402
 from matplotlib.colors import to_rgb  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
+from matplotlib.patches import Patch  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 from PIL import Image  # noqa: E402
 
@@ -40,7 +43,7 @@ TRAIL_POINTS = 60
 SHAPE_COLOR = 'tab:purple'
 STOP_COLOR = '0.75'
 BODY_COLOR = '0.3'
-GIF_BASES = ('k', *(f'C{i}' for i in range(10)), STOP_COLOR, BODY_COLOR)
+GIF_BASES = ('k', *(f'C{i}' for i in range(10)), STOP_COLOR, BODY_COLOR, OBSTACLE_COLOR)
 """Every colour a frame draws in (plots.robot_color cycles through C0..C9)."""
 GIF_SHADES = (1.0, 0.8, 0.6, 0.45, 0.3, 0.15)
 """Each base colour enters a GIF's palette at these weights over white (antialiased edges)."""
@@ -106,12 +109,13 @@ class Scene:
     repulsion_radius: b in m; body_radius: m (0: none drawn); events: as ``core.runs.events``;
     width: of the figure, inches (its height follows the run's extent). The moving artists are
     in :attr:`moving`, each with a gid: 'sensing', 'repulsion', 'trails', 'desired', 'bodies'
-    and 'headings' (unicycles), 'robots', 'clock', 'cursor'.
+    and 'headings' (unicycles), 'robots', 'clock', 'cursor'. obstacles: the static obstacles
+    (world frame), filled in the background (gid 'obstacles', ``figures.obstacles``), or None.
     """
 
     def __init__(self, trajectory: Trajectory, radii: NDArray[np.float64],
                  repulsion_radius: float, body_radius: float, events: Sequence[Event],
-                 title: str, width: float):
+                 title: str, width: float, obstacles: Optional[Obstacles] = None):
         """Lay out the figure and every artist (nothing drawn yet)."""
         self.trajectory = trajectory
         self.events = ordered(events)
@@ -133,6 +137,11 @@ class Scene:
                          label='repulsion disc b'),
                   Line2D([], [], color=DESIRED_COLOR, marker='x', markersize=4,
                          label='desired formation')]
+        if obstacles is not None and obstacles.count:
+            draw_plan(ax, obstacles)
+            legend.append(Patch(facecolor=OBSTACLE_COLOR, alpha=OBSTACLE_ALPHA,
+                                label='obstacles' + (' (x-y projection)' if trajectory.dim == 3
+                                                     else '')))
         if is_moving(trajectory):
             legend += ax.plot(trajectory.q_od[:, 0], trajectory.q_od[:, 1], **REFERENCE_STYLE,
                               label='reference path q_od')

@@ -8,8 +8,11 @@ The offline simulator: the closed loop q' = u of eqs. (1), (14), (25), without R
 unicycles' own equations with the law on their hand points); ``run_fixed_step`` steps the plant
 model every ``dt`` with the command held (zero-order hold), as the plant node does, including
 the bodies' imperfections (``core.model.dynamics``); ``run_metrics`` and ``format_summary`` make
-metrics.json and its summary. ``formation_sim`` (``tools.sim``) is the command line over it;
-the benches and the report use it too.
+metrics.json and its summary. With obstacles (beyond the paper) the law keeps the control points
+off the obstacles grown by the footprint, a moving reference's feed-forward is guarded near them
+(``core.maths.obstacle_tracking``), and RK45's step is capped (:func:`obstacle_step`).
+``formation_sim`` (``tools.sim``) is the command line over it; the benches and the report use
+it too.
 """
 
 from dataclasses import dataclass, replace
@@ -18,8 +21,10 @@ import sys
 import time
 from typing import Callable, Optional, Sequence, TextIO, Tuple
 
-from formation_ros.core.maths.frames import desired_positions, FrameSample
-from formation_ros.core.maths.law import team_command
+from formation_ros.core.maths.frames import desired_positions, FrameSample, from_frame_velocity
+from formation_ros.core.maths.law import Command, LawParams, team_command
+from formation_ros.core.maths.obstacle_tracking import tracking_command
+from formation_ros.core.maths.obstacles import Obstacles
 from formation_ros.core.maths.safety import body_clearance, guaranteed_min_distance
 from formation_ros.core.maths.unicycle import unicycle_rates
 from formation_ros.core.maths.units import NS_PER_S
@@ -28,6 +33,8 @@ from formation_ros.core.model.plant import Commands, PlantCounts, PlantModel
 from formation_ros.core.runs.events import Event, EventKind, timeline_events, with_shapes
 from formation_ros.core.runs.metrics import (body_metrics, compute_metrics, held_metrics,
                                              segment_metrics)
+from formation_ros.core.runs.obstacle_metrics import (obstacle_metrics, STILL_SPEED, STILL_TIME,
+                                                      stuck_line, stuck_robots)
 from formation_ros.core.runs.timeline import Mode, scheduled_shapes, Shape, TeamState, Timeline
 from formation_ros.core.runs.trajectory import Trajectory
 from formation_ros.core.settings.declarations import CommandFrame, DEFAULT_COLLISION_DISTANCE
@@ -159,13 +166,14 @@ def vertices_at(shapes: Timeline[Shape], t: float) -> np.ndarray:
 
 def integrate_segments(rhs: Callable[[float, np.ndarray, np.ndarray], np.ndarray],
                        start: np.ndarray, times: np.ndarray,
-                       shapes: Timeline[Shape]) -> Tuple[np.ndarray, np.ndarray]:
+                       shapes: Timeline[Shape],
+                       max_step: float = math.inf) -> Tuple[np.ndarray, np.ndarray]:
     """
     RK45 from one shape switch to the next, each segment with its shape's vertices.
 
     rhs(t, y, vertices); times: the sample times (T,). A switch makes the right-hand side jump,
-    so each segment is integrated on its own from where the last ended. Returns (t (T,),
-    y (T, len(start))).
+    so each segment is integrated on its own from where the last ended. max_step: the longest
+    step RK45 may take, s (:func:`obstacle_step`). Returns (t (T,), y (T, len(start))).
     """
     from scipy.integrate import solve_ivp  # RK45 only: a --dt run does not load it
     ends = [stamp / NS_PER_S for stamp, _ in shapes.changes() if 0.0 < stamp / NS_PER_S
@@ -177,7 +185,7 @@ def integrate_segments(rhs: Callable[[float, np.ndarray, np.ndarray], np.ndarray
         solution = solve_ivp(lambda t, y: rhs(t, y, vertices), (begin, end), y0,
                              method='RK45', t_eval=np.append(inside, end)
                              if not len(inside) or inside[-1] < end else inside,
-                             rtol=RTOL, atol=ATOL)
+                             rtol=RTOL, atol=ATOL, max_step=max_step)
         if not solution.success:
             raise RuntimeError(f'RK45 failed: {solution.message}')
         keep = np.isin(solution.t, inside)
@@ -187,12 +195,51 @@ def integrate_segments(rhs: Callable[[float, np.ndarray, np.ndarray], np.ndarray
     return np.concatenate(t_out), np.concatenate(y_out)
 
 
+def obstacle_step(config: FormationConfig, times: np.ndarray) -> float:
+    """
+    Return the longest RK45 step of a run among obstacles, s (inf without obstacles).
+
+    Far from obstacles and neighbours the closed loop can be exactly linear (robots holding
+    their places on a line), RK45's error estimate vanishes and its steps grow until one jumps
+    over a wall. A step here moves no robot more than about a quarter of b_o: at most
+    sqrt(dim) c M1 from the bounded command plus twice the fastest feed-forward of eq. (25) at
+    the places of the formation, the reference sampled at up to 200 of ``times`` (T,) s.
+    """
+    obstacles = config.obstacles
+    if obstacles is None:
+        return math.inf
+    reference = config.reference()
+    fastest = 0.0
+    for t in times[::max(1, len(times) // 200)]:
+        frame = reference.sample(float(t))
+        places = desired_positions(config.vertices, frame)
+        feed_forward = from_frame_velocity(np.zeros_like(places), places, frame)
+        fastest = max(fastest, float(np.max(np.linalg.norm(feed_forward, axis=1))))
+    speed = math.sqrt(config.dim) * config.law().u_bound + 2.0 * fastest
+    return 0.25 * obstacles.clearance / speed
+
+
+def law_command(q: np.ndarray, vertices: np.ndarray, sensing_radii: np.ndarray, law: LawParams,
+                frame: FrameSample, obstacles: Optional[Obstacles], tree=None,
+                pairs: Optional[np.ndarray] = None) -> Command:
+    """
+    Return the team's command at q: ``team_command`` with the obstacles, feed-forward guarded.
+
+    obstacles: as the law sees them (``FormationConfig.law_obstacles``) or None; near them a
+    moving reference's feed-forward loses its component into them
+    (``core.maths.obstacle_tracking``). Without obstacles exactly ``team_command``.
+    """
+    command = team_command(q, vertices, sensing_radii, law, frame, tree, pairs, obstacles)
+    return tracking_command(command, q, frame, law, obstacles, sensing_radii)
+
+
 def _assemble(times, states, config, law, reference, shapes):
+    obstacles = config.law_obstacles()
     commands, desired, centres = [], [], []
     for t, q in zip(times, states):
         frame = reference.sample(t)
         vertices = vertices_at(shapes, t)
-        commands.append(team_command(q, vertices, config.sensing_radii, law, frame))
+        commands.append(law_command(q, vertices, config.sensing_radii, law, frame, obstacles))
         desired.append(desired_positions(vertices, frame))
         centres.append(frame.q_od)
     return Trajectory(t=np.asarray(times, dtype=float), q=np.asarray(states),
@@ -224,16 +271,18 @@ def simulate(config: FormationConfig, duration: Optional[float] = None,
     reference = config.reference()
     shapes = shapes_of(config)
     n, dim = config.num_robots, config.dim
+    obstacles = config.law_obstacles()
     assert config.start is not None
 
     def rhs(t: float, y: np.ndarray, vertices: np.ndarray) -> np.ndarray:
         progress.update(t)
         frame = reference.sample(t)
-        return team_command(y.reshape(n, dim), vertices, config.sensing_radii, law,
-                            frame).u.ravel()
+        return law_command(y.reshape(n, dim), vertices, config.sensing_radii, law, frame,
+                           obstacles).u.ravel()
 
-    times, y = integrate_segments(rhs, config.start.ravel(), sample_times(duration, sample_dt),
-                                  shapes)
+    times = sample_times(duration, sample_dt)
+    times, y = integrate_segments(rhs, config.start.ravel(), times, shapes,
+                                  obstacle_step(config, times))
     return _assemble(times, y.reshape(-1, n, dim), config, law, reference, shapes)
 
 
@@ -251,18 +300,20 @@ def simulate_unicycles(config: FormationConfig, duration: float, sample_dt: floa
     shapes = shapes_of(config)
     n = config.num_robots
     bodies = UnicycleBodies(config.body.hand_distance)
+    obstacles = config.law_obstacles()
     assert config.start is not None and config.start_headings is not None
 
     def rhs(t: float, y: np.ndarray, vertices: np.ndarray) -> np.ndarray:
         progress.update(t)
         q, heading = y[:2 * n].reshape(n, 2), y[2 * n:]
-        u = team_command(bodies.control_points(q, heading), vertices, config.sensing_radii,
-                         law, reference.sample(t)).u
+        u = law_command(bodies.control_points(q, heading), vertices, config.sensing_radii,
+                        law, reference.sample(t), obstacles).u
         q_rate, heading_rate = unicycle_rates(heading, bodies.body_command(u, heading))
         return np.concatenate([q_rate.ravel(), heading_rate])
 
     start = np.concatenate([config.start.ravel(), config.start_headings])
-    times, y = integrate_segments(rhs, start, sample_times(duration, sample_dt), shapes)
+    times = sample_times(duration, sample_dt)
+    times, y = integrate_segments(rhs, start, times, shapes, obstacle_step(config, times))
     q_body = y[:, :2 * n].reshape(-1, n, 2)
     heading = y[:, 2 * n:]
     trajectory = _assemble(times, bodies.control_points(q_body, heading), config, law,
@@ -333,6 +384,7 @@ def run_fixed_step(config: FormationConfig, duration: float, dt: float, sample_d
                        pair_radius=law.repulsion_radius, imperfections=imperfections)
     commands = Commands.empty(config.num_robots, bodies.command_width(config.dim))
     shapes = shapes_of(config)
+    obstacles = config.law_obstacles()
     steps = int(round(duration / dt))
     stride = max(1, int(round(sample_dt / dt)))
     largest_u_hat = 0.0
@@ -343,8 +395,9 @@ def run_fixed_step(config: FormationConfig, duration: float, dt: float, sample_d
         sensed = model.sensed(trees=False)
         seen_frame = (frame if sensed.stamp_ns == model.t_ns
                       else reference.sample(sensed.stamp_ns / NS_PER_S))
-        u = team_command(sensed.points, shapes.at(sensed.stamp_ns).vertices,
-                         config.sensing_radii, law, seen_frame, sensed.tree, sensed.pairs).u
+        u = law_command(sensed.points, shapes.at(sensed.stamp_ns).vertices,
+                        config.sensing_radii, law, seen_frame, obstacles, sensed.tree,
+                        sensed.pairs).u
         commands.store_all(bodies.body_command(u, sensed.heading), sensed.stamp_ns)
         if k == steps:
             times.append(model.t)
@@ -423,9 +476,33 @@ def run_metrics(trajectory: Trajectory, config: FormationConfig, integrator: str
         metrics['unknown_commands_reason'] = (
             'the states they answered were not heard' if config.command.stamped
             else 'unstamped commands do not say which state they answered')
+    metrics.update(obstacle_keys(trajectory, config))
     if events:
         metrics['segments'] = segment_metrics(trajectory, events)
     return metrics
+
+
+def obstacle_keys(trajectory: Trajectory, config: FormationConfig) -> dict:
+    """
+    metrics.json keys of the obstacles (``core.runs.obstacle_metrics``), with or without any.
+
+    ``min_obstacle_clearance`` (m, None without obstacles) and ``obstacle_contacts`` of the real
+    bodies (a unicycle's axle centre, ``body.radius`` subtracted) against the real obstacles;
+    ``stuck_robots``: the robots hardly moving at the end, far from their places (records of
+    ``Stuck``), with the rule's ``stuck_still_time`` (s) and ``stuck_still_speed`` (m/s).
+    """
+    bodies = trajectory.q if trajectory.q_body is None else trajectory.q_body
+    radius = config.body.radius
+    keys = obstacle_metrics(bodies, config.obstacles, radius)
+    stuck = stuck_robots(trajectory.t, trajectory.q, trajectory.q_desired, config.obstacles,
+                         bodies=bodies, body_radius=radius)
+    keys.update({'stuck_robots': [robot.record() for robot in stuck],
+                 'stuck_still_time': STILL_TIME, 'stuck_still_speed': STILL_SPEED})
+    if config.obstacles is not None:
+        keys.update({'obstacle_count': config.obstacles.count,
+                     'obstacle_clearance_b_o': config.obstacles.clearance,
+                     'body_footprint': config.body.footprint})
+    return keys
 
 
 def plant_metrics(run: FixedStepRun, config: FormationConfig) -> dict:
@@ -476,10 +553,33 @@ def _segment_line(segment: dict) -> str:
             f"{_measured(segment['final_max_error'], 'm')}")
 
 
+def _obstacle_lines(metrics: dict) -> list:
+    """Summary lines of the obstacles and of the stuck robots (:func:`obstacle_keys`)."""
+    lines = []
+    clearance = metrics.get('min_obstacle_clearance')
+    if clearance is not None:
+        contacts = metrics['obstacle_contacts']
+        what = 'no contact' if not contacts else f'{contacts} CONTACTS'
+        lines.append(f"  obstacles: {metrics.get('obstacle_count', '?')}, closest approach of a "
+                     f'body {clearance:.4g} m ({what}; footprint subtracted, b_o = '
+                     f"{metrics.get('obstacle_clearance_b_o', math.nan):g} m)")
+    stuck = metrics.get('stuck_robots') or ()
+    if stuck:
+        lines.append(f'  stuck ({len(stuck)}: within '
+                     f"{metrics['stuck_still_speed'] * metrics['stuck_still_time']:g} m of where "
+                     f"it ended for the last {metrics['stuck_still_time']:g} s, farther than "
+                     f"{metrics['settle_tolerance']:g} m from its place):")
+        lines += [f'    {stuck_line(robot)}' for robot in stuck]
+    return lines
+
+
 def format_summary(metrics: dict, out_dir: Optional[str] = None) -> str:
     """Human-readable summary lines of a metrics dictionary."""
     settle = metrics['settle_time']
-    settle_text = f'{settle:.2f} s' if settle is not None else 'not settled by the end'
+    stuck = len(metrics.get('stuck_robots') or ())
+    settle_text = (f'{settle:.2f} s' if settle is not None else 'not settled by the end'
+                   + (f': {stuck} robot{"s" if stuck > 1 else ""} stuck (below)' if stuck
+                      else ''))
     collision = 'no collision' if metrics['min_pair_distance'] > 0.0 else 'COLLISION'
     lines = [
         f"  robots: {metrics['num_robots']} in {metrics['dim']}D, "
@@ -513,6 +613,7 @@ def format_summary(metrics: dict, out_dir: Optional[str] = None) -> str:
             f"{metrics['omega_bound']:.4g} rad/s{_limit(metrics, 'max_angular', 'rad/s')})",
         ]
     lines += [_segment_line(segment) for segment in metrics.get('segments', ())]
+    lines += _obstacle_lines(metrics)
     if out_dir:
         lines.append(f'  results in {out_dir}')
     return '\n'.join(lines)

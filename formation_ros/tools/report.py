@@ -243,7 +243,7 @@ def write_report(trajectory: Trajectory, config: FormationConfig, out_dir: str,
         stream.write('\n')
     if plots:
         from formation_ros.figures import plots as figures
-        figures.write_figures(trajectory, config.law(), metrics, out_dir)
+        figures.write_figures(trajectory, config.law(), metrics, out_dir, config.obstacles)
     return metrics
 
 

@@ -225,7 +225,7 @@ def main(argv: Optional[list] = None) -> int:
         stream.write('\n')
     if not args.no_plots:
         from formation_ros.figures import plots
-        plots.write_figures(trajectory, config.law(), metrics, args.out)
+        plots.write_figures(trajectory, config.law(), metrics, args.out, config.obstacles)
     print(f'formation_sim: {integrator}, {duration:g} s simulated in {progress.elapsed:.1f} s')
     print(format_summary(metrics, args.out))
     return 0
@@ -269,7 +269,8 @@ def run_engine_command(args: argparse.Namespace, config: FormationConfig,
         binary.write(stats_text(run.stats.record()))
     if not args.no_plots:
         from formation_ros.figures import plots
-        plots.write_figures(run.trajectory, config.law(), metrics, args.out)
+        plots.write_figures(run.trajectory, config.law(), metrics, args.out,
+                            config.obstacles)
     simulated = duration if run.failure is None else float(run.trajectory.t[-1])
     print(f'formation_sim: {integrator}, {simulated:g} s simulated in {progress.elapsed:.1f} s')
     print(format_summary(metrics, args.out))

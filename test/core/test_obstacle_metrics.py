@@ -6,6 +6,7 @@
 import math
 
 from formation_ros.core.maths.obstacles import Obstacles
+from formation_ros.core.runs import obstacle_metrics as obstacle_metrics_module
 from formation_ros.core.runs.obstacle_metrics import obstacle_metrics, stuck_robots
 import numpy as np
 import pytest
@@ -41,10 +42,19 @@ def test_each_stretch_in_contact_counts_once():
     assert obstacle_metrics(passing(np.zeros(3), 0.0), PILLAR)['obstacle_contacts'] == 1
 
 
+def test_blocks_of_samples_give_the_numbers_of_the_whole(monkeypatch):
+    xs = np.concatenate([np.linspace(-3.0, 3.0, 61), np.linspace(3.0, -3.0, 61)])
+    q = passing(xs, 0.5)
+    whole = obstacle_metrics(q, PILLAR)
+    monkeypatch.setattr(obstacle_metrics_module, 'BLOCK_DISTANCES', 3)
+    assert obstacle_metrics(q, PILLAR) == whole
+
+
 def test_no_obstacles_no_clearance():
     none = Obstacles([], [], [], 0.5, 2)
-    assert obstacle_metrics(passing(np.zeros(3), 0.0), none) == {
-        'min_obstacle_clearance': None, 'obstacle_contacts': 0}
+    for nothing in (none, None):
+        assert obstacle_metrics(passing(np.zeros(3), 0.0), nothing) == {
+            'min_obstacle_clearance': None, 'obstacle_contacts': 0}
 
 
 def test_a_robot_still_and_far_from_its_place_is_named_with_its_nearest_obstacle():
@@ -57,9 +67,15 @@ def test_a_robot_still_and_far_from_its_place_is_named_with_its_nearest_obstacle
     assert stuck[0].error == pytest.approx(3.2) and stuck[0].nearest == 0
     assert stuck[0].gap == pytest.approx(0.2)
     assert stuck[0].line() == ('robot 1 stuck at (-1.2, 0), 3.2 m from its place; nearest '
-                               'obstacle 1, 0.2 m away')
+                               'circle 1, 0.2 m away')
+    assert stuck[0].record() == {'robot': 1, 'position': [-1.2, 0.0],
+                                 'error': pytest.approx(3.2), 'nearest_obstacle': 'circle 1',
+                                 'obstacle_gap': pytest.approx(0.2)}
+    body = stuck_robots(t, q, q_desired, PILLAR, bodies=q - [0.1, 0.0], body_radius=0.05)[0]
+    assert body.position == pytest.approx([-1.3, 0.0]) and body.gap == pytest.approx(0.25)
     alone = stuck_robots(t, q, q_desired)[0]
     assert alone.line() == 'robot 1 stuck at (-1.2, 0), 3.2 m from its place'
+    assert alone.record()['nearest_obstacle'] is None and alone.record()['obstacle_gap'] is None
 
 
 def test_a_robot_still_moving_or_at_its_place_or_a_short_run_is_not_stuck():
@@ -70,3 +86,11 @@ def test_a_robot_still_moving_or_at_its_place_or_a_short_run_is_not_stuck():
     arrived = np.tile([[2.0, 0.0], [10.0, 10.0]], (len(t), 1, 1))
     assert stuck_robots(t, arrived, q_desired, PILLAR) == []
     assert stuck_robots(t[:10], arrived[:10] + 5.0, q_desired[:10], PILLAR) == []
+
+
+def test_a_robot_trembling_on_the_spot_is_stuck():
+    t = np.linspace(0.0, 20.0, 2001)
+    xs = -1.2 + 0.01 * np.where(np.arange(len(t)) % 2, 1.0, -1.0)  # 2 m/s back and forth
+    q = passing(xs, 0.0)
+    q_desired = np.tile([[2.0, 0.0], [10.0, 10.0]], (len(t), 1, 1))
+    assert [s.robot for s in stuck_robots(t, q, q_desired, PILLAR)] == [0]

@@ -11,7 +11,7 @@ s, q and q_desired (T, N, dim) in m; positions are the bodies' (a unicycle's axl
 
 from dataclasses import dataclass
 import math
-from typing import Any, Dict, List, Optional
+from typing import Any, Dict, Iterator, List, Mapping, Optional, Sequence
 
 from formation_ros.core.maths.obstacles import Obstacles
 from formation_ros.core.runs.metrics import formation_errors, SETTLE_TOLERANCE
@@ -21,7 +21,17 @@ from numpy.typing import ArrayLike, NDArray
 STILL_TIME = 5.0
 """Seconds at the end of a run over which a stuck robot has hardly moved."""
 STILL_SPEED = 0.01
-"""m/s: a robot whose mean speed over :data:`STILL_TIME` is below this has hardly moved."""
+"""m/s: a robot that stayed within this times :data:`STILL_TIME` of where it ended has hardly
+moved."""
+BLOCK_DISTANCES = 2_000_000
+"""Robot-obstacle distances measured at once by :func:`obstacle_metrics` (about 50 MB)."""
+
+
+def _blocks(steps: int, robots: int, count: int) -> Iterator[slice]:
+    """Slices of samples holding at most :data:`BLOCK_DISTANCES` robot-obstacle distances."""
+    size = max(1, BLOCK_DISTANCES // max(1, robots * count))
+    for first in range(0, steps, size):
+        yield slice(first, min(first + size, steps))
 
 
 def obstacle_clearances(q: ArrayLike, obstacles: Obstacles,
@@ -39,21 +49,31 @@ def obstacle_clearances(q: ArrayLike, obstacles: Obstacles,
     return gaps
 
 
-def obstacle_metrics(q: ArrayLike, obstacles: Obstacles,
+def obstacle_metrics(q: ArrayLike, obstacles: Optional[Obstacles],
                      body_radius: float = 0.0) -> Dict[str, Any]:
     """
     Return metrics.json's obstacle keys of a run.
 
     ``min_obstacle_clearance``: the smallest gap of any body to any obstacle's surface over the
     samples, m, footprint subtracted (None without obstacles); ``obstacle_contacts``: the
-    contacts, each robot-obstacle pair counted once per stretch of samples in contact.
+    contacts, each robot-obstacle pair counted once per stretch of samples in contact. The
+    samples are measured a block at a time (:data:`BLOCK_DISTANCES`), so a long run of a large
+    team needs no (T, N, M) array.
     """
-    if obstacles.count == 0:
+    if obstacles is None or obstacles.count == 0:
         return {'min_obstacle_clearance': None, 'obstacle_contacts': 0}
-    gaps = obstacle_clearances(q, obstacles, body_radius)
-    touching = gaps <= 0.0
-    starts = touching[0].sum() + np.count_nonzero(touching[1:] & ~touching[:-1])
-    return {'min_obstacle_clearance': float(gaps.min()), 'obstacle_contacts': int(starts)}
+    q = np.asarray(q, dtype=float)
+    smallest, starts = math.inf, 0
+    before: Optional[NDArray[np.bool_]] = None
+    for block in _blocks(len(q), q.shape[1], obstacles.count):
+        gaps = obstacle_clearances(q[block], obstacles, body_radius)
+        smallest = min(smallest, float(gaps.min()))
+        touching = gaps <= 0.0
+        earlier = (np.zeros_like(touching[0]) if before is None else before)
+        starts += int(np.count_nonzero(touching[0] & ~earlier))
+        starts += int(np.count_nonzero(touching[1:] & ~touching[:-1]))
+        before = touching[-1]
+    return {'min_obstacle_clearance': smallest, 'obstacle_contacts': starts}
 
 
 @dataclass(frozen=True)
@@ -61,9 +81,11 @@ class Stuck:
     """
     A robot that ended far from its place, hardly moving.
 
-    robot: its 0-based index; position: (dim,) where it ended, m; error: its distance from its
-    place there, m; nearest: the 0-based index of the obstacle nearest to it (None without
-    obstacles) and gap: the distance to that obstacle's surface, m.
+    robot: its 0-based index; position: (dim,) where it ended (its body: a unicycle's axle
+    centre), m; error: its control point's distance from its place there, m; nearest: the
+    0-based index of the obstacle nearest to it (None without obstacles), obstacle: that
+    obstacle's name (``Obstacles.labels``) and gap: the distance from its footprint to that
+    obstacle's surface, m (inf without obstacles).
     """
 
     robot: int
@@ -71,41 +93,66 @@ class Stuck:
     error: float
     nearest: Optional[int]
     gap: float
+    obstacle: Optional[str] = None
 
     def line(self) -> str:
         """Say in one line which robot is stuck, where, and what is nearest."""
-        where = ', '.join(f'{value:.3g}' for value in self.position)
-        text = f'robot {self.robot + 1} stuck at ({where}), {self.error:.3g} m from its place'
-        if self.nearest is None:
-            return text
-        return f'{text}; nearest obstacle {self.nearest + 1}, {self.gap:.3g} m away'
+        record = self.record()
+        if self.nearest is not None and self.obstacle is None:
+            record['nearest_obstacle'] = f'obstacle {self.nearest + 1}'
+        return stuck_line(record)
+
+    def record(self) -> Dict[str, Any]:
+        """Return the robot as metrics.json keeps it (robot numbered from 1)."""
+        return {'robot': self.robot + 1, 'position': [float(x) for x in self.position],
+                'error': self.error, 'nearest_obstacle': self.obstacle,
+                'obstacle_gap': None if math.isinf(self.gap) else self.gap}
+
+
+def stuck_line(record: Mapping[str, Any]) -> str:
+    """Return :meth:`Stuck.line` of a robot as :meth:`Stuck.record` keeps it."""
+    name, gap = record.get('nearest_obstacle'), record.get('obstacle_gap')
+    where = ', '.join(f'{float(value):.3g}' for value in record['position'])
+    text = (f"robot {record['robot']} stuck at ({where}), {float(record['error']):.3g} m from "
+            'its place')
+    if name is None:
+        return text
+    distance = 'at an unknown distance' if gap is None else f'{float(gap):.3g} m away'
+    return f'{text}; nearest {name}, {distance}'
 
 
 def stuck_robots(t: ArrayLike, q: ArrayLike, q_desired: ArrayLike,
                  obstacles: Optional[Obstacles] = None,
                  tolerance: float = SETTLE_TOLERANCE, still_time: float = STILL_TIME,
-                 still_speed: float = STILL_SPEED) -> List[Stuck]:
+                 still_speed: float = STILL_SPEED, bodies: Optional[ArrayLike] = None,
+                 body_radius: float = 0.0) -> List[Stuck]:
     """
     Return the robots stuck at the end of a run, in index order.
 
-    A robot is stuck when it ends farther than ``tolerance`` (m) from its place and its path
-    over the last ``still_time`` seconds is shorter than ``still_speed * still_time``. A run
-    shorter than ``still_time`` has none.
+    A robot is stuck when its control point ``q`` ends farther than ``tolerance`` (m) from its
+    place ``q_desired`` and stayed within ``still_speed * still_time`` of where it ended over
+    the last ``still_time`` seconds (a robot pressed against an obstacle may tremble on the
+    spot, which a path length would count as moving). A run shorter than ``still_time`` has
+    none. bodies: (T, N, dim) the bodies' positions when they are not the control points
+    (unicycles' axle centres), whose footprint ``body_radius`` (m) is measured to the nearest
+    obstacle.
     """
     times = np.asarray(t, dtype=float)
     q = np.asarray(q, dtype=float)
     if len(times) < 2 or times[-1] - times[0] < still_time:
         return []
     window = times >= times[-1] - still_time
-    steps = np.diff(q[window], axis=0)
-    paths = np.sqrt(np.einsum('tnd,tnd->tn', steps, steps)).sum(axis=0)
+    wander = formation_errors(q[window], q[-1][None]).max(axis=0)
     errors = formation_errors(q[-1], np.asarray(q_desired, dtype=float)[-1])
-    found = np.nonzero((errors > tolerance) & (paths < still_speed * still_time))[0]
-    gaps = (obstacle_clearances(q[-1:], obstacles)[0] if obstacles and obstacles.count
-            else None)
+    found = np.nonzero((errors > tolerance) & (wander < still_speed * still_time))[0]
+    places = q[-1] if bodies is None else np.asarray(bodies, dtype=float)[-1]
+    gaps = (obstacle_clearances(places[None], obstacles, body_radius)[0]
+            if obstacles is not None and obstacles.count and len(found) else None)
+    labels: Sequence[str] = obstacles.labels() if obstacles is not None else ()
     stuck = []
     for robot in found.tolist():
         nearest = None if gaps is None else int(np.argmin(gaps[robot]))
         gap = math.inf if gaps is None or nearest is None else float(gaps[robot, nearest])
-        stuck.append(Stuck(robot, q[-1, robot].copy(), float(errors[robot]), nearest, gap))
+        stuck.append(Stuck(robot, places[robot].copy(), float(errors[robot]), nearest, gap,
+                           None if nearest is None else labels[nearest]))
     return stuck
