@@ -9,7 +9,7 @@ import os
 from formation_ros.core.runs.obstacle_metrics import obstacle_metrics
 from formation_ros.core.settings.params import load_config, validate
 from formation_ros.core.settings.params_file import load_params_file
-from formation_ros.simulation.simulate import run_metrics, simulate
+from formation_ros.simulation.simulate import Progress, run_fixed_step, run_metrics, simulate
 from formation_ros.tools import report, sim
 import numpy as np
 import pytest
@@ -149,3 +149,17 @@ def test_rk45_does_not_step_over_a_thin_wall():
     metrics = obstacle_metrics(trajectory.q, config.obstacles)
     assert metrics['obstacle_contacts'] == 0 and metrics['min_obstacle_clearance'] > 0.0
     assert np.all(trajectory.q[-1, :, 0] < 5.0)  # held on their side, behind their places
+
+
+def test_the_plant_model_keeps_the_guarded_feed_forward_it_audits():
+    """Dragged at 4 m/s (> c M1) into a wall, stepped as the plant steps: no contact, no excess."""
+    config = validate({**BEHIND_A_WALL, 'formation.vertices': [0.0, 0.0, 0.0, 10.0],
+                       'start.positions': [0.0, 0.0, 0.0, 10.0], 'reference.kind': 'line',
+                       'reference.velocity': [4.0, 0.0], 'duration': 3.0,
+                       'obstacles.walls': [5.0, -20.0, 5.0, 20.0, 0.2],
+                       'obstacles.clearance': 1.0})
+    run = run_fixed_step(config, 3.0, 1e-3, 0.01, Progress(3.0, quiet=True))
+    metrics = obstacle_metrics(run.trajectory.q, config.obstacles)
+    assert metrics['obstacle_contacts'] == 0 and metrics['min_obstacle_clearance'] > 0.0
+    assert np.all(run.trajectory.q[-1, :, 0] < 5.0)
+    assert run.largest_u_hat <= config.law().u_bound + 1e-9

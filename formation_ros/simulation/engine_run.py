@@ -25,6 +25,7 @@ from typing import Any, Dict, List, Optional
 
 from formation_ros.core.maths.frames import FrameSample
 from formation_ros.core.maths.law import team_command
+from formation_ros.core.maths.obstacle_tracking import tracking_command
 from formation_ros.core.model.bodies import make_bodies
 from formation_ros.core.runs.output import finite_record
 from formation_ros.core.runs.timeline import Shape, Timeline
@@ -111,8 +112,9 @@ def run_on_engine(config: FormationConfig, duration: float, control_dt: float,
         points = bodies.control_points(measured.positions[:, :dim], heading)
         frame = reference.sample(t)
         vertices = shapes.at(engine.time_ns).vertices
-        u = team_command(points, vertices, config.sensing_radii, law, frame,
-                         obstacles=obstacles).u
+        u = tracking_command(team_command(points, vertices, config.sensing_radii, law, frame,
+                                          obstacles=obstacles),
+                             points, frame, law, obstacles, config.sensing_radii).u
         command = bodies.body_command(u, heading)
         if k % stride == 0 or k == controls:
             truth = engine.poses()
@@ -134,7 +136,8 @@ def run_on_engine(config: FormationConfig, duration: float, control_dt: float,
         except Unstable as exc:
             failure = unstable_line(exc, engine.world, config.body.is_unicycle)
             break
-    trajectory = Trajectory.from_frames(times, points_kept, applied, frames, vertices_kept)
+    trajectory = Trajectory.from_frames(times, points_kept, applied, frames, vertices_kept,
+                                        config.feed_forward_guard())
     if bodies.has_heading:
         trajectory = replace(trajectory, heading=np.array(headings), q_body=np.array(q_body),
                              body_command=np.array(held))

@@ -381,10 +381,11 @@ def run_fixed_step(config: FormationConfig, duration: float, dt: float, sample_d
     model = PlantModel(config.start, config.sensing_radii, step_ns, law, reference,
                        input_timeout_ns=step_ns + delay_ns, collision_distance=collision_distance,
                        bodies=bodies, headings=config.start_headings,
-                       pair_radius=law.repulsion_radius, imperfections=imperfections)
+                       pair_radius=law.repulsion_radius, imperfections=imperfections,
+                       obstacles=config.law_obstacles())
     commands = Commands.empty(config.num_robots, bodies.command_width(config.dim))
     shapes = shapes_of(config)
-    obstacles = config.law_obstacles()
+    obstacles = model.obstacles
     steps = int(round(duration / dt))
     stride = max(1, int(round(sample_dt / dt)))
     largest_u_hat = 0.0
@@ -425,7 +426,8 @@ def run_fixed_step(config: FormationConfig, duration: float, dt: float, sample_d
             q_body.append(report.q)
             held.append(report.admission.u)
     trajectory = Trajectory.from_frames(times, states, applied, frames,
-                                        [vertices_at(shapes, t) for t in times])
+                                        [vertices_at(shapes, t) for t in times],
+                                        config.feed_forward_guard())
     if bodies.has_heading:
         trajectory = replace(trajectory, heading=np.array(headings), q_body=np.array(q_body),
                              body_command=np.array(held))

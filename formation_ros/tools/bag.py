@@ -534,8 +534,9 @@ def trajectory_from_topics(recorded: Recorded,
     if other_frame:
         info['poses_in_another_frame'] = other_frame
     t = np.array(stamps) / NS_PER_S
+    guard = config.feed_forward_guard()
     if not oriented:
-        return Trajectory.from_frames(t, q, held, frames, vertices), info
+        return Trajectory.from_frames(t, q, held, frames, vertices, guard), info
     l_value = config.body.hand_distance
     sampled = np.array([[orientations[(i, stamp)] for i in range(1, n + 1)]
                         for stamp in stamps])
@@ -545,10 +546,12 @@ def trajectory_from_topics(recorded: Recorded,
     u_held = commanded_velocity(held.reshape(-1, width), sampled.reshape(-1, 4), unicycles,
                                 l_value, body_frame).reshape(shape)
     if not unicycles:
-        return Trajectory.from_frames(t, q, u, frames, vertices).with_held(u_held, frames), info
+        return (Trajectory.from_frames(t, q, u, frames, vertices, guard)
+                .with_held(u_held, frames, guard), info)
     heading = headings_from_quaternions(sampled)
     points = UnicycleBodies(l_value).control_points(q, heading)
-    trajectory = Trajectory.from_frames(t, points, u, frames, vertices).with_held(u_held, frames)
+    trajectory = Trajectory.from_frames(t, points, u, frames, vertices, guard).with_held(
+        u_held, frames, guard)
     return replace(trajectory, heading=heading, q_body=q, body_command=held), info
 
 

@@ -115,7 +115,8 @@ def _load_chunks(path: str, params: str, chunks: str, notes: Optional[List[str]]
         config = load_config(params)
         trajectory = trajectory_from_chunks(
             chunks, config.reference().sample, FixedShape(config.vertices),
-            config.body.is_unicycle, (config.num_robots, config.dim))
+            config.body.is_unicycle, (config.num_robots, config.dim),
+            config.feed_forward_guard())
     except ParamError as exc:
         raise ReportError(_param_problem(exc)) from None
     except ChunkShapeError as exc:

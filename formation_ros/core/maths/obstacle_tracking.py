@@ -23,7 +23,7 @@ within c M1 (eq. 14). Everywhere else (no obstacle within b_o, f_i along or away
 repulsion, a fixed reference) the command is eq. (25)'s.
 """
 
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import Optional
 
 from formation_ros.core.maths.frames import FrameSample, from_frame_velocity
@@ -117,3 +117,30 @@ def tracking_command(command: Command, q: ArrayLike, frame: Optional[FrameSample
     """
     change = feed_forward_change(q, frame, law, obstacles, sensing_radii)
     return command if change is None else replace(command, u=command.u + change)
+
+
+@dataclass(frozen=True)
+class FeedForwardGuard:
+    """
+    The rule as whoever reads commands back needs it: the law, the obstacles, the radii.
+
+    law: the constants of eq. (14); obstacles: as the law sees them (grown by the footprint);
+    sensing_radii: (N,) R_i, m. A command of eq. (25) under the rule is ``u = J^T u_hat + f_i +
+    change``: inverting eq. (25) for u_hat takes :meth:`change` off first.
+    """
+
+    law: LawParams
+    obstacles: Obstacles
+    sensing_radii: NDArray[np.float64]
+
+    def change(self, q: ArrayLike, frame: Optional[FrameSample]
+               ) -> Optional[NDArray[np.float64]]:
+        """Return :func:`feed_forward_change` at q (N, dim) in ``frame``, or None."""
+        return feed_forward_change(q, frame, self.law, self.obstacles, self.sensing_radii)
+
+    def sent(self, u: ArrayLike, q: ArrayLike, frame: Optional[FrameSample]
+             ) -> NDArray[np.float64]:
+        """Return eq. (25)'s own part of commands u (N, dim) at q: u less :meth:`change`."""
+        change = self.change(q, frame)
+        own: NDArray[np.float64] = np.asarray(u, dtype=float)
+        return own if change is None else own - change

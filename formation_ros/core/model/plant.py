@@ -23,6 +23,8 @@ from typing import Dict, List, Optional, Set, Tuple, TYPE_CHECKING
 
 from formation_ros.core.maths.frames import from_frame_velocity, to_frame_velocity
 from formation_ros.core.maths.law import LawParams
+from formation_ros.core.maths.obstacle_tracking import feed_forward_change
+from formation_ros.core.maths.obstacles import Obstacles
 from formation_ros.core.maths.pairs import pairs_within, row_differences, squared_norms
 from formation_ros.core.maths.reference import Reference
 from formation_ros.core.maths.sensing import neighbour_lists, sensed_pairs, sensor_radii
@@ -336,7 +338,8 @@ class PlantModel:
                  law: LawParams, reference: Reference, input_timeout_ns: int,
                  collision_distance: float, max_speed: float = 0.0,
                  bodies: Optional[Bodies] = None, headings: Optional[ArrayLike] = None,
-                 pair_radius: float = 0.0, imperfections: Imperfections = IDEAL):
+                 pair_radius: float = 0.0, imperfections: Imperfections = IDEAL,
+                 obstacles: Optional[Obstacles] = None):
         """Place the robots at ``start`` (and ``headings``) at time 0."""
         self.body: Bodies = PointBodies(max_speed) if bodies is None else bodies
         self.q = np.array(start, dtype=float)
@@ -349,6 +352,7 @@ class PlantModel:
         self.step_ns = int(step_ns)
         self.law = law
         self.reference = reference
+        self.obstacles = obstacles
         self.input_timeout_ns = int(input_timeout_ns)
         self.collision_distance = float(collision_distance)
         self.contact_distance = max(self.collision_distance, self.body.contact_distance)
@@ -523,13 +527,18 @@ class PlantModel:
                 rows = counted & (stamps == stamp)
                 state = self._state_at(int(stamp))[rows]
                 frame = self.reference.sample(int(stamp) / NS_PER_S)
-                u_hat = to_frame_velocity(u[rows], state, frame)
+                change = feed_forward_change(state, frame, self.law, self.obstacles,
+                                             self.radii[rows])
+                sent = u[rows] if change is None else u[rows] - change
+                u_hat = to_frame_velocity(sent, state, frame)
                 largest[rows] = np.max(np.abs(u_hat), axis=1)
                 clip = largest[rows] > limit
                 if np.any(clip):
                     index = np.flatnonzero(rows)[clip]
                     clipped[index] = from_frame_velocity(np.clip(u_hat[clip], -bound, bound),
                                                          state[clip], frame)
+                    if change is not None:
+                        clipped[index] += change[clip]
                     over[index] = True
         return clipped, over, largest
 

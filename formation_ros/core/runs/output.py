@@ -22,6 +22,7 @@ import shutil
 from typing import Any, Callable, Dict, Mapping, Optional, Tuple
 
 from formation_ros.core.maths.frames import FrameSample
+from formation_ros.core.maths.obstacle_tracking import FeedForwardGuard
 from formation_ros.core.maths.units import NS_PER_S
 from formation_ros.core.runs.trajectory import (CHUNKS_DIR, ChunkWriter, read_body_chunks,
                                                 read_chunks, read_held_chunks, save_atomically,
@@ -61,7 +62,8 @@ class FixedShape:
 
 
 def trajectory_from_chunks(folder: str, frame_at: FrameAt, shape_at: ShapeAt, bodies: bool,
-                           robots: Optional[Tuple[int, int]] = None) -> Trajectory:
+                           robots: Optional[Tuple[int, int]] = None,
+                           guard: Optional[FeedForwardGuard] = None) -> Trajectory:
     """
     Return the run a :class:`~formation_ros.core.runs.trajectory.ChunkWriter` wrote to ``folder``.
 
@@ -69,7 +71,8 @@ def trajectory_from_chunks(folder: str, frame_at: FrameAt, shape_at: ShapeAt, bo
     m; bodies: read the unicycles' heading, axle centres and (v, w) too; robots: the (N, dim)
     the chunks must hold, else :class:`ChunkShapeError`. A command held beside the one sent
     (u_held, written by a world) is read back with its formation-frame u_hat_held. ValueError
-    when the folder holds no readable chunk.
+    when the folder holds no readable chunk. guard: the obstacles' feed-forward rule the
+    commands were given under (``Trajectory.from_frames``), or None.
     """
     t, q, u = read_chunks(folder)
     if robots is not None and q.shape[1:] != tuple(robots):
@@ -77,12 +80,12 @@ def trajectory_from_chunks(folder: str, frame_at: FrameAt, shape_at: ShapeAt, bo
     frames = [frame_at(time_s) for time_s in t]
     shapes = (shape_at.vertices if isinstance(shape_at, FixedShape) else
               [np.asarray(shape_at(int(round(time_s * NS_PER_S))), dtype=float) for time_s in t])
-    trajectory = Trajectory.from_frames(t, q, u, frames, shapes)
+    trajectory = Trajectory.from_frames(t, q, u, frames, shapes, guard)
     body = read_body_chunks(folder) if bodies else None
     if body is not None:
         trajectory = replace(trajectory, **body)
     held = read_held_chunks(folder)
-    return trajectory if held is None else trajectory.with_held(held, frames)
+    return trajectory if held is None else trajectory.with_held(held, frames, guard)
 
 
 def stats_text(record: Mapping[str, Any]) -> bytes:
@@ -114,11 +117,18 @@ class RunOutput:
     stops the output (:attr:`failure`); what was written is kept.
     """
 
-    def __init__(self, output_dir: str, who: str, goes_on: str) -> None:
-        """Write into ``output_dir`` once :meth:`start` made its chunk folder."""
+    def __init__(self, output_dir: str, who: str, goes_on: str,
+                 guard: Optional[FeedForwardGuard] = None) -> None:
+        """
+        Write into ``output_dir`` once :meth:`start` made its chunk folder.
+
+        guard: the obstacles' feed-forward rule the commands were given under, taken off when
+        u_hat is read back (``FormationConfig.feed_forward_guard``; None without obstacles).
+        """
         self.output_dir = output_dir
         self.who = who
         self.goes_on = goes_on
+        self.guard = guard
         self.chunks: Optional[ChunkWriter] = None
         self.failure: Optional[str] = None
         """Why the output stopped: 'cannot write to WHERE (REASON)'; None while it runs."""
@@ -190,7 +200,8 @@ class RunOutput:
         if self.chunks is None:
             return None
         try:
-            return trajectory_from_chunks(self.chunks.folder, frame_at, shape_at, bodies)
+            return trajectory_from_chunks(self.chunks.folder, frame_at, shape_at, bodies,
+                                          guard=self.guard)
         except ValueError:
             return None
 

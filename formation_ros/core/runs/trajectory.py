@@ -8,6 +8,7 @@ import os
 from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 from formation_ros.core.maths.frames import desired_positions, FrameSample, to_frame_velocity
+from formation_ros.core.maths.obstacle_tracking import FeedForwardGuard
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -80,32 +81,36 @@ class Trajectory:
 
     @classmethod
     def from_frames(cls, t: ArrayLike, q: ArrayLike, u: ArrayLike,
-                    frames: Sequence[FrameSample], vertices: ArrayLike) -> 'Trajectory':
+                    frames: Sequence[FrameSample], vertices: ArrayLike,
+                    guard: Optional[FeedForwardGuard] = None) -> 'Trajectory':
         """
         Build a trajectory from states and commands and the reference frame of each sample.
 
         t: (T,) s; q, u: (T, N, dim); frames: T FrameSamples; vertices: (N, dim), or (T, N,
         dim) for a shape that changes (the shape in force at each sample). u_hat comes from
-        inverting eq. (25), desired positions from eq. (20).
+        inverting eq. (25) (the obstacles' rule ``guard`` taken off first, if given), desired
+        positions from eq. (20).
         """
         q = np.asarray(q, dtype=float)
         u = np.asarray(u, dtype=float)
         shapes = np.asarray(vertices, dtype=float)
         per_sample = shapes if shapes.ndim == 3 else [shapes] * len(frames)
         return cls(t=np.asarray(t, dtype=float), q=q, u=u,
-                   u_hat=frame_velocities(u, q, frames),
+                   u_hat=frame_velocities(u, q, frames, guard),
                    q_desired=np.array([desired_positions(v, f)
                                        for v, f in zip(per_sample, frames)]),
                    q_od=np.array([f.q_od for f in frames]))
 
-    def with_held(self, u_held: ArrayLike, frames: Sequence[FrameSample]) -> 'Trajectory':
+    def with_held(self, u_held: ArrayLike, frames: Sequence[FrameSample],
+                  guard: Optional[FeedForwardGuard] = None) -> 'Trajectory':
         """
         Return a copy with u_held (T, N, dim) m/s and its u_hat_held (eq. 25 inverted at q).
 
         frames: the T reference samples the trajectory was built with (:meth:`from_frames`).
         """
         held = np.array(u_held, dtype=float)
-        return replace(self, u_held=held, u_hat_held=frame_velocities(held, self.q, frames))
+        return replace(self, u_held=held,
+                       u_hat_held=frame_velocities(held, self.q, frames, guard))
 
     @classmethod
     def load(cls, path: str) -> 'Trajectory':
@@ -120,10 +125,16 @@ class Trajectory:
                           if name in data})
 
 
-def frame_velocities(u: ArrayLike, q: ArrayLike,
-                     frames: Sequence[FrameSample]) -> NDArray[np.float64]:
-    """Return u (T, N, dim) m/s in the formation frame of each sample, eq. (25) inverted."""
-    return np.array([to_frame_velocity(u_k, q_k, f)
+def frame_velocities(u: ArrayLike, q: ArrayLike, frames: Sequence[FrameSample],
+                     guard: Optional[FeedForwardGuard] = None) -> NDArray[np.float64]:
+    """
+    Return u (T, N, dim) m/s in the formation frame of each sample, eq. (25) inverted.
+
+    guard: the obstacles' feed-forward rule the commands were given under
+    (``core.maths.obstacle_tracking``), taken off before the inversion; None: none.
+    """
+    return np.array([to_frame_velocity(u_k if guard is None else guard.sent(u_k, q_k, f),
+                                       q_k, f)
                      for u_k, q_k, f in zip(np.asarray(u, dtype=float),
                                             np.asarray(q, dtype=float), frames)])
 

@@ -22,6 +22,7 @@ from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 from formation_ros.core.maths.frames import desired_positions, from_frame_velocity
 from formation_ros.core.maths.jump import JumpKind
 from formation_ros.core.maths.law import LawParams, make_law, PSI_FUNCTIONS, PsiKind
+from formation_ros.core.maths.obstacle_tracking import FeedForwardGuard
 from formation_ros.core.maths.obstacles import Obstacles
 from formation_ros.core.maths.pairs import closest_pair
 from formation_ros.core.maths.reference import dimension_problem, PERIODIC, Reference
@@ -366,6 +367,19 @@ class FormationConfig:
         if self.obstacles is None:
             return None
         return self.obstacles.grown(self.body.footprint)
+
+    def feed_forward_guard(self) -> Optional[FeedForwardGuard]:
+        """
+        Return the obstacles' feed-forward rule the robots' commands are given under, or None.
+
+        With obstacles, a moving reference's feed-forward near them is guarded
+        (``core.maths.obstacle_tracking``): whoever reads u_hat back from a command takes that
+        change off first. None without obstacles.
+        """
+        obstacles = self.law_obstacles()
+        if obstacles is None:
+            return None
+        return FeedForwardGuard(self.law(), obstacles, self.sensing_radii)
 
     def reference(self) -> Reference:
         """Build the moving desired trajectory (``core.maths.reference.Reference``)."""
