@@ -19,6 +19,9 @@ from formation_ros.core.settings.names import robot_name
 
 POSE = 'pose'
 NEIGHBOURS = 'neighbors'
+OBSTACLES = 'obstacles'
+"""Robot i's obstacles, ``/robot_<i>/obstacles``: a PoseArray sent with each pose by the plant and
+the relay when the map has obstacles (docs/ros_interface.md, "Obstacles")."""
 CMD_VEL = 'cmd_vel'
 REFERENCE = '/formation/reference'
 CLOCK = '/clock'
@@ -33,6 +36,9 @@ STATES = '/formation/states'
 """Team transport: every robot's pose in one PoseArray per state (``core.rules.transport``)."""
 TEAM_COMMANDS = '/formation/commands'
 """Team transport: one MultiDOFJointTrajectory per robot process or fleet per state."""
+TEAM_OBSTACLES = '/formation/obstacles'
+"""Team transport with obstacles: every robot's obstacles of a state, one MultiDOFJointTrajectory
+(``ros.cdr.encode_team_obstacles``), sent before the state."""
 MEASURED_POSE = 'measured_pose'
 """The world's ground truth of robot i, ``/robot_<i>/measured_pose`` (the relay's default
 source, ``relay.source_topic``): what a motion-capture driver gives a lab."""

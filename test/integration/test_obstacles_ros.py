@@ -1,0 +1,87 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+Obstacles through ROS: the plant tells each robot its obstacles, the robots go round them.
+
+A pillar stands between robot 1's start and its place; robot 4 senses only 0.6 m and is never
+that near; a second pillar is far from everyone. Over real DDS, every ``obstacles`` message is
+checked against the one rule (``told_obstacles`` of the pose with its stamp), the commands
+against c M1, and the plant's own count of contacts.
+"""
+
+import json
+
+from formation_ros.core.maths.obstacles import quaternion_normals, told_obstacles
+from formation_ros.core.settings.params import load_config
+from formation_ros.ros import fields, qos
+from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
+from helpers import launch, logged, stop_when, write_params
+import numpy as np
+
+PILLARS = {
+    'start.positions': [-1.3, -1.1, 0.0, 1.6, -1.6, 0.0, 1.6, 0.0],
+    'start.random_radius': None, 'start.min_separation': None,
+    'repulsion_radius': 0.5, 'sensing_radii': [2.0, 2.0, 2.0, 0.6],
+    'obstacles.circles': [0.0, 0.0, 0.3, 10.0, 0.0, 0.5], 'obstacles.clearance': 0.4,
+    'plant.lockstep': True, 'plant.realtime_factor': 2.0,
+}
+
+
+def test_robots_go_round_a_pillar_they_are_told_of(processes, install, probe, tmp_path):
+    params = write_params(tmp_path, 'square_4.yaml', PILLARS)
+    config = load_config(params, 'plant')
+    bound = config.law().u_bound
+    told, poses, commands = {1: {}, 4: {}}, {1: {}, 4: {}}, []
+    for i in (1, 4):
+        probe.create_subscription(
+            PoseArray, f'/robot_{i}/obstacles',
+            lambda m, i=i: told[i].setdefault(fields.stamp_to_ns(m.header.stamp), m),
+            qos.recording(qos.STATE))
+        probe.create_subscription(
+            PoseStamped, f'/robot_{i}/pose',
+            lambda m, i=i: poses[i].setdefault(fields.stamp_to_ns(m.header.stamp), m),
+            qos.recording(qos.STATE))
+    for i in range(1, 5):
+        probe.create_subscription(
+            TwistStamped, f'/robot_{i}/cmd_vel',
+            lambda m: commands.append((m.twist.linear.x, m.twist.linear.y)), qos.COMMAND)
+    out = tmp_path / 'out'
+    launch(processes, install, params, out=out, per_process=4)
+
+    def arrived():
+        if not poses[1]:
+            return False
+        last = poses[1][max(poses[1])].pose.position
+        return np.hypot(last.x - 1.0, last.y - 1.0) < 0.05
+
+    info = stop_when(probe, processes, arrived, timeout=240)
+    assert info.returncode == 0, processes.log('launcher')
+    log = logged(probe, processes, 'launcher', 'obstacle contacts')
+    assert '0 obstacle contacts' in log, log[-3000:]
+
+    stats = json.loads((out / 'plant_stats.json').read_text())
+    assert stats['obstacle_contacts'] == 0 and stats['min_obstacle_gap'] > 0.0, stats
+    assert commands and np.max(np.abs(commands)) <= bound + 1e-9
+    passed = [m.pose.position for m in poses[1].values()]
+    assert min(np.hypot(p.x, p.y) for p in passed) > 0.3, 'robot 1 went round, not through'
+    assert max(p.x for p in passed) > 0.9 and min(p.x for p in passed) < -1.0
+
+    both = [stamp for stamp in told[1] if stamp in poses[1]]
+    assert len(both) > 50, (len(told[1]), len(poses[1]))
+    near = 0
+    for stamp in both:
+        message, pose = told[1][stamp], poses[1][stamp].pose.position
+        assert message.header.frame_id == config.world_frame
+        q = np.array([[pose.x, pose.y]])
+        rule = told_obstacles(config.obstacles, q, q, config.sensing_radii[:1])
+        points = np.array([[p.position.x, p.position.y] for p in message.poses]).reshape(-1, 2)
+        assert np.array_equal(points, rule.points[0][rule.listed[0]])
+        assert len(points) == 1, 'the pillar near, never the far one'
+        assert abs(np.hypot(*points[0]) - 0.3) < 1e-12  # on the surface
+        quats = [[p.orientation.x, p.orientation.y, p.orientation.z, p.orientation.w]
+                 for p in message.poses]
+        assert np.allclose(quaternion_normals(np.array(quats), 2)[0], points[0] / 0.3)
+        near += 1
+    assert near == len(both)
+    assert told[4] and all(len(m.poses) == 0 for m in told[4].values()), 'nothing near: empty'
