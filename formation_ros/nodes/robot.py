@@ -273,16 +273,18 @@ class RobotNode(Node):
             self.answer.arm(due.after_ns / NS_PER_S)
 
     def see(self, pose: PoseData, neighbours: PoseArrayData, heard_ns: int, new: bool,
-            last: Optional[Tuple[Command, Optional[NDArray[np.float64]]]] = None) -> None:
+            last: Optional[Tuple[Command, Optional[NDArray[np.float64]]]] = None,
+            obstacles: bool = False) -> None:
         """
         Take this robot's pose and neighbours in a state its link read, heard at ``heard_ns``.
 
         new: a state to answer (the link's leader); last: the robot's latest command and its
-        published form (diagnostics), if one was computed.
+        published form (diagnostics), if one was computed; obstacles: the state's obstacles
+        came with it.
         """
         self.pose, self.neighbours = pose, neighbours
         if self.core is not None:
-            self.core.state_heard(pose.stamp_ns, heard_ns, new)
+            self.core.state_heard(pose.stamp_ns, heard_ns, new, obstacles)
         else:
             self.policy.heard(['pose', 'neighbour'], heard_ns, state=new)
         if last is not None:

@@ -7,7 +7,8 @@ Obstacles through ROS: the plant tells each robot its obstacles, the robots go r
 A pillar stands between robot 1's start and its place; robot 4 senses only 0.6 m and is never
 that near; a second pillar is far from everyone. Over real DDS, every ``obstacles`` message is
 checked against the one rule (``told_obstacles`` of the pose with its stamp), the commands
-against c M1, and the plant's own count of contacts.
+against c M1, and the plant's own count of contacts; with either transport (the team's carries
+the obstacles in ``/formation/obstacles``, a robot's own topics go while someone listens).
 """
 
 import json
@@ -18,6 +19,7 @@ from formation_ros.ros import fields, qos
 from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
 from helpers import launch, logged, stop_when, write_params
 import numpy as np
+import pytest
 
 PILLARS = {
     'start.positions': [-1.3, -1.1, 0.0, 1.6, -1.6, 0.0, 1.6, 0.0],
@@ -28,8 +30,10 @@ PILLARS = {
 }
 
 
-def test_robots_go_round_a_pillar_they_are_told_of(processes, install, probe, tmp_path):
-    params = write_params(tmp_path, 'square_4.yaml', PILLARS)
+@pytest.mark.parametrize('transport', ['robot', 'team'])
+def test_robots_go_round_a_pillar_they_are_told_of(processes, install, probe, tmp_path,
+                                                   transport):
+    params = write_params(tmp_path, 'square_4.yaml', {**PILLARS, 'transport': transport})
     config = load_config(params, 'plant')
     bound = config.law().u_bound
     told, poses, commands = {1: {}, 4: {}}, {1: {}, 4: {}}, []
@@ -45,7 +49,8 @@ def test_robots_go_round_a_pillar_they_are_told_of(processes, install, probe, tm
     for i in range(1, 5):
         probe.create_subscription(
             TwistStamped, f'/robot_{i}/cmd_vel',
-            lambda m: commands.append((m.twist.linear.x, m.twist.linear.y)), qos.COMMAND)
+            lambda m: commands.append((m.twist.linear.x, m.twist.linear.y)),
+            qos.COMMAND_INPUT)
     out = tmp_path / 'out'
     launch(processes, install, params, out=out, per_process=4)
 
