@@ -409,7 +409,7 @@ class PlantNode(Node):
         self.marker_pub.publish(formation_markers(
             self.model.q, self.config.sensing_radii, self.law.repulsion_radius, desired,
             self.paths, self.model.t_ns, self.config.world_frame,
-            self.model.heading if self.unicycles else None))
+            self.model.heading if self.unicycles else None, self.config.obstacles))
 
     def write_chunk(self) -> None:
         """Write the samples since the last chunk into ``plant.output_dir`` (a failure: once)."""
