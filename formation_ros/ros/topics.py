@@ -110,6 +110,17 @@ def team_topics() -> List[Topic]:
             Topic(TEAM_COMMANDS, 'trajectory_msgs/msg/MultiDOFJointTrajectory', QosKind.COMMAND)]
 
 
+def obstacle_topics(robot_id: int) -> List[Topic]:
+    """
+    Return the obstacle topics of robot ``robot_id`` and of the team transport.
+
+    Published by the plant and the relay only when the map has obstacles
+    (docs/ros_interface.md, "Obstacles").
+    """
+    return [Topic(robot_topic(robot_id, OBSTACLES), 'geometry_msgs/msg/PoseArray', QosKind.STATE),
+            Topic(TEAM_OBSTACLES, 'trajectory_msgs/msg/MultiDOFJointTrajectory', QosKind.STATE)]
+
+
 def world_topics(robot_id: int, wheeled: bool) -> List[Topic]:
     """
     Return what the ``world`` node publishes for robot ``robot_id``: measured pose, odometry.
