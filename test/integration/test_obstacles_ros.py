@@ -7,13 +7,16 @@ Obstacles through ROS: the plant tells each robot its obstacles, the robots go r
 A pillar stands between robot 1's start and its place; robot 4 senses only 0.6 m and is never
 that near; a second pillar is far from everyone. Over real DDS, every ``obstacles`` message is
 checked against the one rule (``told_obstacles`` of the pose with its stamp), the commands
-against c M1, and the plant's own count of contacts; with either transport (the team's carries
+against c M1, the plant's own count of contacts, and the lockstep trajectory against the law
+with the map grown by the footprint stepped offline; with either transport (the team's carries
 the obstacles in ``/formation/obstacles``, a robot's own topics go while someone listens).
 """
 
 import json
 
+from formation_ros.core.maths.law import team_command
 from formation_ros.core.maths.obstacles import quaternion_normals, told_obstacles
+from formation_ros.core.runs.trajectory import Trajectory
 from formation_ros.core.settings.params import load_config
 from formation_ros.ros import fields, qos
 from geometry_msgs.msg import PoseArray, PoseStamped, TwistStamped
@@ -90,3 +93,13 @@ def test_robots_go_round_a_pillar_they_are_told_of(processes, install, probe, tm
         near += 1
     assert near == len(both)
     assert told[4] and all(len(m.poses) == 0 for m in told[4].values()), 'nothing near: empty'
+
+    run = Trajectory.load(str(out / 'trajectory.npz'))
+    assert len(run.t) > 200
+    dt, law, grown = config.plant.step_ns * 1e-9, config.law(), config.law_obstacles()
+    q = run.q[0]
+    for k in range(len(run.t) - 1):
+        frame = config.reference().sample(run.t[k])
+        q = q + dt * team_command(q, config.vertices, config.sensing_radii, law, frame,
+                                  obstacles=grown).u
+        assert np.max(np.abs(q - run.q[k + 1])) < 1e-9, k
