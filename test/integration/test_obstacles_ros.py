@@ -103,3 +103,48 @@ def test_robots_go_round_a_pillar_they_are_told_of(processes, install, probe, tm
         q = q + dt * team_command(q, config.vertices, config.sensing_radii, law, frame,
                                   obstacles=grown).u
         assert np.max(np.abs(q - run.q[k + 1])) < 1e-9, k
+
+
+def test_unicycles_are_told_the_points_closest_to_their_hand_points(processes, install, probe,
+                                                                    tmp_path):
+    hand = 0.1
+    params = write_params(tmp_path, 'square_4.yaml', {
+        **PILLARS, 'body.kind': 'unicycle', 'body.hand_distance': hand,
+        'start.headings': [0.9, -1.6, 0.0, 3.1]})
+    config = load_config(params, 'plant')
+    told, poses = {}, {}
+    probe.create_subscription(
+        PoseArray, '/robot_1/obstacles',
+        lambda m: told.setdefault(fields.stamp_to_ns(m.header.stamp), m), qos.recording(qos.STATE))
+    probe.create_subscription(
+        PoseStamped, '/robot_1/pose',
+        lambda m: poses.setdefault(fields.stamp_to_ns(m.header.stamp), m),
+        qos.recording(qos.STATE))
+    out = tmp_path / 'out'
+    launch(processes, install, params, out=out, per_process=4)
+
+    def hand_point(message):
+        p, o = message.pose.position, message.pose.orientation
+        heading = 2.0 * np.arctan2(o.z, o.w)
+        return np.array([p.x, p.y]) + hand * np.array([np.cos(heading), np.sin(heading)])
+
+    def arrived():
+        return bool(poses) and np.hypot(*(hand_point(poses[max(poses)]) - 1.0)) < 0.05
+
+    info = stop_when(probe, processes, arrived, timeout=240)
+    assert info.returncode == 0, processes.log('launcher')
+    stats = json.loads((out / 'plant_stats.json').read_text())
+    assert stats['obstacle_contacts'] == 0 and stats['min_obstacle_gap'] > 0.0, stats
+    both = [stamp for stamp in told if stamp in poses]
+    assert len(both) > 50
+    for stamp in both:
+        pose = poses[stamp].pose.position
+        body, point = np.array([[pose.x, pose.y]]), hand_point(poses[stamp])[None]
+        rule = told_obstacles(config.obstacles, body, point, config.sensing_radii[:1])
+        points = np.array([[p.position.x, p.position.y]
+                           for p in told[stamp].poses]).reshape(-1, 2)
+        assert np.allclose(points, rule.points[0][rule.listed[0]], rtol=0.0, atol=1e-12)
+    near = [stamp for stamp in both if told[stamp].poses]
+    assert near, 'robot 1 was told of the pillar'
+    bodies = np.array([[poses[s].pose.position.x, poses[s].pose.position.y] for s in both])
+    assert np.min(np.hypot(bodies[:, 0], bodies[:, 1])) > 0.3, 'its body went round'
