@@ -25,6 +25,7 @@ from formation_ros.core.model.bodies import make_bodies
 from formation_ros.core.model.plant import PLANT_STATS_FILE, PlantModel, StepReport
 from formation_ros.core.rules.admission import Reason
 from formation_ros.core.rules.lockstep import AnswerWait
+from formation_ros.core.rules.obstacle_watch import ObstacleWatch
 from formation_ros.core.rules.pacing import Pacer
 from formation_ros.core.rules.plant_gate import (CLOCK_MATCH_LINE, ClockMatch, GAVE_UP_LINE,
                                                  leftover_line, Phase, StartGate, Verdict,
@@ -128,7 +129,10 @@ class PlantNode(Node):
         self.state_topics = PlantTopics(
             self, self.n, self.dim, config.world_frame, self.team_transport,
             self.team_transport and settings.wait_for_subscribers <= 1,
-            self.unicycles or body_frame, self.steady)
+            self.unicycles or body_frame, self.steady, config.obstacles, config.sensing_radii)
+        self.obstacle_watch = (None if config.obstacles is None
+                               else ObstacleWatch(config.obstacles, config.body.radius))
+        """The bodies against the real obstacles (``core.rules.obstacle_watch``), with a map."""
         self.command_topics: List[str] = []
         if self.team_transport:
             self.team_reader = TeamCommandReader(self.n)
@@ -312,6 +316,9 @@ class PlantNode(Node):
             t, q, u, extras = trajectory_sample(report, self.unicycles)
             self.output.append(t, q, u, **extras)
         self._log(report)
+        if self.obstacle_watch is not None:
+            for line in self.obstacle_watch.step(self.model.q, self.model.t):
+                self.get_logger().error(line)
 
     def _log(self, report: StepReport) -> None:
         """Say once what changed: a robot's command status, a bound violation, a collision."""
@@ -374,6 +381,11 @@ class PlantNode(Node):
         level, message, values = self.status_report.report(
             now, self.model, self.gate.phase, self.changes.states.at(self.model.t_ns).mode.value,
             self.stats.held_steps, self.refusals.refusals, heard)
+        if self.obstacle_watch is not None:
+            values.update(self.obstacle_watch.values())
+            if self.obstacle_watch.contacts:
+                level, message = 'error', (f'{self.obstacle_watch.contacts} obstacle contacts; '
+                                           + message)
         self.diagnostics_pub.publish(diagnostics(PLANT_STATUS, level, message, values))
 
     def _command_states(self) -> List[str]:
@@ -397,7 +409,7 @@ class PlantNode(Node):
         self.marker_pub.publish(formation_markers(
             self.model.q, self.config.sensing_radii, self.law.repulsion_radius, desired,
             self.paths, self.model.t_ns, self.config.world_frame,
-            self.model.heading if self.unicycles else None))
+            self.model.heading if self.unicycles else None, self.config.obstacles))
 
     def write_chunk(self) -> None:
         """Write the samples since the last chunk into ``plant.output_dir`` (a failure: once)."""
@@ -417,7 +429,10 @@ class PlantNode(Node):
         desired = desired_positions(self._vertices_at(self.model.t_ns),
                                     self.reference.sample(self.model.t))
         failure = self.output.failure
+        obstacles = ('' if self.obstacle_watch is None
+                     else f', {self.obstacle_watch.summary()}')
         self.get_logger().info(self.stats.summary(self.model, wall, desired, self.law.u_bound)
+                               + obstacles
                                + (f'; output stopped early: {failure}' if failure else ''))
         if not self.output.running:
             return
@@ -425,6 +440,8 @@ class PlantNode(Node):
             self.model, wall, self.refusals.refusals, len(self.changes.shapes.changes()),
             event_records(timeline_events(self.changes.shapes, self.changes.states)),
             self.config.imperfections.as_dict(), self.config.transport.value)
+        if self.obstacle_watch is not None:
+            record.update(self.obstacle_watch.record())
         failed = self.output.write(PLANT_STATS_FILE, record, self.reference.sample,
                                    self._vertices_at, self.unicycles, self.model.t)
         if failed is not None:

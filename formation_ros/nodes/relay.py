@@ -7,7 +7,9 @@ Relay node (executable ``relay``): the range sensor of the plant, without the bo
 In a lab the bodies are real and a motion-capture system measures them: :class:`RelayNode`
 reads each robot's measured pose (``relay.source_topic``, a PoseStamped or an Odometry) and
 publishes what the plant would, every robot's ``pose`` and ``neighbors`` with the one sensing
-rule of ``core.maths.sensing``, all with one wall-clock stamp per cycle at ``relay.rate``. Beside a
+rule of ``core.maths.sensing``, all with one wall-clock stamp per cycle at ``relay.rate``, and with
+an arena map (``obstacles.*``) each robot's ``obstacles`` by the plant's rule
+(``core.maths.obstacles.told_obstacles``), stamped as its pose and sent before it. Beside a
 simulated lab (the ``world`` node) it runs on the world's ``/clock`` (``use_sim_time:=true``):
 a cycle is due every ``1 / relay.rate`` s of simulated time, stamped with it, and a
 measurement's age is simulated time since it arrived (:meth:`RelayNode.now_ns`). A
@@ -26,6 +28,7 @@ from typing import Callable, Dict, List, Optional, Tuple
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.maths.frames import valid_quaternions
+from formation_ros.core.maths.obstacles import told_obstacles
 from formation_ros.core.maths.sensing import sensed_pairs, sensor_radii
 from formation_ros.core.maths.unicycle import headings_from_quaternions
 from formation_ros.core.maths.units import NS_PER_S
@@ -34,8 +37,8 @@ from formation_ros.core.rules.admission import Reason, refusal
 from formation_ros.core.settings.declarations import Exe, ParamError, SourceType
 from formation_ros.core.settings.team import team_values
 from formation_ros.ros import qos, topics
-from formation_ros.ros.cdr import (CdrError, PoseData, read_odometry, read_pose_stamped,
-                                   StateEncoder)
+from formation_ros.ros.cdr import (CdrError, encode_obstacles, PoseData, read_odometry,
+                                   read_pose_stamped, StateEncoder)
 from formation_ros.ros.diagnostics import diagnostics, PERIOD
 from formation_ros.ros.once import OnceLog, RefusalLog
 from formation_ros.ros.parameters import declare_parameters
@@ -75,12 +78,17 @@ class RelayNode(Node):
         self.n, self.dim = config.num_robots, config.dim
         self.world_frame = config.world_frame
         self.unicycles = config.body.is_unicycle
-        margin = make_bodies(config.body).sensing_margin
+        self.bodies = make_bodies(config.body)
+        margin = self.bodies.sensing_margin
         self.reach = sensor_radii(config.sensing_radii, margin)
+        self.radii = config.sensing_radii
+        self.obstacles = config.obstacles
+        """The arena's map (None: none, no obstacles topics)."""
         self.max_age_ns = int(settings.max_age * NS_PER_S)
         self.sources = [settings.source(i) for i in range(1, self.n + 1)]
         outputs = {topics.robot_topic(i, name) for i in range(1, self.n + 1)
-                   for name in (topics.POSE, topics.NEIGHBOURS, topics.CMD_VEL)}
+                   for name in (topics.POSE, topics.NEIGHBOURS, topics.CMD_VEL,
+                                topics.OBSTACLES)}
         outputs |= {topics.REFERENCE, topics.CLOCK, topics.DIAGNOSTICS, topics.MARKERS,
                     topics.PARAMS, topics.SHAPE, topics.STATUS}
         looped = sorted(set(self.sources) & outputs)
@@ -118,8 +126,11 @@ class RelayNode(Node):
                                      lambda data, index=i: callback(index, data),
                                      qos.MEASUREMENT, raw=True)
             for i, topic in enumerate(self.sources)]
-        self.pose_pubs, self.neighbour_pubs = [], []
+        self.pose_pubs, self.neighbour_pubs, self.obstacle_pubs = [], [], []
         for i in range(1, self.n + 1):
+            if self.obstacles is not None:
+                self.obstacle_pubs.append(self.create_publisher(
+                    PoseArray, topics.robot_topic(i, topics.OBSTACLES), qos.STATE))
             self.pose_pubs.append(self.create_publisher(
                 PoseStamped, topics.robot_topic(i, topics.POSE), qos.STATE))
             self.neighbour_pubs.append(self.create_publisher(
@@ -251,7 +262,10 @@ class RelayNode(Node):
                                      f"{missing or 'none'}")
         stamp_ns = self.get_clock().now().nanoseconds
         poses, arrays = self._encode(np.flatnonzero(measured), stamp_ns)
+        told = self._told(stamp_ns)
         for i in np.flatnonzero(fresh).tolist():
+            if told:
+                self.obstacle_pubs[i].publish(told[i])
             self.pose_pubs[i].publish(poses[i])
             self.neighbour_pubs[i].publish(arrays[i])
         self.published_cycles += 1
@@ -271,6 +285,21 @@ class RelayNode(Node):
         norms = np.linalg.norm(self.orientations, axis=1)
         return self.encoder.encode(q, known[observer], known[seen], stamp_ns,
                                    orientations=self.orientations / norms[:, None])
+
+    def _told(self, stamp_ns: int) -> List[bytes]:
+        """
+        Return every robot's obstacles at ``stamp_ns`` from its measured pose, as the plant's.
+
+        The rule is ``told_obstacles``: the obstacles within R_i of the measured position,
+        each by its surface point closest to the control point (a unicycle's hand point, from
+        the measured heading). Empty without a map.
+        """
+        if self.obstacles is None:
+            return []
+        q = self.positions[:, :self.dim]
+        points = self.bodies.control_points(q, headings_from_quaternions(self.orientations))
+        return encode_obstacles(stamp_ns, self.world_frame,
+                                told_obstacles(self.obstacles, q, points, self.radii))
 
     def _log_staleness(self, measured: np.ndarray, fresh: np.ndarray) -> None:
         """Say once when a measured robot goes stale and once when it is measured again."""

@@ -19,11 +19,13 @@ docs/faults.md. One per robot::
         --params-file config/paper_section5.yaml -p use_sim_time:=true
 """
 
+import dataclasses
 import time
 from typing import Any, Callable, Dict, List, Optional, Tuple
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.maths.law import Command
+from formation_ros.core.maths.obstacles import MAX_TOLD, quaternion_normals
 from formation_ros.core.maths.units import NS_PER_S
 from formation_ros.core.rules.admission import Reason
 from formation_ros.core.rules.answers import AnswerPolicy
@@ -94,7 +96,8 @@ class RobotNode(Node):
         self.command_frame = (messages.body_frame(settings.robot_id) if body_frame
                               else config.world_frame)
         self.control = Control(self.law, [self.sensing_radius], self.dim, self.unicycle,
-                               config.body.hand_distance, body_frame)
+                               config.body.hand_distance, body_frame, config.body.footprint,
+                               config.obstacle_clearance)
         """This robot's law and command frame (what it senses, its diagnostics)."""
         self.evaluates = config.team_transport or self.sim_time
         """Whether this robot evaluates the reference at each state's stamp itself."""
@@ -113,6 +116,8 @@ class RobotNode(Node):
                                    self.watch_ns, settings.wait_for_subscribers)
         self.pose: Optional[PoseData] = None
         self.neighbours: Optional[PoseArrayData] = None
+        self.obstacles: Optional[PoseArrayData] = None
+        """The latest obstacles admitted (None: none heard: the law as without obstacles)."""
         self.core: Optional[RobotCore] = None
         """What decides this robot's answers (a link's first robot: all of its robots'); None
         for a link's other robots, answered by the first."""
@@ -196,6 +201,9 @@ class RobotNode(Node):
                                      raw=True)
         self.create_subscription(PoseArray, topics.NEIGHBOURS, self.on_neighbours,
                                  qos.STATE_INPUT, raw=True)
+        if self.config.obstacle_clearance is not None:
+            self.create_subscription(PoseArray, topics.OBSTACLES, self.on_obstacles,
+                                     qos.STATE_INPUT, raw=True)
 
     @staticmethod
     def now_ns() -> int:
@@ -237,6 +245,26 @@ class RobotNode(Node):
             assert self.core is not None
             self._arm(self.core.neighbours_heard(heard.stamp_ns, self.now_ns()))
 
+    def on_obstacles(self, data: bytes) -> None:
+        """
+        Store the latest obstacles heard, read from the serialized PoseArray (untrusted).
+
+        Admitted as a state (world_frame, finite, unit quaternions, its stamp on this robot's
+        clock), at most MAX_TOLD points, each normal with a direction in the team's space;
+        then the state of that stamp waits for them (``RobotCore.obstacles_heard``).
+        """
+        heard = self.inputs.read('obstacles', lambda raw: read_pose_array(raw, MAX_TOLD), data,
+                                 Reason.TOO_MANY_POINTS)
+        if heard is None or not self.admit_state('obstacles', heard, True):
+            return
+        normals = quaternion_normals(heard.orientations, self.dim)
+        if not np.all(np.any(normals != 0.0, axis=1)):
+            self.inputs.refuse('obstacles', Refused(Reason.NO_NORMAL))
+            return
+        self.obstacles = heard
+        assert self.core is not None
+        self._arm(self.core.obstacles_heard(heard.stamp_ns, self.now_ns()))
+
     def _arm(self, due: Due) -> None:
         """Arm the answer when the core says it is due."""
         if due.now:
@@ -245,16 +273,18 @@ class RobotNode(Node):
             self.answer.arm(due.after_ns / NS_PER_S)
 
     def see(self, pose: PoseData, neighbours: PoseArrayData, heard_ns: int, new: bool,
-            last: Optional[Tuple[Command, Optional[NDArray[np.float64]]]] = None) -> None:
+            last: Optional[Tuple[Command, Optional[NDArray[np.float64]]]] = None,
+            obstacles: bool = False) -> None:
         """
         Take this robot's pose and neighbours in a state its link read, heard at ``heard_ns``.
 
         new: a state to answer (the link's leader); last: the robot's latest command and its
-        published form (diagnostics), if one was computed.
+        published form (diagnostics), if one was computed; obstacles: the state's obstacles
+        came with it.
         """
         self.pose, self.neighbours = pose, neighbours
         if self.core is not None:
-            self.core.state_heard(pose.stamp_ns, heard_ns, new)
+            self.core.state_heard(pose.stamp_ns, heard_ns, new, obstacles)
         else:
             self.policy.heard(['pose', 'neighbour'], heard_ns, state=new)
         if last is not None:
@@ -297,8 +327,13 @@ class RobotNode(Node):
     def _sensed_alone(self) -> Sensed:
         """Return what this robot knows of the state stored (``Control.alone``)."""
         assert self.pose is not None and self.neighbours is not None
-        return self.control.alone(self.index, self.pose.position, self.pose.orientation,
-                                  self.neighbours.positions, self.neighbours.orientations)
+        sensed = self.control.alone(self.index, self.pose.position, self.pose.orientation,
+                                    self.neighbours.positions, self.neighbours.orientations)
+        if self.obstacles is None:
+            return sensed
+        heard = self.control.heard_obstacles([(self.obstacles.positions,
+                                               self.obstacles.orientations)])
+        return dataclasses.replace(sensed, obstacles=heard)
 
     def on_state(self) -> None:
         """Answer a state as soon as its pose and neighbours are in (armed by the callbacks)."""

@@ -10,12 +10,16 @@ senses each robot's neighbours with the plant's sensing rule (``core.maths.sensi
 output the leader serves (``core.rules.robot_core``): every robot's command from one call of
 ``core.rules.control.Control``, in one
 ``/formation/commands`` message, and on a robot's own ``cmd_vel`` while someone subscribes to
-it (``ros.on_demand``). The message layouts and rules: docs/ros_interface.md ("Transports").
+it (``ros.on_demand``). With ``obstacles.clearance`` it hears ``/formation/obstacles`` too
+and takes a state once the obstacles of its stamp are in (after the first obstacles heard).
+The message layouts and rules: docs/ros_interface.md ("Transports", "Obstacles").
 """
 
+import dataclasses
 from typing import Callable, List, Optional, Protocol, Sequence, Tuple
 
 from formation_ros.core.maths.law import Command, LawParams
+from formation_ros.core.maths.obstacles import HeardObstacles, MAX_TOLD, quaternion_normals
 from formation_ros.core.maths.sensing import sensed_pairs, sensor_radii
 from formation_ros.core.model.bodies import make_bodies
 from formation_ros.core.rules.admission import Reason
@@ -30,7 +34,7 @@ from formation_ros.core.settings.params import FormationConfig
 from formation_ros.core.settings.team import LINK_VALUES
 from formation_ros.ros import qos, topics
 from formation_ros.ros.cdr import (encode_names, encode_team_commands, PoseArrayData, PoseData,
-                                   read_pose_array)
+                                   read_pose_array, read_team_obstacles, TeamObstaclesData)
 from formation_ros.ros.command_output import CmdVel, Output
 from formation_ros.ros.on_demand import LISTENERS_PERIOD, OnDemand
 from formation_ros.ros.robot_inputs import InputGate
@@ -73,8 +77,9 @@ class LinkedRobot(Protocol):
         """Admit a state of input ``name`` as of now."""
 
     def see(self, pose: PoseData, neighbours: PoseArrayData, heard_ns: int, new: bool,
-            last: Optional[Tuple[Command, Optional[NDArray[np.float64]]]] = None) -> None:
-        """Take the robot's pose and neighbours in a state the link read."""
+            last: Optional[Tuple[Command, Optional[NDArray[np.float64]]]] = None,
+            obstacles: bool = False) -> None:
+        """Take the robot's pose and neighbours (and obstacles) in a state the link read."""
 
     def serve(self, output: Output, control: Control,
               senses: Callable[[], Sensed]) -> RobotCore:
@@ -128,7 +133,8 @@ class RobotsLink:
         self.indices = np.array([node.index for node in self.nodes], dtype=np.intp)
         radii = np.array([node.sensing_radius for node in self.nodes])
         self.control = Control(leader.law, radii, self.dim, leader.control.unicycle,
-                               leader.control.hand_distance, leader.control.body_frame)
+                               leader.control.hand_distance, leader.control.body_frame,
+                               leader.control.footprint, leader.control.obstacle_clearance)
         self.needs_orientation = leader.control.unicycle or leader.control.body_frame
         self.reach = np.zeros(self.n)
         self.reach[self.indices] = sensor_radii(radii, make_bodies(config.body).sensing_margin)
@@ -143,6 +149,11 @@ class RobotsLink:
         self.sensed_now: Optional[Sensed] = None
         self.seen = np.zeros(0, dtype=np.intp)
         self.bounds = np.zeros(len(self.nodes) + 1, dtype=np.intp)
+        self.heard_obstacles: Optional[bytes] = None
+        self.obstacles: Optional[TeamObstaclesData] = None
+        """The latest obstacles admitted (None: none heard yet: the law as without them)."""
+        self.pending = False
+        """Whether the state taken waits for its obstacles."""
         self.last_sent: Optional[bytes] = None
         self.sent: List[Tuple[CmdVel, bytes]] = []
         """The cmd_vel messages that went with the latest team command, by robot."""
@@ -161,6 +172,9 @@ class RobotsLink:
         self.wake = Wake(leader, self.on_wake, leader.steady)
         leader.create_subscription(PoseArray, topics.STATES, self.on_states, qos.STATE_INPUT,
                                    raw=True)
+        if leader.control.obstacle_clearance is not None:
+            leader.create_subscription(MultiDOFJointTrajectory, topics.TEAM_OBSTACLES,
+                                       self.on_obstacles, qos.STATE_INPUT, raw=True)
         self.listeners_timer = leader.create_timer(LISTENERS_PERIOD, self.on_demand.look,
                                                    clock=leader.steady)
 
@@ -174,18 +188,60 @@ class RobotsLink:
         self.take_state()
         self.leader.on_state()
 
+    def on_obstacles(self, data: bytes) -> None:
+        """Store the latest team obstacles' bytes and wake the link."""
+        self.heard_obstacles = data
+        self.wake.arm()
+
     def take_state(self) -> None:
         """
         Read and admit the team state heard (if any), sense, and give the leader its part.
 
         A copy of the state taken last (the plant sends one again while it waits for answers)
         is not read again: it is heard anew and answered as a copy (``core.rules.answers``).
+        Once obstacles were heard, a state is given with the obstacles of its stamp, when
+        they are in.
         """
         data, self.heard = self.heard, None
-        if data is None or (data != self.taken and not self._sense(data)):
+        if data is not None:
+            if data != self.taken and not self._sense(data):
+                return
+            self.taken, self.taken_ns = data, self.leader.now_ns()
+            self.pending = True
+        self._take_obstacles()
+        if not self.pending or self.state is None or not (
+                self.obstacles is None or self.obstacles.stamp_ns == self.state.stamp_ns):
             return
-        self.taken, self.taken_ns = data, self.leader.now_ns()
+        self.pending = False
+        if self.obstacles is not None and self.sensed_now is not None:
+            self.sensed_now = dataclasses.replace(self.sensed_now,
+                                                  obstacles=self._heard(self.obstacles))
         self._give(self.leader, new=True)
+
+    def _take_obstacles(self) -> None:
+        """Read and admit the team obstacles heard (untrusted: ``read_team_obstacles``)."""
+        data, self.heard_obstacles = self.heard_obstacles, None
+        if data is None:
+            return
+        leader = self.leader
+        heard = leader.inputs.read('obstacles', lambda raw: read_team_obstacles(
+            raw, self.n, MAX_TOLD * self.n), data, Reason.TOO_MANY_POINTS)
+        if heard is None or not leader.admit_state('obstacles', PoseArrayData(
+                heard.stamp_ns, heard.frame_id, heard.positions, heard.orientations), True):
+            return
+        if not np.all(np.any(quaternion_normals(heard.orientations, self.dim) != 0.0, axis=1)):
+            leader.inputs.refuse('obstacles', Refused(Reason.NO_NORMAL))
+            return
+        self.obstacles = heard
+
+    def _heard(self, heard: TeamObstaclesData) -> Optional[HeardObstacles]:
+        """Return the obstacles of this link's robots in ``heard`` (``Control``)."""
+        local = self.local[heard.robots]
+        order = np.argsort(local, kind='stable')
+        bounds = np.searchsorted(local[order], np.arange(len(self.nodes) + 1))
+        rows = [order[bounds[k]:bounds[k + 1]] for k in range(len(self.nodes))]
+        return self.control.heard_obstacles([(heard.positions[r], heard.orientations[r])
+                                             for r in rows])
 
     def _sense(self, data: bytes) -> bool:
         """Read and admit a new state's bytes, sense; False if refused."""
@@ -229,7 +285,8 @@ class RobotsLink:
                           tuple(state.orientations[node.index].tolist())),
                  PoseArrayData(state.stamp_ns, state.frame_id, state.positions[seen],
                                state.orientations[seen]),
-                 self.taken_ns, new, None if latest is None else latest.row(k))
+                 self.taken_ns, new, None if latest is None else latest.row(k),
+                 self.obstacles is not None and self.obstacles.stamp_ns == state.stamp_ns)
 
     def report_to(self, node: LinkedRobot) -> None:
         """Give robot ``node`` what it would have heard and computed (its diagnostics)."""

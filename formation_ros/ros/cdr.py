@@ -27,9 +27,10 @@ import struct
 from typing import Dict, List, Optional, Sequence, Tuple
 
 from formation_ros.core.maths.frames import frame_from_pose, FrameSample
+from formation_ros.core.maths.obstacles import normal_quaternions, Told
 from formation_ros.core.maths.unicycle import quaternions_from_headings
 from formation_ros.core.maths.units import NS_PER_S
-from formation_ros.core.rules.transport import robot_indices, state_rows
+from formation_ros.core.rules.transport import NAME as ROBOT_NAME, robot_indices, state_rows
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -569,3 +570,99 @@ def encode_diagnostics(stamp_ns: int, statuses: Sequence[StatusData]) -> bytes:
             out += _pad(len(out), 4) + _string(key)
             out += _pad(len(out), 4) + _string(value)
     return bytes(out)
+
+
+def encode_obstacles(stamp_ns: int, frame_id: str, told: Told) -> List[bytes]:
+    """
+    Return every robot's ``obstacles`` message: a serialized PoseArray each, at ``stamp_ns``.
+
+    told: ``core.maths.obstacles.told_obstacles`` of N robots; robot i's message lists its
+    obstacles in map order, pose k the surface point (position, m) and the outward normal
+    there as the x axis of its orientation (docs/ros_interface.md, "Obstacles"); none near:
+    an empty PoseArray.
+    """
+    rows = state_rows(told.points.reshape(-1, told.points.shape[-1]),
+                      normal_quaternions(told.normals.reshape(-1, told.normals.shape[-1])))
+    rows = rows.reshape(told.listed.shape + (POSE_DOUBLES,))
+    return [encode_team_states(stamp_ns, frame_id, rows[i][told.listed[i]])
+            for i in range(len(rows))]
+
+
+@dataclass(frozen=True)
+class TeamObstaclesData:
+    """
+    A team obstacles message (``/formation/obstacles``), as read.
+
+    stamp_ns: the stamp of the state it goes with; frame_id: its header's frame; per point
+    listed: the robot it is for (0-based, (P,)), its position (P, 3) m and its orientation
+    (P, 4) (x, y, z, w), the outward normal as its x axis.
+    """
+
+    stamp_ns: int
+    frame_id: str
+    robots: NDArray[np.intp]
+    positions: NDArray[np.float64]
+    orientations: NDArray[np.float64]
+
+
+def encode_team_obstacles(stamp_ns: int, frame_id: str, told: Told) -> bytes:
+    """
+    Return the team transport's obstacles of a state: a MultiDOFJointTrajectory.
+
+    ``joint_names[k]`` is the robot ``robot_<i>`` point k is for (a robot once per point, in
+    id order, then map order), its one trajectory point's ``transforms[k]`` the surface point
+    (translation) and the normal (the rotation's x axis), as robot i's ``obstacles`` pose k
+    (:func:`encode_obstacles`); no velocities nor accelerations, ``time_from_start`` zero.
+    """
+    robots, kept = np.nonzero(told.listed)
+    dim = told.points.shape[-1]
+    rows = np.zeros((len(robots), TRANSFORM_DOUBLES), dtype=LITTLE_DOUBLE)
+    rows[:, :dim] = told.points[robots, kept]
+    rows[:, 3:] = normal_quaternions(told.normals[robots, kept])
+    head = encode_header(stamp_ns, frame_id)
+    head += _pad(len(head), 4) + encode_names([f'robot_{i + 1}' for i in robots.tolist()])
+    head += _pad(len(head), 4)
+    head += struct.pack('<II', 1, len(rows))
+    if len(rows):
+        head += _pad(len(head), 8) + rows.tobytes()
+    return head + struct.pack('<IIiI', 0, 0, 0, 0)
+
+
+def read_team_obstacles(data: bytes, num_robots: int, max_points: int) -> TeamObstaclesData:
+    """
+    Read a team obstacles message (:func:`encode_team_obstacles`); CdrError if not one.
+
+    Untrusted: at most ``max_points`` points (:class:`TooManyPoses`, counted before any is
+    read), each named ``robot_<i>`` with 1 <= i <= ``num_robots``, one transform per name,
+    no velocities or accelerations, nothing left over.
+    """
+    reader = _Reader(data, 'MultiDOFJointTrajectory')
+    stamp_ns, frame_id = reader.header()
+    count = reader.uint32()
+    if count > max_points:
+        raise TooManyPoses(f'{count} points, more than {max_points}')
+    if count * 5 > len(reader.view) - reader.offset:
+        raise CdrError(f'cut short: {count} names do not fit')
+    names = [reader.string('a joint name') for _ in range(count)]
+    robots = np.empty(count, dtype=np.intp)
+    for k, name in enumerate(names):
+        match = ROBOT_NAME.fullmatch(name)
+        if match is None or int(match.group(1)) > num_robots:
+            raise CdrError(f'joint_names: {name[:40]!r} is not robot_<i> with i in '
+                           f'1..{num_robots}')
+        robots[k] = int(match.group(1)) - 1
+    if reader.uint32() != 1:
+        raise CdrError('not one trajectory point')
+    if reader.uint32() != count:
+        raise CdrError(f'not one transform per name ({count} names)')
+    start = _align(reader.offset, 8)
+    _skip_elements(reader, TRANSFORM_DOUBLES * count)
+    values = (np.frombuffer(reader.view, dtype=np.dtype(np.float64).newbyteorder(reader.endian),
+                            count=count * TRANSFORM_DOUBLES, offset=start)
+              if count else np.zeros(0))
+    if reader.uint32() != 0 or reader.uint32() != 0:
+        raise CdrError('velocities or accelerations in an obstacles message')
+    reader._take('iI', 8, 4)
+    reader.end()
+    rows = values.reshape(count, TRANSFORM_DOUBLES).astype(np.float64)
+    return TeamObstaclesData(stamp_ns, frame_id, robots, rows[:, :3], rows[:, 3:])

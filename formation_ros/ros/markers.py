@@ -6,12 +6,14 @@ RViz markers of the formation (``/formation/markers``, visualization_msgs/Marker
 
 Namespaces: ``robots`` (spheres), ``sensing`` (discs in 2D, balls in 3D, radius R_i: a sphere
 list per distinct radius), ``repulsion`` (radius b, one sphere list), ``desired`` (the desired
-formation polygon), ``paths`` (recent paths, one line list). Every marker is in the world frame;
-the arrays come from the plant. The number of markers does not grow with the team (a list
-marker per kind, not a marker per robot).
+formation polygon), ``paths`` (recent paths, one line list), ``obstacles`` (the map's real
+obstacles: a cylinder per circle, a box and two end cylinders per wall, a sphere per sphere).
+Every marker is in the world frame; the arrays come from the plant. The number of markers does
+not grow with the team (a list marker per kind, not a marker per robot).
 """
 
 from collections import deque
+import math
 
 from formation_ros.ros.messages import ns_to_stamp, WORLD_FRAME
 from geometry_msgs.msg import Point
@@ -23,6 +25,10 @@ ROBOT_DIAMETER = 0.2
 DISC_THICKNESS = 0.01
 HEADING_LENGTH = 0.3
 """Length of the line that shows a unicycle's heading in RViz, m."""
+PILLAR_HEIGHT = {2: DISC_THICKNESS, 3: 20.0}
+"""How tall circles and walls are drawn, m: flat in 2D; in 3D (unbounded in z) this tall,
+about z = 0."""
+OBSTACLE_RGBA = (0.45, 0.35, 0.25, 0.9)
 
 
 def _point(row):
@@ -84,14 +90,15 @@ class Paths:
 
 
 def formation_markers(q, sensing_radii, repulsion_radius, desired, paths, stamp_ns,
-                      frame_id=WORLD_FRAME, headings=None):
+                      frame_id=WORLD_FRAME, headings=None, obstacles=None):
     """
     Build the MarkerArray of one moment.
 
     q: (N, dim) positions; sensing_radii: (N,); repulsion_radius: b; desired: (N, dim) desired
     positions of the shape in force; paths: the robots' recent positions (:class:`Paths`);
     stamp_ns: time; frame_id: the world frame (``world_frame``); headings: (N,) rad of
-    unicycles, drawn as a line :data:`HEADING_LENGTH` long from each body (None: none).
+    unicycles, drawn as a line :data:`HEADING_LENGTH` long from each body (None: none);
+    obstacles: the map (:func:`obstacle_markers`; None: none).
     """
     dim = q.shape[1]
     array = MarkerArray()
@@ -122,4 +129,40 @@ def formation_markers(q, sensing_radii, repulsion_radius, desired, paths, stamp_
         lines.points = [point for path in paths.points
                         for segment in zip(list(path)[:-1], list(path)[1:]) for point in segment]
         array.markers.append(lines)
+    if obstacles is not None:
+        array.markers.extend(obstacle_markers(obstacles, stamp_ns, frame_id))
     return array
+
+
+def obstacle_markers(obstacles, stamp_ns, frame_id=WORLD_FRAME):
+    """
+    Return the markers of a map's obstacles (``core.maths.obstacles.Obstacles``), ns ``obstacles``.
+
+    Circles: a CYLINDER each (diameter 2 r); walls: a CUBE along the segment (its length, 2 t
+    wide) and a CYLINDER of radius t at each end (the points within t of the segment); spheres:
+    a SPHERE each. Circles and walls are :data:`PILLAR_HEIGHT` tall, as they are unbounded in
+    3D. The real obstacles, not grown by the footprint.
+    """
+    height = PILLAR_HEIGHT[obstacles.dim]
+    markers = []
+
+    def add(kind, centre, size, yaw=0.0):
+        marker = _marker('obstacles', len(markers), kind, stamp_ns, OBSTACLE_RGBA, frame_id)
+        marker.pose.position = _point(centre)
+        marker.pose.orientation.z = math.sin(yaw / 2.0)
+        marker.pose.orientation.w = math.cos(yaw / 2.0)
+        marker.scale.x, marker.scale.y, marker.scale.z = (float(v) for v in size)
+        markers.append(marker)
+
+    for x, y, r in obstacles.circles.tolist():
+        add(Marker.CYLINDER, (x, y), (2.0 * r, 2.0 * r, height))
+    for x1, y1, x2, y2, t in obstacles.walls.tolist():
+        length = math.hypot(x2 - x1, y2 - y1)
+        if length > 0.0:
+            add(Marker.CUBE, ((x1 + x2) / 2.0, (y1 + y2) / 2.0), (length, 2.0 * t, height),
+                math.atan2(y2 - y1, x2 - x1))
+        for end in ((x1, y1), (x2, y2)):
+            add(Marker.CYLINDER, end, (2.0 * t, 2.0 * t, height))
+    for x, y, z, r in obstacles.spheres.tolist():
+        add(Marker.SPHERE, (x, y, z), (2.0 * r, 2.0 * r, 2.0 * r))
+    return markers

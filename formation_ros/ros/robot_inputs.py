@@ -54,12 +54,17 @@ class InputGate:
         """Return the refusals counted, by (input, reason)."""
         return self.refusals.refusals
 
-    def read(self, name: str, reader: Callable[[bytes], Read], data: bytes) -> Optional[Read]:
-        """Return ``reader(data)``; None, the refusal counted, if the bytes do not fit it."""
+    def read(self, name: str, reader: Callable[[bytes], Read], data: bytes,
+             too_many: Reason = Reason.TOO_MANY) -> Optional[Read]:
+        """
+        Return ``reader(data)``; None, the refusal counted, if the bytes do not fit it.
+
+        too_many: the reason of a message with more elements than the reader takes.
+        """
         try:
             return reader(data)
         except TooManyPoses as exc:
-            self.refuse(name, Refused(Reason.TOO_MANY, f' ({exc})'))
+            self.refuse(name, Refused(too_many, f' ({exc})'))
         except CdrError as exc:
             self.refuse(name, Refused(Reason.MALFORMED, f' ({exc})'))
         return None

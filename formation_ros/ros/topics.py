@@ -19,6 +19,9 @@ from formation_ros.core.settings.names import robot_name
 
 POSE = 'pose'
 NEIGHBOURS = 'neighbors'
+OBSTACLES = 'obstacles'
+"""Robot i's obstacles, ``/robot_<i>/obstacles``: a PoseArray sent with each pose by the plant and
+the relay when the map has obstacles (docs/ros_interface.md, "Obstacles")."""
 CMD_VEL = 'cmd_vel'
 REFERENCE = '/formation/reference'
 CLOCK = '/clock'
@@ -33,6 +36,9 @@ STATES = '/formation/states'
 """Team transport: every robot's pose in one PoseArray per state (``core.rules.transport``)."""
 TEAM_COMMANDS = '/formation/commands'
 """Team transport: one MultiDOFJointTrajectory per robot process or fleet per state."""
+TEAM_OBSTACLES = '/formation/obstacles'
+"""Team transport with obstacles: every robot's obstacles of a state, one MultiDOFJointTrajectory
+(``ros.cdr.encode_team_obstacles``), sent before the state."""
 MEASURED_POSE = 'measured_pose'
 """The world's ground truth of robot i, ``/robot_<i>/measured_pose`` (the relay's default
 source, ``relay.source_topic``): what a motion-capture driver gives a lab."""
@@ -102,6 +108,17 @@ def team_topics() -> List[Topic]:
     """Return the two topics of the team transport: the team's states and its commands."""
     return [Topic(STATES, 'geometry_msgs/msg/PoseArray', QosKind.STATE),
             Topic(TEAM_COMMANDS, 'trajectory_msgs/msg/MultiDOFJointTrajectory', QosKind.COMMAND)]
+
+
+def obstacle_topics(robot_id: int) -> List[Topic]:
+    """
+    Return the obstacle topics of robot ``robot_id`` and of the team transport.
+
+    Published by the plant and the relay only when the map has obstacles
+    (docs/ros_interface.md, "Obstacles").
+    """
+    return [Topic(robot_topic(robot_id, OBSTACLES), 'geometry_msgs/msg/PoseArray', QosKind.STATE),
+            Topic(TEAM_OBSTACLES, 'trajectory_msgs/msg/MultiDOFJointTrajectory', QosKind.STATE)]
 
 
 def world_topics(robot_id: int, wheeled: bool) -> List[Topic]:

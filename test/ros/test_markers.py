@@ -1,9 +1,11 @@
 # Copyright 2026 The formation_ros authors.
 # SPDX-License-Identifier: Apache-2.0
 
-"""RViz markers: what each namespace shows, and a count of markers that does not grow with N."""
+"""RViz markers: what each namespace shows (obstacles too), a count that does not grow with N."""
 
-from formation_ros.ros.markers import DISC_THICKNESS, formation_markers, HEADING_LENGTH, Paths
+from formation_ros.core.maths.obstacles import Obstacles
+from formation_ros.ros.markers import (DISC_THICKNESS, formation_markers, HEADING_LENGTH,
+                                       obstacle_markers, Paths, PILLAR_HEIGHT)
 from geometry_msgs.msg import Point
 import numpy as np
 import pytest
@@ -71,3 +73,26 @@ def test_unicycle_headings_are_lines_ahead_and_every_marker_is_in_the_world_fram
     assert np.allclose(as_rows(ahead.points), [(0.0, 0.0, 0.0), (HEADING_LENGTH, 0.0, 0.0),
                                                (1.0, 2.0, 0.0), (1.0, 2.0 + HEADING_LENGTH, 0.0)])
     assert {m.header.frame_id for m in array.markers} == {'map'}
+
+
+def test_obstacles_are_drawn_where_they_are_as_they_are():
+    obstacles = Obstacles([1.0, 2.0, 0.5], [0.0, 0.0, 0.0, 2.0, 0.1], [], 0.3, 2)
+    q = np.array([[0.0, -3.0]])
+    array = formation_markers(q, np.array([1.0]), 0.5, q, Paths(1, 2), 0, 'map',
+                              obstacles=obstacles)
+    drawn = [m for m in array.markers if m.ns == 'obstacles']
+    assert [m.type for m in drawn] == [Marker.CYLINDER, Marker.CUBE, Marker.CYLINDER,
+                                       Marker.CYLINDER]
+    assert len({m.id for m in drawn}) == 4 and all(m.header.frame_id == 'map' for m in drawn)
+    pillar, wall, start, end = drawn
+    assert (pillar.pose.position.x, pillar.pose.position.y) == (1.0, 2.0)
+    assert pillar.scale.x == pillar.scale.y == 1.0 and pillar.scale.z == PILLAR_HEIGHT[2]
+    assert (wall.pose.position.x, wall.pose.position.y) == (0.0, 1.0)
+    assert (wall.scale.x, wall.scale.y) == (2.0, pytest.approx(0.2))
+    yaw = 2.0 * np.arctan2(wall.pose.orientation.z, wall.pose.orientation.w)
+    assert yaw == pytest.approx(np.pi / 2.0)
+    assert (end.pose.position.x, end.pose.position.y) == (0.0, 2.0)
+    assert end.scale.x == pytest.approx(0.2)
+    balls = obstacle_markers(Obstacles([], [], [0.0, 1.0, 2.0, 0.7], 0.3, 3), 5)
+    assert [m.type for m in balls] == [Marker.SPHERE]
+    assert balls[0].pose.position.z == 2.0 and balls[0].scale.z == pytest.approx(1.4)

@@ -22,7 +22,8 @@ from formation_ros.core.maths.choice import Choice
 from formation_ros.core.maths.frames import (FrameSample, from_frame_velocity, STATIONARY,
                                              to_frame, to_frame_vectors)
 from formation_ros.core.maths.jump import JumpFunction, JumpKind, make_jump
-from formation_ros.core.maths.obstacles import log_obstacle_factor, obstacle_terms, Obstacles
+from formation_ros.core.maths.obstacles import (log_obstacle_factor, obstacle_terms, Obstacles,
+                                                ObstacleSurfaces)
 from formation_ros.core.maths.pairs import (pairs_within, row_differences, sorted_pairs,
                                             squared_norms)
 import numpy as np
@@ -184,7 +185,7 @@ class Command:
 def robot_command(q_i: ArrayLike, vertex_i: ArrayLike, neighbours: ArrayLike,
                   sensing_radius: float, law: LawParams,
                   frame: Optional[FrameSample] = STATIONARY,
-                  obstacles: Optional[Obstacles] = None) -> Command:
+                  obstacles: Optional[ObstacleSurfaces] = None) -> Command:
     """
     Control of one robot from what it knows (eqs. 13, 14, 21, 25).
 
@@ -205,7 +206,7 @@ def robot_command(q_i: ArrayLike, vertex_i: ArrayLike, neighbours: ArrayLike,
 def robot_commands(q_own: ArrayLike, vertices: ArrayLike, observer: ArrayLike,
                    neighbours: ArrayLike, sensing_radii: ArrayLike, law: LawParams,
                    frame: Optional[FrameSample] = STATIONARY,
-                   obstacles: Optional[Obstacles] = None) -> Command:
+                   obstacles: Optional[ObstacleSurfaces] = None) -> Command:
     """
     Control of K robots, each from what it knows: :func:`robot_command` for all in one call.
 
@@ -255,7 +256,7 @@ def team_command(q: ArrayLike, vertices: ArrayLike, sensing_radii: ArrayLike, la
                  frame: Optional[FrameSample] = STATIONARY,
                  tree: Optional['cKDTree'] = None,
                  pairs: Optional[NDArray[np.intp]] = None,
-                 obstacles: Optional[Obstacles] = None) -> Command:
+                 obstacles: Optional[ObstacleSurfaces] = None) -> Command:
     """
     Control of every robot at once (the vectorised form of :func:`robot_command`).
 
@@ -291,7 +292,8 @@ def team_command(q: ArrayLike, vertices: ArrayLike, sensing_radii: ArrayLike, la
 
 
 def obstacle_sum(q: ArrayLike, sensing_radii: ArrayLike, law: LawParams,
-                 frame: Optional[FrameSample], obstacles: Obstacles) -> NDArray[np.float64]:
+                 frame: Optional[FrameSample],
+                 obstacles: ObstacleSurfaces) -> NDArray[np.float64]:
     """
     Return each robot's sum over its obstacles of betabar'_io (q_i - p_io), formation frame.
 

@@ -25,7 +25,7 @@ zero on its surface; nothing here modifies its arguments.
 
 from dataclasses import dataclass
 import math
-from typing import NamedTuple, Tuple
+from typing import NamedTuple, Optional, Protocol, Sequence, Tuple
 
 from formation_ros.core.maths.jump import JumpFunction
 import numpy as np
@@ -37,6 +37,11 @@ term has no value there; the command saturates at c M1 as for two robots at one 
 CIRCLE_COLUMNS = 3
 WALL_COLUMNS = 5
 SPHERE_COLUMNS = 4
+MAX_TOLD = 256
+"""The most obstacle points one robot's message may list (``obstacles`` topic): more is
+refused unread (an arena's map gives a robot far fewer within its R_i)."""
+NORMAL_FLOOR = 1e-6
+"""A heard normal whose part in the team's space is shorter than this has no direction there."""
 
 
 class Surface(NamedTuple):
@@ -231,3 +236,152 @@ def log_obstacle_factor(q: ArrayLike, obstacles: Obstacles, jump: JumpFunction,
     with np.errstate(divide='ignore'):
         logs = np.log(obstacle_beta(distances, jump, obstacles.clearance))
     return -kappa * float(np.sum(logs))
+
+
+class ObstacleSurfaces(Protocol):
+    """
+    What the law takes of obstacles (``core.maths.law.obstacle_sum``).
+
+    count: obstacles a robot may have; clearance: b_o, m; ``surface(q)``: the
+    :class:`Surface` of every one seen from positions q (N, dim): :class:`Obstacles` (a map)
+    and :class:`HeardObstacles` (points heard) are two.
+    """
+
+    @property
+    def count(self) -> int:
+        """Return the number of obstacles M of a robot (columns of the surface)."""
+
+    @property
+    def clearance(self) -> float:
+        """Return b_o, m."""
+
+    def surface(self, q: ArrayLike) -> Surface:
+        """Return the :class:`Surface` of the obstacles seen from positions q (N, dim)."""
+
+
+class Told(NamedTuple):
+    """
+    What the plant or relay tells each of N robots of M obstacles (``obstacles`` topic).
+
+    listed: (N, M) whether obstacle o is told to robot i: its surface within R_i of the body's
+    position; points: (N, M, dim) the surface point closest to the robot's control point, m;
+    normals: (N, M, dim) the unit outward normals there (the surface is real, not grown).
+    """
+
+    listed: NDArray[np.bool_]
+    points: NDArray[np.float64]
+    normals: NDArray[np.float64]
+
+
+def told_obstacles(obstacles: Obstacles, positions: ArrayLike, control_points: ArrayLike,
+                   sensing_radii: ArrayLike) -> Told:
+    """
+    Return what every robot is told of ``obstacles``: the one rule of the plant and the relay.
+
+    positions: (N, dim) the bodies' positions (a unicycle's centre), m; control_points:
+    (N, dim) the points the law acts on (a unicycle's hand point), m; sensing_radii: (N,) R_i,
+    m. An obstacle is listed for robot i when its surface is nearer than R_i to the position
+    (the sensor is on the body); the point told is the real surface's point closest to the
+    control point, with the outward normal there (docs/ros_interface.md, "Obstacles").
+    """
+    radii = np.asarray(sensing_radii, dtype=float).reshape(-1, 1)
+    listed = obstacles.surface(positions).distances < radii
+    closest = obstacles.surface(control_points)
+    return Told(listed, closest.points, closest.normals)
+
+
+def normal_quaternions(normals: ArrayLike) -> NDArray[np.float64]:
+    """
+    Return unit quaternions (..., 4) (x, y, z, w) whose rotation takes +x onto ``normals``.
+
+    normals: (..., 2 or 3) unit vectors (a 2D one lies in the plane). The shortest rotation;
+    for -x, the half turn about +z. Inverse: :func:`quaternion_normals`.
+    """
+    n = np.asarray(normals, dtype=float)
+    full = np.zeros(n.shape[:-1] + (3,))
+    full[..., :n.shape[-1]] = n
+    quat = np.stack([np.zeros(full.shape[:-1]), -full[..., 2], full[..., 1],
+                     1.0 + full[..., 0]], axis=-1)
+    norm = np.linalg.norm(quat, axis=-1)
+    back = norm < 1e-12
+    quat[back] = (0.0, 0.0, 1.0, 0.0)
+    norm[back] = 1.0
+    result: NDArray[np.float64] = quat / norm[..., None]
+    return result
+
+
+def quaternion_normals(quaternions: ArrayLike, dim: int) -> NDArray[np.float64]:
+    """
+    Return the x axes (..., dim) of unit quaternions (..., 4) (x, y, z, w): heard normals.
+
+    In 2D the axis's part in the plane, made unit again; one shorter than
+    :data:`NORMAL_FLOOR` there comes back as zeros (no direction: the caller refuses it).
+    """
+    x, y, z, w = np.moveaxis(np.asarray(quaternions, dtype=float), -1, 0)
+    axis = np.stack([1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y + w * z),
+                     2.0 * (x * z - w * y)], axis=-1)[..., :dim]
+    norm = np.linalg.norm(axis, axis=-1, keepdims=True)
+    usable = norm >= NORMAL_FLOOR
+    result: NDArray[np.float64] = np.where(usable, axis / np.where(usable, norm, 1.0), 0.0)
+    return result
+
+
+@dataclass(frozen=True)
+class HeardObstacles:
+    """
+    The obstacles K robots heard: per robot, surface points and outward normals (world frame).
+
+    points: (K, M, dim) m and normals: (K, M, dim) unit, robot k's first ``counts[k]`` rows
+    (the rest padding); counts: (K,); footprint: f, m, the radius about the control point
+    that holds the body (``BodySettings.footprint``); clearance: b_o, m. Each point with its
+    normal bounds its obstacle by the tangent half-space (a convex obstacle lies behind the
+    tangent plane at any point of its surface), grown by f: robot k at q is
+    ``d = (q - p) . n - f`` from it, the grown half-space's closest point is ``q - d n``.
+    For the point the plant tells (closest to q) that is exactly the obstacle grown by f:
+    the law's terms equal the map's (docs/ros_interface.md, "Obstacles").
+    """
+
+    points: NDArray[np.float64]
+    normals: NDArray[np.float64]
+    counts: NDArray[np.intp]
+    footprint: float
+    clearance: float
+
+    @classmethod
+    def from_lists(cls, heard: Sequence[Optional[Tuple[ArrayLike, ArrayLike]]], dim: int,
+                   footprint: float, clearance: float) -> 'HeardObstacles':
+        """
+        Gather K robots' (points (m_k, >= dim), normals (m_k, >= dim)) heard; None: none.
+
+        Padded to the largest m_k; the arrays are copies.
+        """
+        counts = np.array([0 if pair is None else len(np.asarray(pair[0])) for pair in heard],
+                          dtype=np.intp)
+        width = int(counts.max()) if len(counts) else 0
+        points = np.zeros((len(heard), width, dim))
+        normals = np.zeros((len(heard), width, dim))
+        normals[..., 0] = 1.0
+        for k, pair in enumerate(heard):
+            if pair is not None and counts[k]:
+                points[k, :counts[k]] = np.asarray(pair[0], dtype=float)[:, :dim]
+                normals[k, :counts[k]] = np.asarray(pair[1], dtype=float)[:, :dim]
+        return cls(points, normals, counts, float(footprint), float(clearance))
+
+    @property
+    def count(self) -> int:
+        """Return M: the most obstacles any of the robots heard."""
+        return int(self.points.shape[1])
+
+    def surface(self, q: ArrayLike) -> Surface:
+        """
+        Return the :class:`Surface` of the grown half-spaces seen from q (K, dim), m.
+
+        A padded entry is at distance +inf (never near), its point q itself.
+        """
+        q = np.asarray(q, dtype=float).reshape(len(self.points), -1)
+        listed = np.arange(self.count)[None, :] < self.counts[:, None]
+        offset = q[:, None, :] - self.points
+        depth = np.einsum('kmd,kmd->km', offset, self.normals) - self.footprint
+        distances = np.where(listed, depth, np.inf)
+        closest = q[:, None, :] - np.where(listed, depth, 0.0)[..., None] * self.normals
+        return Surface(closest, distances, self.normals)

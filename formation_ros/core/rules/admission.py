@@ -33,6 +33,8 @@ class Reason(enum.Enum):
     CLOCK = 'stamps from another clock'
     NOT_NEWER = 'a stamp no later than the last one taken (a repeated or reordered measurement)'
     TOO_MANY = 'more neighbours than there are robots'
+    TOO_MANY_POINTS = 'more obstacle points than a robot takes'
+    NO_NORMAL = 'a normal (the x axis of an orientation) with no direction in the plane'
     TOO_FAST = 'a speed or turn rate its reference kind cannot have'
     OTHER_REFERENCE = ('a frame other than the one its reference parameters and the announced '
                        'changes give')

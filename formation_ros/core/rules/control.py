@@ -13,10 +13,11 @@ robots (``nodes.robots_link``) K.
 """
 
 from dataclasses import dataclass
-from typing import Optional, Tuple
+from typing import Optional, Sequence, Tuple
 
 from formation_ros.core.maths.frames import FrameSample
 from formation_ros.core.maths.law import Command, LawParams, robot_commands
+from formation_ros.core.maths.obstacles import HeardObstacles, quaternion_normals
 from formation_ros.core.maths.unicycle import headings_from_quaternions
 from formation_ros.core.model.bodies import BodyKind, BodySettings, make_bodies
 import numpy as np
@@ -33,7 +34,8 @@ class Sensed:
     indices: (K,) the robots' 0-based ids; points: (K, dim) the points the law acts on, m
     (:meth:`Control.points`); headings: (K,) rad; orientations: (K, 4) quaternions (x, y, z,
     w); (observer, neighbours): (P,) indices into the K robots and (P, dim) the points each
-    sensed, in order (``core.maths.law.robot_commands``).
+    sensed, in order (``core.maths.law.robot_commands``); obstacles: the obstacles they
+    heard with this state (:meth:`Control.heard_obstacles`), None: none heard, as without any.
     """
 
     indices: NDArray[np.intp]
@@ -42,6 +44,7 @@ class Sensed:
     orientations: Float
     observer: NDArray[np.intp]
     neighbours: Float
+    obstacles: Optional[HeardObstacles] = None
 
 
 @dataclass(frozen=True)
@@ -74,13 +77,18 @@ class Control:
 
     law: the law's constants; radii: (K,) R_i of the robots, m; dim: 2 or 3; unicycle, with
     hand_distance (m): the law acts on hand points and commands are (v, w); body_frame: u is
-    published in each robot's body frame.
+    published in each robot's body frame; footprint: the radius about the control point that
+    holds the body, m (``BodySettings.footprint``); obstacle_clearance: b_o, m
+    (``obstacles.clearance``; None: obstacles heard are not used).
     """
 
     def __init__(self, law: LawParams, radii: ArrayLike, dim: int, unicycle: bool,
-                 hand_distance: float, body_frame: bool) -> None:
+                 hand_distance: float, body_frame: bool, footprint: float = 0.0,
+                 obstacle_clearance: Optional[float] = None) -> None:
         """Keep the constants; ``radii`` is copied."""
         self.law = law
+        self.footprint = float(footprint)
+        self.obstacle_clearance = obstacle_clearance
         self.radii = np.array(radii, dtype=float)
         self.dim = dim
         self.unicycle = unicycle
@@ -118,6 +126,25 @@ class Control:
         return Sensed(np.array([index], dtype=np.intp), points[:1], headings[:1], own,
                       np.zeros(len(points) - 1, dtype=np.intp), points[1:])
 
+    def heard_obstacles(self, heard: Sequence[Optional[Tuple[ArrayLike, ArrayLike]]]
+                        ) -> Optional[HeardObstacles]:
+        """
+        Return the obstacles K robots heard, as the law takes them; None without any.
+
+        heard: per robot, (positions (m, >= dim) m, orientations (m, 4) unit quaternions) of
+        its ``obstacles`` message, the surface points and their outward normals as x axes
+        (docs/ros_interface.md, "Obstacles"), or None: no message. None when no robot heard
+        one or this robot has no b_o (``obstacles.clearance``).
+        """
+        if self.obstacle_clearance is None or all(pair is None for pair in heard):
+            return None
+        lists = [None if pair is None else
+                 (pair[0], quaternion_normals(np.asarray(pair[1], dtype=float).reshape(-1, 4),
+                                              self.dim))
+                 for pair in heard]
+        return HeardObstacles.from_lists(lists, self.dim, self.footprint,
+                                         self.obstacle_clearance)
+
     def zero(self) -> Float:
         """Return the K robots' zero commands: (K, width)."""
         return np.zeros((len(self.radii), self.width))
@@ -131,7 +158,7 @@ class Control:
         formation frame; frame: the reference's frame at the state.
         """
         law = robot_commands(sensed.points, vertices, sensed.observer, sensed.neighbours,
-                             self.radii, self.law, frame)
+                             self.radii, self.law, frame, sensed.obstacles)
         body: Optional[Float] = None
         if self.unicycle or self.body_frame:
             body = self.bodies.body_command(law.u, sensed.headings, sensed.orientations)

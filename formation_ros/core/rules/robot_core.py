@@ -7,7 +7,8 @@ What K >= 1 robots of one process do with the states they hear: when and what th
 :class:`RobotCore` is the decision loop of a robot node (K = 1) and of a process's link to its
 robots (``transport: team``, K robots in one law call), without ROS: it notes the states heard
 (:meth:`RobotCore.pose_heard`, :meth:`RobotCore.neighbours_heard`,
-:meth:`RobotCore.state_heard`, :meth:`RobotCore.reference_heard`), says when to look
+:meth:`RobotCore.obstacles_heard`, :meth:`RobotCore.state_heard`,
+:meth:`RobotCore.reference_heard`), says when to look
 (:class:`Wake`), and at a look (:meth:`RobotCore.on_state`, :meth:`RobotCore.on_watchdog`)
 returns an :class:`Answer`: the commands to publish (None: zero) or the answer to send again,
 and the lines to log once. Which states it answers is ``core.rules.answers.AnswerPolicy``'s
@@ -126,14 +127,22 @@ class RobotCore:
         """The stamp of the latest pose (or state) heard, ns (None: none yet)."""
         self.neighbours_ns: Optional[int] = None
         """The stamp of the latest neighbours heard, ns (None: none yet)."""
+        self.obstacles_ns: Optional[int] = None
+        """The stamp of the latest obstacles heard, ns (None: none yet)."""
         self.awaiting_neighbours = False
         self.latest: Optional[Commands] = None
         """The commands computed last (K rows)."""
 
     @property
     def paired(self) -> bool:
-        """Whether the pose and the neighbours heard last are of one state (same stamp)."""
-        return self.pose_ns is not None and self.neighbours_ns == self.pose_ns
+        """
+        Whether the pose and the neighbours heard last are of one state (same stamp).
+
+        Once obstacles were heard, their latest must be of that state too (the plant and
+        the relay send them with every pose); before, a robot answers as without obstacles.
+        """
+        return (self.pose_ns is not None and self.neighbours_ns == self.pose_ns
+                and (self.obstacles_ns is None or self.obstacles_ns == self.pose_ns))
 
     def pose_heard(self, stamp_ns: int, now_ns: int) -> Wake:
         """
@@ -161,10 +170,32 @@ class RobotCore:
             return Wake(now=True)
         return Wake()
 
-    def state_heard(self, stamp_ns: int, now_ns: int, new: bool) -> None:
-        """Note a state (pose and neighbours) stamped ``stamp_ns``; ``new``: one to answer."""
+    def obstacles_heard(self, stamp_ns: int, now_ns: int) -> Wake:
+        """
+        Note admitted obstacles stamped ``stamp_ns``, heard at ``now_ns``; answer if paired.
+
+        From the first, obstacles are an input that goes stale as the pose does (no obstacle
+        message for input_timeout: zero), and a state waits for its own.
+        """
+        self.obstacles_ns = stamp_ns
+        self.policy.heard(['obstacles'], now_ns)
+        if self.paired:
+            self.awaiting_neighbours = False
+            return Wake(now=True)
+        return Wake()
+
+    def state_heard(self, stamp_ns: int, now_ns: int, new: bool,
+                    obstacles: bool = False) -> None:
+        """
+        Note a state (pose and neighbours) stamped ``stamp_ns``; ``new``: one to answer.
+
+        obstacles: the obstacles of the state came with it (:meth:`obstacles_heard`).
+        """
         self.pose_ns = self.neighbours_ns = stamp_ns
         self.policy.heard(['pose', 'neighbour'], now_ns, state=new)
+        if obstacles:
+            self.obstacles_ns = stamp_ns
+            self.policy.heard(['obstacles'], now_ns)
 
     def reference_heard(self, now_ns: int) -> Wake:
         """Note a reference sample admitted at ``now_ns``: in lockstep, answer at once."""
