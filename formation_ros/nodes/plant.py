@@ -101,7 +101,8 @@ class PlantNode(Node):
                                 bodies=make_bodies(config.body, settings.max_speed,
                                                    body_frame=body_frame and not self.unicycles),
                                 headings=config.start_headings,
-                                imperfections=config.imperfections)
+                                imperfections=config.imperfections,
+                                obstacles=config.law_obstacles())
         self.lockstep, self.team_transport = config.lockstep, config.team_transport
         self.answer_wait = AnswerWait()
         self.publish_every = 1 if self.lockstep else settings.steps_per_publish
@@ -119,7 +120,8 @@ class PlantNode(Node):
         self.refusal: Optional[str] = None
         self.exit_code: Optional[int] = None
         self.clock_heard = 0
-        self.output = RunOutput(settings.output_dir, 'plant', 'the plant goes on controlling')
+        self.output = RunOutput(settings.output_dir, 'plant', 'the plant goes on controlling',
+                                config.feed_forward_guard())
         if settings.output_dir:
             failed = self.output.start(self.model.t)
             if failed is not None:

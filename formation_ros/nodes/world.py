@@ -116,7 +116,8 @@ class WorldNode(Node):
         """(N,) commands of each robot already stale when the step timer applied them."""
         self.rate_window = (time.monotonic_ns(), 0)
         self.output_dir = self.world.output_dir
-        self.output = RunOutput(self.output_dir, 'world', 'the world goes on')
+        self.output = RunOutput(self.output_dir, 'world', 'the world goes on',
+                                config.feed_forward_guard())
         self.gate = StartGate(time.monotonic(), False, self.get_fully_qualified_name(),
                               WORLD_LOOK_TIME)
         self.team_check = TeamCheck(self, WORLD_STATUS)

@@ -10,10 +10,13 @@ robot that hears none is the robot without obstacles; an old point still bounds 
 """
 
 from formation_ros.core.maths.law import make_law, robot_commands, team_command
+from formation_ros.core.maths.obstacle_tracking import tracking_command
 from formation_ros.core.maths.obstacles import (HeardObstacles, MAX_OBSTACLE_REPULSION,
                                                 normal_quaternions, Obstacles,
                                                 quaternion_normals, told_obstacles)
+from formation_ros.core.maths.reference import Reference
 from formation_ros.core.maths.unicycle import hand_points
+from formation_ros.core.rules.control import Control, Sensed
 import numpy as np
 import pytest
 
@@ -165,3 +168,26 @@ def test_normals_go_through_quaternions_and_back(dim):
 def test_a_normal_out_of_the_plane_has_no_direction_in_2d():
     up = normal_quaternions(np.array([[0.0, 0.0, 1.0]]))
     assert np.array_equal(quaternion_normals(up, 2), np.zeros((1, 2)))
+
+
+def test_a_robot_guards_the_feed_forward_as_formation_sim_does():
+    """Dragged at 4 m/s towards a wall it heard: the robots' command is the offline one."""
+    wall = Obstacles([], [5.0, -20.0, 5.0, 20.0, 0.2], [], 1.0, 2)
+    q = np.array([[4.2, 0.0], [4.5, 3.0], [0.0, 8.0]])
+    radii = np.full(3, 2.0)
+    frame = Reference('line', 2, [0.0, 0.0], [4.0, 0.0]).sample(1.0)
+    vertices = np.array([[0.0, 0.0], [0.0, 3.0], [-4.0, 8.0]])
+    control = Control(LAW, radii, 2, False, 0.0, False, 0.1, wall.clearance)
+    told = told_obstacles(wall, q, q, radii)
+    heard = heard_from(told, 2, 0.1, wall.clearance)
+    orientations = np.tile([0.0, 0.0, 0.0, 1.0], (3, 1))
+    sensed = Sensed(np.arange(3), q, np.zeros(3), orientations, np.zeros(0, dtype=np.intp),
+                    np.zeros((0, 2)), heard)
+    robots = control.commands(sensed, vertices, frame).law
+    grown = wall.grown(0.1)
+    offline = tracking_command(team_command(q, vertices, radii, LAW, frame, obstacles=grown),
+                               q, frame, LAW, grown, radii)
+    assert np.max(np.abs(robots.u - offline.u)) <= 1e-12
+    plain = team_command(q, vertices, radii, LAW, frame, obstacles=grown)
+    assert robots.u[0, 0] < plain.u[0, 0] - 0.1  # the rule took feed-forward off robot 1
+    assert np.array_equal(robots.u[2], plain.u[2])  # robot 3 is far from the wall

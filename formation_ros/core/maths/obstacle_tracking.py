@@ -28,7 +28,7 @@ from typing import Optional
 
 from formation_ros.core.maths.frames import FrameSample, from_frame_velocity
 from formation_ros.core.maths.law import Command, LawParams, RADIUS_MAX
-from formation_ros.core.maths.obstacles import obstacle_terms, Obstacles
+from formation_ros.core.maths.obstacles import obstacle_terms, Obstacles, ObstacleSurfaces
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -65,7 +65,7 @@ def guarded_feed_forward(feed_forward: ArrayLike, away: ArrayLike,
 
 
 def feed_forward_change(q: ArrayLike, frame: Optional[FrameSample], law: LawParams,
-                        obstacles: Optional[Obstacles], sensing_radii: ArrayLike
+                        obstacles: Optional[ObstacleSurfaces], sensing_radii: ArrayLike
                         ) -> Optional[NDArray[np.float64]]:
     """
     Return what the rule changes in each robot's world command, (N, dim) m/s, or None.
@@ -106,7 +106,7 @@ def change_for(q: ArrayLike, frame: Optional[FrameSample], away: ArrayLike,
 
 
 def tracking_command(command: Command, q: ArrayLike, frame: Optional[FrameSample],
-                     law: LawParams, obstacles: Optional[Obstacles],
+                     law: LawParams, obstacles: Optional[ObstacleSurfaces],
                      sensing_radii: ArrayLike) -> Command:
     """
     Return ``command`` (of ``law.team_command`` at q) with the feed-forward guarded.

@@ -17,6 +17,7 @@ from typing import Optional, Sequence, Tuple
 
 from formation_ros.core.maths.frames import FrameSample
 from formation_ros.core.maths.law import Command, LawParams, robot_commands
+from formation_ros.core.maths.obstacle_tracking import tracking_command
 from formation_ros.core.maths.obstacles import HeardObstacles, quaternion_normals
 from formation_ros.core.maths.unicycle import headings_from_quaternions
 from formation_ros.core.model.bodies import BodyKind, BodySettings, make_bodies
@@ -157,8 +158,10 @@ class Control:
         sensed: what they know (:class:`Sensed`); vertices: (K, dim) their places in the
         formation frame; frame: the reference's frame at the state.
         """
-        law = robot_commands(sensed.points, vertices, sensed.observer, sensed.neighbours,
-                             self.radii, self.law, frame, sensed.obstacles)
+        law = tracking_command(
+            robot_commands(sensed.points, vertices, sensed.observer, sensed.neighbours,
+                           self.radii, self.law, frame, sensed.obstacles),
+            sensed.points, frame, self.law, sensed.obstacles, self.radii)
         body: Optional[Float] = None
         if self.unicycle or self.body_frame:
             body = self.bodies.body_command(law.u, sensed.headings, sensed.orientations)
