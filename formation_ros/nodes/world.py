@@ -43,7 +43,7 @@ from formation_ros.core.settings.params import world_size_problem
 from formation_ros.physics.engine import Engine, Unstable, unstable_line
 from formation_ros.physics.intake import CommandInbox
 from formation_ros.physics.obstacles import footprint_note
-from formation_ros.physics.scanner import scan_period, steps_per_scan
+from formation_ros.physics.scanner import height_note, scan_period, steps_per_scan
 from formation_ros.physics.scene import WORLD_FILE
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import (CdrError, encode_clock, encode_odometry, encode_pose_stamped,
@@ -186,6 +186,11 @@ class WorldNode(Node):
                               self.engine.model.footprint)
         if note is not None:
             self.get_logger().warning(f'world: {note}')
+        if scanner is not None:
+            low = height_note(self.engine.obstacles.count, self.world.obstacle_height,
+                              scanner.height)
+            if low is not None:
+                self.get_logger().warning(f'world: {low}')
 
     def _start_output(self) -> None:
         """

@@ -24,6 +24,7 @@ points (``core.maths.scan.scan_points``).
 """
 
 import math
+from typing import Optional
 
 from formation_ros.core.maths.scan import ScanShape
 from formation_ros.core.maths.unicycle import headings_from_quaternions
@@ -58,6 +59,19 @@ def steps_per_scan(world: WorldSettings) -> int:
 def scan_period(world: WorldSettings) -> float:
     """Return the time between two scans, s: :func:`steps_per_scan` steps (``scan_time``)."""
     return steps_per_scan(world) * world.timestep
+
+
+def height_note(obstacles: int, obstacle_height: float, scan_height: float) -> Optional[str]:
+    """
+    Say in one line that the scans pass over the obstacles, or None.
+
+    obstacles: how many there are; obstacle_height: ``world.obstacle_height``, m; scan_height:
+    the scan plane's height above the floor, m (:attr:`Scanner.height`).
+    """
+    if obstacles == 0 or obstacle_height > scan_height:
+        return None
+    return (f'world.obstacle_height {obstacle_height:g} m is not above the scan plane at '
+            f'{scan_height:g} m: the scans pass over every obstacle')
 
 
 class Scanner:

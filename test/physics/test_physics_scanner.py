@@ -9,7 +9,7 @@ from formation_ros.core.maths.scan import scan_points, scan_problem
 from formation_ros.core.settings.declarations import ParamError
 from formation_ros.core.settings.params import validate
 from formation_ros.physics.engine import Engine
-from formation_ros.physics.scanner import scan_period, steps_per_scan
+from formation_ros.physics.scanner import height_note, scan_period, steps_per_scan
 import numpy as np
 from physics_helpers import bases, team
 import pytest
@@ -89,6 +89,16 @@ def test_a_pillar_beyond_range_max_reads_inf_and_within_it_its_distance():
     near = Engine(bases(positions, [0.0, 0.0], {**far, 'world.scan_range_min': 3.95,
                                                 'world.scan_range_max': 5.0})).scans()[0]
     assert np.isinf(near[0]), 'a return below range_min reads +inf'
+
+
+def test_obstacles_lower_than_the_scan_plane_are_not_seen_and_said_so():
+    low = lab(extra={'world.obstacle_height': 0.04})
+    assert low.scanner.height == pytest.approx(0.0565)
+    assert np.isinf(low.scans()[0][30]), 'the scan passes over the pillar'
+    note = height_note(low.obstacles.count, 0.04, low.scanner.height)
+    assert note is not None and 'pass over every obstacle' in note
+    assert height_note(low.obstacles.count, 0.5, low.scanner.height) is None
+    assert height_note(0, 0.04, low.scanner.height) is None
 
 
 def test_the_noise_is_gaussian_and_seeded_by_start_seed():
