@@ -7,12 +7,13 @@ World node (executable ``world``): the physics engine behind the topics a simula
 It steps :class:`formation_ros.physics.engine.Engine` (MuJoCo) on the steady clock at
 ``world.realtime_factor`` (``core.rules.pacing``) and gives the robots what a simulator and its
 ROS bridge give a lab (Gazebo with ros_gz_bridge): ``/clock``, each robot's ground truth on
-``/robot_<i>/measured_pose`` (the relay's default source) and, for wheeled bases, wheel
-odometry on ``/robot_<i>/odom``; it drives the bodies from ``/robot_<i>/cmd_vel``, whose
-callbacks only store (``physics.intake``). It builds the obstacle map (``obstacles.*``) as static
-geoms the bodies collide with, counts contacts between robots and, apart, with obstacles, and, with
-``world.output_dir``, writes ``world.xml``, ``trajectory.npz`` and ``world_stats.json``
-(``core.runs.output``, ``core.runs.world_stats``).
+``/robot_<i>/measured_pose`` (the relay's default source), for wheeled bases wheel
+odometry on ``/robot_<i>/odom`` and, for wheeled and planar bases, a laser scan on
+``/robot_<i>/scan`` (``physics.scanner``, at ``world.scan_rate``); it drives the bodies from
+``/robot_<i>/cmd_vel``, whose callbacks only store (``physics.intake``). It builds the
+obstacle map (``obstacles.*``) as static geoms the bodies collide with, counts contacts between
+robots and, apart, with obstacles, and, with ``world.output_dir``, writes ``world.xml``,
+``trajectory.npz`` and ``world_stats.json`` (``core.runs.output``, ``core.runs.world_stats``).
 Before its first step it looks at the domain through the plant's start gate
 (``core.rules.plant_gate``, ``ros.clock_look``): beside another plant or world it refuses (exit 2).
 How to start it, what it refuses and writes: docs/physics.md ("The world node"); its topics:
@@ -37,10 +38,12 @@ from formation_ros.core.runs.trajectory import TRAJECTORY_FILE
 from formation_ros.core.runs.world_stats import WORLD_STATS_FILE
 from formation_ros.core.settings.declarations import CommandFrame, Exe
 from formation_ros.core.settings.exits import ENGINE_FAILED, REFUSED
+from formation_ros.core.settings.names import robot_name
 from formation_ros.core.settings.params import world_size_problem
 from formation_ros.physics.engine import Engine, Unstable, unstable_line
 from formation_ros.physics.intake import CommandInbox
 from formation_ros.physics.obstacles import footprint_note
+from formation_ros.physics.scanner import height_note, scan_period, steps_per_scan
 from formation_ros.physics.scene import WORLD_FILE
 from formation_ros.ros import messages, qos, topics
 from formation_ros.ros.cdr import (CdrError, encode_clock, encode_odometry, encode_pose_stamped,
@@ -58,6 +61,7 @@ from numpy.typing import NDArray
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rosgraph_msgs.msg import Clock as ClockMsg
+from sensor_msgs.msg import LaserScan
 
 WORLD_STATUS = 'formation_ros/world'
 MIN_TICK = 0.005
@@ -75,6 +79,10 @@ stats)."""
 CHUNK_PERIOD = 1.0
 ODOMETRY_HEIGHT = 0.0
 """The height of an odometry pose, m: wheel odometry is planar."""
+SCAN = 'scan'
+"""A robot's laser scan topic, ``/robot_<i>/scan`` (a TurtleBot3's ``/scan`` in its namespace)."""
+SCAN_FRAME = 'base_scan'
+"""A robot's scanner frame, ``robot_<i>/base_scan``: at its pose body's position, x forward."""
 HEARD_KEPT = 256
 """States kept per robot to read a held command at the orientation it answered: 5 s at 50 Hz,
 more than a command is ever held (``world.cmd_timeout``)."""
@@ -139,6 +147,13 @@ class WorldNode(Node):
             TwistStamped if self.stamped else Twist, topics.robot_topic(i, topics.CMD_VEL),
             lambda data, index=i - 1: self.on_command(index, data), qos.COMMAND_INPUT,
             raw=True) for i in range(1, self.n + 1)]
+        scanner = self.engine.scanner
+        self.steps_per_scan = 0 if scanner is None else steps_per_scan(self.world)
+        self.scan_time = 0.0 if scanner is None else scan_period(self.world)
+        self.scan_frames = [f'{robot_name(i)}/{SCAN_FRAME}' for i in range(1, self.n + 1)]
+        self.scan_pubs = [] if scanner is None else [self.create_publisher(
+            LaserScan, topics.robot_topic(i, SCAN), qos.MEASUREMENT)
+            for i in range(1, self.n + 1)]
         self.diagnostics_pub = self.create_publisher(DiagnosticArray, topics.DIAGNOSTICS,
                                                      qos.DIAGNOSTICS)
         self.heard: Optional[HeardOrientations] = None
@@ -162,6 +177,8 @@ class WorldNode(Node):
             f'world: {self.n} {self.engine.model.kind.value} robots in {self.dim}D, timestep '
             f'{self.world.timestep:g} s, realtime factor {self.world.realtime_factor:g}, '
             f'poses at {self.world.pose_rate:g} Hz'
+            + (f', scans of {self.world.scan_rays} rays at {1.0 / self.scan_time:g} Hz'
+               if scanner is not None else ', no scanner')
             + (f', obstacles: {self.engine.obstacles.count}' if self.engine.obstacles.count
                else '')
             + (f', writing to {self.output_dir}' if self.output_dir else ''))
@@ -170,6 +187,11 @@ class WorldNode(Node):
                               self.engine.model.footprint)
         if note is not None:
             self.get_logger().warning(f'world: {note}')
+        if scanner is not None:
+            low = height_note(self.engine.obstacles.count, self.world.obstacle_height,
+                              scanner.height)
+            if low is not None:
+                self.get_logger().warning(f'world: {low}')
 
     def _start_output(self) -> None:
         """
@@ -248,6 +270,7 @@ class WorldNode(Node):
             self.pacer.start(now, self.engine.steps)
             self.rate_window = (now, self.engine.steps)
             self._publish()
+            self._publish_scans()
             return
         rows, commands, stamps = self.inbox.drain()
         if len(rows):
@@ -257,10 +280,15 @@ class WorldNode(Node):
         try:
             while due > 0:
                 steps = min(due, self.steps_per_pose - self.engine.steps % self.steps_per_pose)
+                if self.steps_per_scan:
+                    steps = min(steps, self.steps_per_scan
+                                - self.engine.steps % self.steps_per_scan)
                 self.engine.step(steps)
                 due -= steps
                 if self.engine.steps % self.steps_per_pose == 0:
                     self._publish()
+                if self.steps_per_scan and self.engine.steps % self.steps_per_scan == 0:
+                    self._publish_scans()
         except Unstable as exc:
             self._blew_up(exc)
         self._log_contacts()
@@ -295,6 +323,16 @@ class WorldNode(Node):
             self._publish_odometry(t_ns)
         if self.output.running:
             self._sample(t_ns)
+
+    def _publish_scans(self) -> None:
+        """Publish every robot's laser scan, stamped now (simulated time), in its base_scan."""
+        if not self.scan_pubs:
+            return
+        assert self.engine.scanner is not None
+        t_ns = self.engine.time_ns
+        shape = self.engine.scanner.shape
+        for pub, frame, ranges in zip(self.scan_pubs, self.scan_frames, self.engine.scans()):
+            pub.publish(messages.laser_scan(t_ns, frame, shape, ranges, self.scan_time))
 
     def _publish_odometry(self, t_ns: int) -> None:
         """Publish each base's wheel odometry: pose in world_frame, (v, w) in its base_link."""

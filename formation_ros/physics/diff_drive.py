@@ -13,9 +13,9 @@ from dataclasses import dataclass
 import math
 from xml.etree import ElementTree
 
-from formation_ros.physics.parts import (add, cylinder_inertia, FLOOR_GROUP, footprint_geom,
-                                         heading_mark, inertial, ModelKind, number, numbers,
-                                         servo_gain, velocity_servo)
+from formation_ros.physics.parts import (add, cylinder_inertia, DRAWN_GROUP, FLOOR_GROUP,
+                                         footprint_geom, heading_mark, inertial, ModelKind,
+                                         number, numbers, servo_gain, velocity_servo)
 import numpy as np
 from numpy.typing import NDArray
 
@@ -135,7 +135,7 @@ class DiffDrive:
         add(base, 'geom', name=f'{name}_caster', type='sphere',
             size=number(self.caster_radius), pos=numbers(self.caster_position), mass='0',
             condim='1', priority='1', contype=str(FLOOR_GROUP), conaffinity='0',
-            rgba='0.3 0.3 0.3 1')
+            group=str(DRAWN_GROUP), rgba='0.3 0.3 0.3 1')
         heading_mark(base, name, self.footprint, chassis_z + CHASSIS_HALF_HEIGHT)
         for side, sign in (('left', 1.0), ('right', -1.0)):
             wheel = add(base, 'body', name=f'{name}_{side}_wheel_link',
@@ -149,7 +149,8 @@ class DiffDrive:
                 contype=str(FLOOR_GROUP), conaffinity='0', group='3')
             add(wheel, 'geom', name=f'{name}_{side}_rim', type='cylinder',
                 size=numbers((r, half_width)), euler=numbers((0.5 * math.pi, 0.0, 0.0)),
-                mass='0', contype='0', conaffinity='0', rgba='0.1 0.1 0.1 1')
+                mass='0', contype='0', conaffinity='0', group=str(DRAWN_GROUP),
+                rgba='0.1 0.1 0.1 1')
         return name
 
     def add_actuators(self, actuators: ElementTree.Element, name: str) -> None:

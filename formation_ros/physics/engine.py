@@ -25,6 +25,7 @@ crazyswarm2's simulator backends share one. It builds the scene of a validated c
   (``obstacles.*``, static geoms: ``physics.obstacles``) :attr:`Engine.obstacle_contacts`
   counts a robot's contacts with them apart and :attr:`Engine.obstacle_approach` keeps the
   smallest gap of a body to an obstacle's surface (ground truth, footprint subtracted);
+* :meth:`Engine.scans` casts the planar bodies' laser scans (``physics.scanner``);
 * :meth:`Engine.stats` is what the run did (``core.runs.world_stats.WorldRunStats``).
 
 A step that makes a body's pose non-finite or absurd (MuJoCo's own check of the state, which
@@ -50,6 +51,7 @@ from formation_ros.physics.contacts import (ClosestApproach, ContactLog, Obstacl
 from formation_ros.physics.diff_drive import DiffDrive
 from formation_ros.physics.obstacles import obstacle_of_geom
 from formation_ros.physics.odometry import ODOMETRY_PERIOD, WheelOdometry
+from formation_ros.physics.scanner import Scanner
 from formation_ros.physics.scene import build_scene, Scene
 import mujoco
 import numpy as np
@@ -168,6 +170,11 @@ class Engine:
                                            for name in self.scene.names])
             self.odometer = WheelOdometry(self.model, start.positions[:, :2], start.headings,
                                           self.data.qpos[self._wheel_angles])
+        self.scanner: Optional[Scanner] = None
+        if self.dim == 2 and self.world.scan_rate > 0.0:
+            footprint = self._id(mujoco.mjtObj.mjOBJ_GEOM, f'{self.scene.names[0]}_footprint')
+            self.scanner = Scanner(self.mj_model, self._pose_bodies,
+                                   float(self.data.geom_xpos[footprint, 2]), self.world)
 
     def _id(self, kind: 'mujoco.mjtObj', name: str) -> int:
         index = int(mujoco.mj_name2id(self.mj_model, kind, name))
@@ -340,6 +347,17 @@ class Engine:
         """Return the true positions (N, dim), m, and headings (N,), rad."""
         truth = self.poses()
         return truth.positions[:, :self.dim], truth.headings
+
+    def scans(self) -> Float:
+        """
+        Return every robot's laser scan now (N, world.scan_rays), m; +inf: no return.
+
+        At the pose bodies' positions of :meth:`poses` (``physics.scanner``); ValueError without
+        a scanner (3D flyers, ``world.scan_rate`` 0).
+        """
+        if self.scanner is None:
+            raise ValueError('no scanner: only planar bodies with world.scan_rate > 0 have one')
+        return self.scanner.scan(self.data)
 
     def odometry(self) -> Tuple[Float, Float]:
         """Return the wheel odometry's positions (N, 2), m, and headings (N,), rad."""

@@ -31,6 +31,9 @@ FOOTPRINT_GROUP = 2
 """Collision bits of the footprints, which touch each other only."""
 FLOOR_GROUP = 1
 """Collision bits of what rolls on the floor (wheels, caster)."""
+DRAWN_GROUP = 1
+"""The visual group of the geoms only drawn (heading marks, wheels' rims, casters): the viewer
+shows it (as group 0), the laser scanner does not see it (``physics.scanner``)."""
 AXES = (('x', '1 0 0'), ('y', '0 1 0'), ('z', '0 0 1'))
 """The world axes a carriage slides along: (name, direction)."""
 
@@ -106,7 +109,7 @@ def heading_mark(body: ElementTree.Element, name: str, footprint: float,
     add(body, 'geom', name=f'{name}_front', type='box',
         size=numbers((0.25 * footprint, 0.1 * footprint, 0.005)),
         pos=numbers((0.7 * footprint, 0.0, half_height)), mass='0', contype='0',
-        conaffinity='0', rgba='0.95 0.75 0.1 1')
+        conaffinity='0', group=str(DRAWN_GROUP), rgba='0.95 0.75 0.1 1')
 
 
 def rotated(vectors: Float, yaw: Float) -> Float:

@@ -8,6 +8,7 @@ The nodes write their hot topics as bytes (``cdr``); the typed messages they pub
 (a shape's PoseArray, diagnostics, the team's status) are built here.
 """
 
+from array import array
 import math
 
 from builtin_interfaces.msg import Time
@@ -16,6 +17,7 @@ from formation_ros.core.maths.units import NS_PER_S
 from formation_ros.core.runs.timeline import Mode, TeamState
 from formation_ros.core.settings.names import robot_name
 from geometry_msgs.msg import Pose, PoseArray
+from sensor_msgs.msg import LaserScan
 
 WORLD_FRAME = 'world'
 FORMATION_FRAME = 'formation'
@@ -54,6 +56,27 @@ def pose_array(points, stamp_ns, dim, frame_id=WORLD_FRAME):
         pose.position.x, pose.position.y, pose.position.z = xyz(point, dim)
         pose.orientation.w = 1.0
         msg.poses.append(pose)
+    return msg
+
+
+def laser_scan(stamp_ns, frame_id, shape, ranges, scan_time):
+    """
+    Build a LaserScan of ``ranges`` ((R,), m; +inf: no return) stamped ``stamp_ns``.
+
+    shape: the scan's ``core.maths.scan.ScanShape`` (its mount is the frame's origin); ray k
+    at ``angle_min + k * angle_increment`` counter-clockwise, angle_max the last ray's;
+    scan_time: s between two scans. All rays are taken at the stamp (time_increment 0); no
+    intensities.
+    """
+    msg = stamped(LaserScan(), stamp_ns, frame_id)
+    msg.angle_min = float(shape.angle_min)
+    msg.angle_increment = float(shape.angle_increment)
+    msg.angle_max = float(shape.angle_min + (len(ranges) - 1) * shape.angle_increment)
+    msg.time_increment = 0.0
+    msg.scan_time = float(scan_time)
+    msg.range_min = float(shape.range_min)
+    msg.range_max = float(shape.range_max)
+    msg.ranges = array('f', [float(value) for value in ranges])
     return msg
 
 

@@ -22,7 +22,7 @@ def test_the_defaults_are_a_turtlebot3_burger_at_two_millisecond_steps():
 
 def test_every_world_parameter_is_described_with_a_range_and_read_by_the_simulator():
     names = [name for name in BY_NAME if name.startswith('world.')]
-    assert set(names) == {f'world.{field}' for field in WORLD_FIELDS} and len(names) == 14
+    assert set(names) == {f'world.{field}' for field in WORLD_FIELDS} and len(names) == 19
     for name in names:
         param = BY_NAME[name]
         assert param.description and Exe.SIM in param.users

@@ -474,6 +474,24 @@ DECLARATIONS = (
           'builds in 2D, m: they stand on the floor and must rise above the bodies (the law '
           'treats them as unbounded in z). In 3D they span the flight volume instead.',
           low=above(0.0), high=at_least(LENGTH_LIMIT), users=PHYSICS),
+    Param('world.scan_rate', Kind.DOUBLE, 5.0,
+          "Rate of each planar robot's laser scan (/robot_<i>/scan), Hz of simulated time "
+          '(a TurtleBot3 LDS: 5 Hz; at most 1 / world.timestep); 0: no scanner. 3D flyers '
+          'have none.', low=at_least(0.0), high=at_least(100000.0), users=PHYSICS),
+    Param('world.scan_rays', Kind.INT, 360,
+          'Rays of each scan, evenly spaced over a full turn counter-clockwise from the '
+          "base's +x (LDS: 360, one a degree).", low=at_least(1), high=at_least(100000),
+          users=PHYSICS),
+    Param('world.scan_range_min', Kind.DOUBLE, 0.12,
+          'Nearest return a scan reports, m (LDS: 0.12 m); a nearer one reads +inf; less '
+          'than world.scan_range_max.', low=at_least(0.0), high=at_least(LENGTH_LIMIT),
+          users=PHYSICS),
+    Param('world.scan_range_max', Kind.DOUBLE, 3.5,
+          'Farthest return a scan reports, m (LDS: 3.5 m); nothing within it reads +inf.',
+          low=above(0.0), high=at_least(LENGTH_LIMIT), users=PHYSICS),
+    Param('world.scan_noise', Kind.DOUBLE, 0.0,
+          'Standard deviation of Gaussian noise on every scan return, m, seeded by start.seed '
+          '(0: exact ranges).', low=at_least(0.0), high=at_least(LENGTH_LIMIT), users=PHYSICS),
     Param('world.output_dir', Kind.STRING, '',
           'If set, the world writes world.xml (and its results) there.', users=PHYSICS),
 )

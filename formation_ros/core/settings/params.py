@@ -212,7 +212,10 @@ class WorldSettings:
     body's servo force limit per axis, N; torque_limit: its heading servo's, N m;
     floor_friction: sliding friction coefficient of the floor; cmd_timeout: a command older
     than this stops the motors, s; obstacle_height: the height of 2D pillars and walls, m;
-    output_dir: where world.xml and the results go ('' none).
+    scan_rate: each planar robot's laser scans, Hz (0 none); scan_rays: rays per scan;
+    scan_range_min, scan_range_max: the returns a scan reports, m; scan_noise: standard
+    deviation of their noise, m (seeded by ``seed`` too); output_dir: where world.xml and the
+    results go ('' none).
     """
 
     timestep: float = 0.002
@@ -229,6 +232,11 @@ class WorldSettings:
     floor_friction: float = 1.0
     cmd_timeout: float = 0.5
     obstacle_height: float = 0.5
+    scan_rate: float = 5.0
+    scan_rays: int = 360
+    scan_range_min: float = 0.12
+    scan_range_max: float = 3.5
+    scan_noise: float = 0.0
     output_dir: str = ''
 
     @property
@@ -249,7 +257,8 @@ class WorldSettings:
 
 WORLD_FIELDS = ('timestep', 'realtime_factor', 'pose_rate', 'pose_noise', 'mass',
                 'wheel_radius', 'wheel_track', 'wheel_torque', 'force_limit', 'torque_limit',
-                'floor_friction', 'cmd_timeout', 'obstacle_height', 'output_dir')
+                'floor_friction', 'cmd_timeout', 'obstacle_height', 'scan_rate', 'scan_rays',
+                'scan_range_min', 'scan_range_max', 'scan_noise', 'output_dir')
 """The fields of :class:`WorldSettings` read from ``world.<field>``."""
 WORLD_MAX_ROBOTS = 1000
 """The most robots the physics engine takes (the world node, ``formation_sim --engine
@@ -279,6 +288,14 @@ def world_settings(values: Mapping[str, Any], problems: Problems) -> WorldSettin
         problems.append(('world.pose_rate', f'{world.pose_rate:g} Hz is faster than the '
                                             f'engine steps (1 / world.timestep = '
                                             f'{1.0 / world.timestep:g} Hz)'))
+    if world.scan_rate * world.timestep > 1.0:
+        problems.append(('world.scan_rate', f'{world.scan_rate:g} Hz is faster than the '
+                                            f'engine steps (1 / world.timestep = '
+                                            f'{1.0 / world.timestep:g} Hz)'))
+    if world.scan_range_min >= world.scan_range_max:
+        problems.append(('world.scan_range_min', f'{world.scan_range_min:g} m is not less than '
+                                                 f'world.scan_range_max '
+                                                 f'({world.scan_range_max:g} m)'))
     return world
 
 
