@@ -94,3 +94,16 @@ def test_a_robot_trembling_on_the_spot_is_stuck():
     q = passing(xs, 0.0)
     q_desired = np.tile([[2.0, 0.0], [10.0, 10.0]], (len(t), 1, 1))
     assert [s.robot for s in stuck_robots(t, q, q_desired, PILLAR)] == [0]
+
+
+def test_a_base_turning_on_the_spot_is_stuck_though_its_hand_point_sweeps():
+    t = np.linspace(0.0, 20.0, 2001)
+    axle = passing(np.full(len(t), -1.3), 0.0)
+    angle = 3.0 * t
+    hand = axle.copy()
+    hand[:, 0, 0] += 0.08 * np.cos(angle)
+    hand[:, 0, 1] += 0.08 * np.sin(angle)
+    q_desired = np.tile([[2.0, 0.0], [10.0, 10.0]], (len(t), 1, 1))
+    assert stuck_robots(t, hand, q_desired, PILLAR) == []  # the hand point alone: moving
+    stuck = stuck_robots(t, hand, q_desired, PILLAR, bodies=axle, body_radius=0.05)
+    assert [s.robot for s in stuck] == [0] and stuck[0].position == pytest.approx([-1.3, 0.0])

@@ -134,15 +134,17 @@ def stuck_robots(t: ArrayLike, q: ArrayLike, q_desired: ArrayLike,
     the last ``still_time`` seconds (a robot pressed against an obstacle may tremble on the
     spot, which a path length would count as moving). A run shorter than ``still_time`` has
     none. bodies: (T, N, dim) the bodies' positions when they are not the control points
-    (unicycles' axle centres), whose footprint ``body_radius`` (m) is measured to the nearest
-    obstacle.
+    (unicycles' axle centres): whether a robot stays is told by its body (a base turning on the
+    spot sweeps its hand point round it), and its footprint ``body_radius`` (m) is measured to
+    the nearest obstacle.
     """
     times = np.asarray(t, dtype=float)
     q = np.asarray(q, dtype=float)
     if len(times) < 2 or times[-1] - times[0] < still_time:
         return []
     window = times >= times[-1] - still_time
-    wander = formation_errors(q[window], q[-1][None]).max(axis=0)
+    where = q if bodies is None else np.asarray(bodies, dtype=float)
+    wander = formation_errors(where[window], where[-1][None]).max(axis=0)
     errors = formation_errors(q[-1], np.asarray(q_desired, dtype=float)[-1])
     found = np.nonzero((errors > tolerance) & (wander < still_speed * still_time))[0]
     places = q[-1] if bodies is None else np.asarray(bodies, dtype=float)[-1]
