@@ -80,7 +80,7 @@ class RecorderNode(Node):
         self.once = OnceLog(self.get_logger())
         self.subscriptions_by_topic: Dict[str, Any] = {}
         recorded = topics.recorded_topics(config.num_robots, settings.markers,
-                                          config.command.stamped)
+                                          config.command.stamped, config.obstacles is not None)
         command_names = {topics.robot_topic(i, topics.CMD_VEL)
                          for i in range(1, config.num_robots + 1)}
         self.commands_to_subscribe = {topic.name: topic for topic in recorded

@@ -135,11 +135,17 @@ def world_topics(robot_id: int, wheeled: bool) -> List[Topic]:
     return found
 
 
-def recorded_topics(num_robots: int, markers: bool,
-                    stamped_commands: bool = True) -> List[Topic]:
-    """Return every topic a recording of the formation holds (``/formation/params`` aside)."""
+def recorded_topics(num_robots: int, markers: bool, stamped_commands: bool = True,
+                    obstacles: bool = False) -> List[Topic]:
+    """
+    Return every topic a recording of the formation holds (``/formation/params`` aside).
+
+    obstacles: the map has obstacles, so each robot's ``obstacles`` is recorded too.
+    """
     topics = [topic for i in range(1, num_robots + 1)
               for topic in robot_topics(i, stamped_commands)]
+    if obstacles:
+        topics += [obstacle_topics(i)[0] for i in range(1, num_robots + 1)]
     topics += [
         Topic(REFERENCE, 'nav_msgs/msg/Odometry', QosKind.REFERENCE),
         Topic(CLOCK, 'rosgraph_msgs/msg/Clock', QosKind.CLOCK),
