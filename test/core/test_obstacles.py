@@ -212,3 +212,36 @@ def test_the_command_stays_bounded_on_and_inside_obstacles():
     assert np.all(np.isfinite(command.u))
     assert np.max(np.abs(command.u_hat)) <= law.u_bound
     assert command.u_hat[0, 1] == pytest.approx(law.u_bound)
+
+
+@pytest.mark.parametrize('dim', [2, 3])
+def test_the_terms_measured_near_only_are_the_terms_of_every_surface(dim):
+    """Obstacles.terms skips far pairs: the same sums as obstacle_terms of the whole surface."""
+    rng = np.random.default_rng(7 + dim)
+    circles = np.column_stack([rng.uniform(-8.0, 8.0, (30, 2)), rng.uniform(0.1, 0.6, 30)])
+    walls = np.column_stack([rng.uniform(-8.0, 8.0, (6, 4)), rng.uniform(0.05, 0.2, 6)])
+    spheres = (np.column_stack([rng.uniform(-8.0, 8.0, (5, 3)), rng.uniform(0.2, 0.8, 5)])
+               if dim == 3 else [])
+    obstacles = Obstacles(circles, walls, spheres, 0.9, dim)
+    q = rng.uniform(-9.0, 9.0, size=(400, dim))
+    radii = rng.uniform(0.5, 2.0, size=len(q))
+    jump = make_jump('poly', 2)
+    every = obstacle_terms(q, obstacles.surface(q), jump, obstacles.clearance, radii)
+    near = obstacles.terms(q, jump, radii)
+    assert np.any(np.any(every != 0.0, axis=1)) and np.any(np.all(every == 0.0, axis=1))
+    assert np.max(np.abs(near - every)) <= 1e-12 * max(1.0, float(np.max(np.abs(every))))
+
+
+@pytest.mark.parametrize('dim', [2, 3])
+def test_the_distances_alone_are_the_surfaces_distances(dim):
+    rng = np.random.default_rng(11 + dim)
+    circles = np.column_stack([rng.uniform(-5.0, 5.0, (8, 2)), rng.uniform(0.1, 0.6, 8)])
+    walls = np.column_stack([rng.uniform(-5.0, 5.0, (3, 4)), rng.uniform(0.05, 0.2, 3)])
+    spheres = (np.column_stack([rng.uniform(-5.0, 5.0, (2, 3)), rng.uniform(0.2, 0.8, 2)])
+               if dim == 3 else [])
+    obstacles = Obstacles(circles, walls, spheres, 0.9, dim)
+    q = rng.uniform(-6.0, 6.0, size=(200, dim))
+    assert np.allclose(obstacles.distances(q), obstacles.surface(q).distances, rtol=0.0,
+                       atol=1e-12)
+    assert obstacles.distances(q).shape == (200, obstacles.count)
+    assert Obstacles([], [], [], 0.9, dim).distances(q).shape == (200, 0)

@@ -22,8 +22,7 @@ from formation_ros.core.maths.choice import Choice
 from formation_ros.core.maths.frames import (FrameSample, from_frame_velocity, STATIONARY,
                                              to_frame, to_frame_vectors)
 from formation_ros.core.maths.jump import JumpFunction, JumpKind, make_jump
-from formation_ros.core.maths.obstacles import (log_obstacle_factor, obstacle_terms, Obstacles,
-                                                ObstacleSurfaces)
+from formation_ros.core.maths.obstacles import log_obstacle_factor, Obstacles, ObstacleSurfaces
 from formation_ros.core.maths.pairs import (pairs_within, row_differences, sorted_pairs,
                                             squared_norms)
 import numpy as np
@@ -305,8 +304,8 @@ def obstacle_sum(q: ArrayLike, sensing_radii: ArrayLike, law: LawParams,
     q = np.asarray(q, dtype=float)
     if obstacles.count == 0:
         return np.zeros_like(q)
-    terms = obstacle_terms(q, obstacles.surface(q), law.jump, obstacles.clearance,
-                           np.minimum(np.asarray(sensing_radii, dtype=float), RADIUS_MAX))
+    terms = obstacles.terms(q, law.jump,
+                            np.minimum(np.asarray(sensing_radii, dtype=float), RADIUS_MAX))
     return to_frame_vectors(terms, frame)
 
 

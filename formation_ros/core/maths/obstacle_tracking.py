@@ -28,7 +28,7 @@ from typing import Optional
 
 from formation_ros.core.maths.frames import FrameSample, from_frame_velocity
 from formation_ros.core.maths.law import Command, LawParams, RADIUS_MAX
-from formation_ros.core.maths.obstacles import obstacle_terms, Obstacles, ObstacleSurfaces
+from formation_ros.core.maths.obstacles import Obstacles, ObstacleSurfaces
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -83,7 +83,7 @@ def feed_forward_change(q: ArrayLike, frame: Optional[FrameSample], law: LawPara
     if not np.any(from_frame_velocity(np.zeros_like(q), q, frame)):
         return None
     radii = np.minimum(np.asarray(sensing_radii, dtype=float), RADIUS_MAX)
-    away = obstacle_terms(q, obstacles.surface(q), law.jump, obstacles.clearance, radii)
+    away = obstacles.terms(q, law.jump, radii)
     return change_for(q, frame, away, obstacles.clearance)
 
 

@@ -25,7 +25,7 @@ zero on its surface; nothing here modifies its arguments.
 
 from dataclasses import dataclass
 import math
-from typing import NamedTuple, Optional, Protocol, Sequence, Tuple
+from typing import Callable, NamedTuple, Optional, Protocol, Sequence, Tuple
 
 from formation_ros.core.maths.jump import JumpFunction
 import numpy as np
@@ -55,6 +55,11 @@ class Surface(NamedTuple):
     points: NDArray[np.float64]
     distances: NDArray[np.float64]
     normals: NDArray[np.float64]
+
+
+Pairs = Tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
+"""The surface seen across P (robot, obstacle) pairs: points (P, dim), distances (P,), normals
+(P, dim)."""
 
 
 def _rows(values: ArrayLike, columns: int, name: str) -> NDArray[np.float64]:
@@ -139,9 +144,71 @@ class Obstacles:
         A position on an obstacle's axis or segment (no direction to the surface) takes +x.
         """
         q = np.asarray(q, dtype=float).reshape(-1, self.dim)
-        parts = [_circle_surface(q, self.circles), _wall_surface(q, self.walls),
-                 _sphere_surface(q, self.spheres)]
+        parts = []
+        for rows, pairs in self._kinds():
+            robots = np.repeat(np.arange(len(q)), len(rows))
+            points, distances, normals = pairs(q[robots], np.tile(rows, (len(q), 1)))
+            shape = (len(q), len(rows))
+            parts.append((points.reshape(*shape, self.dim), distances.reshape(shape),
+                          normals.reshape(*shape, self.dim)))
+        if not parts:
+            none = np.zeros((len(q), 0, self.dim))
+            return Surface(none, np.zeros((len(q), 0)), none)
         return Surface(*(np.concatenate([part[k] for part in parts], axis=1) for k in range(3)))
+
+    def distances(self, q: ArrayLike) -> NDArray[np.float64]:
+        """
+        Return d_io of every robot and obstacle, (N, M) m, negative inside: ``surface(q)``'s.
+
+        Without the points and normals: a disc's, pillar's or ball's distance is the distance to
+        its centre (in the plane for discs and pillars) less its radius; walls are measured as
+        :meth:`surface` does.
+        """
+        q = np.asarray(q, dtype=float).reshape(-1, self.dim)
+        parts = [np.zeros((len(q), 0))]
+        for rows, pairs in self._kinds():
+            if pairs is _wall_pairs:
+                robots = np.repeat(np.arange(len(q)), len(rows))
+                measured = pairs(q[robots], np.tile(rows, (len(q), 1)))[1]
+                parts.append(measured.reshape(len(q), len(rows)))
+            else:
+                centres, reach = _bounds(rows, pairs)
+                parts.append(np.sqrt(_apart_sq(q, centres)) - reach)
+        return np.concatenate(parts, axis=1)
+
+    def terms(self, q: ArrayLike, jump: JumpFunction,
+              sensing_radii: ArrayLike) -> NDArray[np.float64]:
+        """
+        Return :func:`obstacle_terms` of every robot, measuring only the obstacles that can act.
+
+        q: (N, dim) positions, m; sensing_radii: (N,) R_i, m. An obstacle acts on robot i only
+        where d_io < min(R_i, b_o); d_io is at least the distance to the obstacle's centre (a
+        wall's middle) less its reach (radius; half-length plus t), so pairs farther than that
+        are never measured. The same sums as ``obstacle_terms(q, self.surface(q), ...)`` at a
+        cost that grows with the pairs near each other, not with N x M surfaces. (N, dim), 1/m.
+        """
+        q = np.asarray(q, dtype=float).reshape(-1, self.dim)
+        radii = np.broadcast_to(np.asarray(sensing_radii, dtype=float).reshape(-1), (len(q),))
+        acts = np.minimum(radii, self.clearance)
+        summed = np.zeros_like(q)
+        for rows, pairs in self._kinds():
+            centres, reach = _bounds(rows, pairs)
+            apart_sq = _apart_sq(q, centres)
+            within = acts[:, None] + reach[None, :]
+            robots, kinds = np.nonzero(apart_sq < within * within)
+            if len(robots) == 0:
+                continue
+            points, distances, normals = pairs(q[robots], rows[kinds])
+            near = Surface(points[:, None, :], distances[:, None], normals[:, None, :])
+            np.add.at(summed, robots, obstacle_terms(q[robots], near, jump, self.clearance,
+                                                     radii[robots]))
+        return summed
+
+    def _kinds(self) -> Tuple[Tuple[NDArray[np.float64], Callable[..., Pairs]], ...]:
+        """Return (rows, their pair function) of each kind present, in :attr:`count` order."""
+        kinds = ((self.circles, _circle_pairs), (self.walls, _wall_pairs),
+                 (self.spheres, _sphere_pairs))
+        return tuple((rows, pairs) for rows, pairs in kinds if len(rows))
 
 
 def _toward(offset: NDArray[np.float64]) -> Tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -154,43 +221,60 @@ def _toward(offset: NDArray[np.float64]) -> Tuple[NDArray[np.float64], NDArray[n
     return unit, norm
 
 
-def _in_plane(q: NDArray[np.float64], axis_xy: NDArray[np.float64], reach: NDArray[np.float64]
-              ) -> Surface:
-    """Return the surface of plane shapes from their axis points (N, K, 2) and radii (K,)."""
-    unit, norm = _toward(q[:, None, :2] - axis_xy)
-    points = np.repeat(q[:, None, :], axis_xy.shape[1], axis=1)
-    points[..., :2] = axis_xy + reach[:, None] * unit
+def _in_plane(q: NDArray[np.float64], axis_xy: NDArray[np.float64],
+              radius: NDArray[np.float64]) -> Pairs:
+    """Return the surface of plane shapes from pairs' positions q (P, dim), axis points (P, 2)."""
+    unit, norm = _toward(q[:, :2] - axis_xy)
+    points = np.array(q)
+    points[:, :2] = axis_xy + radius[:, None] * unit
     normals = np.zeros_like(points)
-    normals[..., :2] = unit
-    return Surface(points, norm - reach, normals)
+    normals[:, :2] = unit
+    return points, norm - radius, normals
 
 
-def _circle_surface(q: NDArray[np.float64], circles: NDArray[np.float64]) -> Surface:
-    """Discs (2D) or vertical pillars (3D): the closest point keeps the robot's z."""
-    centres = np.broadcast_to(circles[None, :, :2], (len(q), len(circles), 2))
-    return _in_plane(q, centres, circles[:, 2])
+def _circle_pairs(q: NDArray[np.float64], circles: NDArray[np.float64]) -> Pairs:
+    """Discs (2D) or vertical pillars (3D), rows (P, 3): the closest point keeps the robot's z."""
+    return _in_plane(q, circles[:, :2], circles[:, 2])
 
 
-def _wall_surface(q: NDArray[np.float64], walls: NDArray[np.float64]) -> Surface:
-    """Thick segments: the closest point of the segment, then the half-thickness towards q."""
+def _wall_pairs(q: NDArray[np.float64], walls: NDArray[np.float64]) -> Pairs:
+    """Thick segments, rows (P, 5): the closest point of the segment, then t towards q."""
     start, end = walls[:, 0:2], walls[:, 2:4]
     along = end - start
-    length_sq = np.einsum('kd,kd->k', along, along)
-    reach = np.einsum('nkd,kd->nk', q[:, None, :2] - start, along)
+    length_sq = np.einsum('pd,pd->p', along, along)
+    reach = np.einsum('pd,pd->p', q[:, :2] - start, along)
     with np.errstate(invalid='ignore', divide='ignore'):
         fraction = np.where(length_sq > 0.0, reach / length_sq, 0.0)
-    nearest = start + np.clip(fraction, 0.0, 1.0)[..., None] * along
+    nearest = start + np.clip(fraction, 0.0, 1.0)[:, None] * along
     return _in_plane(q, nearest, walls[:, 4])
 
 
-def _sphere_surface(q: NDArray[np.float64], spheres: NDArray[np.float64]) -> Surface:
-    """Balls: the closest point along the line from the centre."""
-    if len(spheres) == 0:
-        none = np.zeros((len(q), 0, q.shape[1]))
-        return Surface(none, np.zeros((len(q), 0)), none)
-    unit, norm = _toward(q[:, None, :] - spheres[:, :3])
+def _sphere_pairs(q: NDArray[np.float64], spheres: NDArray[np.float64]) -> Pairs:
+    """Balls, rows (P, 4): the closest point along the line from the centre."""
+    unit, norm = _toward(q - spheres[:, :3])
     radius = spheres[:, 3]
-    return Surface(spheres[:, :3] + radius[:, None] * unit, norm - radius, unit)
+    return spheres[:, :3] + radius[:, None] * unit, norm - radius, unit
+
+
+def _apart_sq(q: NDArray[np.float64], centres: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Return the squared distances (N, K) from q (N, dim) to centres (K, 2 or 3), m^2."""
+    apart_sq = np.zeros((len(q), len(centres)))
+    for axis in range(centres.shape[1]):
+        offset = q[:, axis, None] - centres[None, :, axis]
+        apart_sq += offset * offset
+    return apart_sq
+
+
+def _bounds(rows: NDArray[np.float64], pairs: Callable[..., Pairs]
+            ) -> Tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Return each obstacle's centre (K, 2 or 3) and reach (K,): no surface point lies farther."""
+    if pairs is _wall_pairs:
+        along = rows[:, 2:4] - rows[:, 0:2]
+        middle = 0.5 * (rows[:, 0:2] + rows[:, 2:4])
+        return middle, 0.5 * np.linalg.norm(along, axis=1) + rows[:, 4]
+    if pairs is _circle_pairs:
+        return rows[:, :2], rows[:, 2]
+    return rows[:, :3], rows[:, 3]
 
 
 def obstacle_beta(distance: ArrayLike, jump: JumpFunction, clearance: float
@@ -243,8 +327,9 @@ class ObstacleSurfaces(Protocol):
     What the law takes of obstacles (``core.maths.law.obstacle_sum``).
 
     count: obstacles a robot may have; clearance: b_o, m; ``surface(q)``: the
-    :class:`Surface` of every one seen from positions q (N, dim): :class:`Obstacles` (a map)
-    and :class:`HeardObstacles` (points heard) are two.
+    :class:`Surface` of every one seen from positions q (N, dim); ``terms(q, jump, radii)``:
+    the obstacles' part of eq. (13) (:func:`obstacle_terms`), computed as each kind best can:
+    :class:`Obstacles` (a map) and :class:`HeardObstacles` (points heard) are two.
     """
 
     @property
@@ -257,6 +342,10 @@ class ObstacleSurfaces(Protocol):
 
     def surface(self, q: ArrayLike) -> Surface:
         """Return the :class:`Surface` of the obstacles seen from positions q (N, dim)."""
+
+    def terms(self, q: ArrayLike, jump: JumpFunction,
+              sensing_radii: ArrayLike) -> NDArray[np.float64]:
+        """Return :func:`obstacle_terms` of the obstacles at q (N, dim): (N, dim), 1/m."""
 
 
 class Told(NamedTuple):
@@ -385,3 +474,8 @@ class HeardObstacles:
         distances = np.where(listed, depth, np.inf)
         closest = q[:, None, :] - np.where(listed, depth, 0.0)[..., None] * self.normals
         return Surface(closest, distances, self.normals)
+
+    def terms(self, q: ArrayLike, jump: JumpFunction,
+              sensing_radii: ArrayLike) -> NDArray[np.float64]:
+        """Return :func:`obstacle_terms` of the K robots from what they heard: (K, dim), 1/m."""
+        return obstacle_terms(q, self.surface(q), jump, self.clearance, sensing_radii)

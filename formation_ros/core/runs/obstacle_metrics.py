@@ -44,7 +44,7 @@ def obstacle_clearances(q: ArrayLike, obstacles: Obstacles,
     """
     q = np.asarray(q, dtype=float)
     steps, n, dim = q.shape
-    distances = obstacles.surface(q.reshape(-1, dim)).distances
+    distances = obstacles.distances(q.reshape(-1, dim))
     gaps: NDArray[np.float64] = distances.reshape(steps, n, obstacles.count) - body_radius
     return gaps
 
