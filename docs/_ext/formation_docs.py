@@ -165,7 +165,8 @@ def formation_topics() -> List[Tuple[str, str, str]]:
     found = [(t.name.replace(topics.robot_namespace(1), ROBOT_PLACEHOLDER), t.type_name,
               qos_text(qos.BY_KIND[t.qos]))
              for t in (topics.recorded_topics(1, markers=True) + topics.team_topics()
-                       + topics.obstacle_topics(1) + topics.world_topics(1, wheeled=True))]
+                       + topics.obstacle_topics(1) + topics.world_topics(1, wheeled=True)
+                       + [topics.scan_topic(1)])]
     found.append((topics.PARAMS, 'std_msgs/msg/String', 'bag only (written by the recorder)'))
     return found
 

@@ -79,10 +79,6 @@ stats)."""
 CHUNK_PERIOD = 1.0
 ODOMETRY_HEIGHT = 0.0
 """The height of an odometry pose, m: wheel odometry is planar."""
-SCAN = 'scan'
-"""A robot's laser scan topic, ``/robot_<i>/scan`` (a TurtleBot3's ``/scan`` in its namespace)."""
-SCAN_FRAME = 'base_scan'
-"""A robot's scanner frame, ``robot_<i>/base_scan``: at its pose body's position, x forward."""
 HEARD_KEPT = 256
 """States kept per robot to read a held command at the orientation it answered: 5 s at 50 Hz,
 more than a command is ever held (``world.cmd_timeout``)."""
@@ -150,9 +146,9 @@ class WorldNode(Node):
         scanner = self.engine.scanner
         self.steps_per_scan = 0 if scanner is None else steps_per_scan(self.world)
         self.scan_time = 0.0 if scanner is None else scan_period(self.world)
-        self.scan_frames = [f'{robot_name(i)}/{SCAN_FRAME}' for i in range(1, self.n + 1)]
+        self.scan_frames = [f'{robot_name(i)}/{topics.SCAN_FRAME}' for i in range(1, self.n + 1)]
         self.scan_pubs = [] if scanner is None else [self.create_publisher(
-            LaserScan, topics.robot_topic(i, SCAN), qos.MEASUREMENT)
+            LaserScan, topics.robot_topic(i, topics.SCAN), qos.MEASUREMENT)
             for i in range(1, self.n + 1)]
         self.diagnostics_pub = self.create_publisher(DiagnosticArray, topics.DIAGNOSTICS,
                                                      qos.DIAGNOSTICS)

@@ -44,6 +44,10 @@ MEASURED_POSE = 'measured_pose'
 source, ``relay.source_topic``): what a motion-capture driver gives a lab."""
 ODOM = 'odom'
 """The world's wheel odometry of a differential-drive robot i, ``/robot_<i>/odom``."""
+SCAN = 'scan'
+"""A world robot's laser scan, ``/robot_<i>/scan`` (a TurtleBot3's ``/scan`` in its namespace)."""
+SCAN_FRAME = 'base_scan'
+"""A world robot's scanner frame, ``robot_<i>/base_scan``: at its body's position, x forward."""
 MEASUREMENT_TYPES: Dict[str, str] = {
     'pose': 'geometry_msgs/msg/PoseStamped',
     'odometry': 'nav_msgs/msg/Odometry',
@@ -133,6 +137,11 @@ def world_topics(robot_id: int, wheeled: bool) -> List[Topic]:
         found.append(Topic(robot_topic(robot_id, ODOM), MEASUREMENT_TYPES['odometry'],
                            QosKind.MEASUREMENT))
     return found
+
+
+def scan_topic(robot_id: int) -> Topic:
+    """Return the laser scan the ``world`` node publishes for robot ``robot_id`` (planar)."""
+    return Topic(robot_topic(robot_id, SCAN), 'sensor_msgs/msg/LaserScan', QosKind.MEASUREMENT)
 
 
 def recorded_topics(num_robots: int, markers: bool, stamped_commands: bool = True,
