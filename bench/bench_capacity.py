@@ -6,7 +6,7 @@ Capacity benchmark: how many robots, at what rate, on this machine (on demand, n
 
 Usage: python bench/bench_capacity.py [--sizes 10 20 50 100] [--rates 20 50]
 [--modes process fleet] [--transport robot team] [--robots-per-process 25] [--measure 20]
-[--reference-rate 10] [--lockstep] [--prefix INSTALL] [--out DIR] [--keep]
+[--reference-rate 10] [--obstacles K] [--lockstep] [--prefix INSTALL] [--out DIR] [--keep]
 or:    python bench/bench_capacity.py --figure JSON... --out DIR
 
 For each transport, mode, team size N and control rate it runs scripts/launch_formation.sh on
@@ -15,7 +15,10 @@ apart), control_rate and plant.publish_rate = RATE, reference.rate 10 Hz (robots
 time evaluate the reference themselves and only check its samples), plant.rate 100 Hz, one
 process per robot ('process') or --robots-per-process robots per 'fleet' process ('fleet'),
 with the per-robot topics ('robot', the default) or the team messages ('team': one state message,
-one command message per process per state; parameter transport). It byte-compiles the
+one command message per process per state; parameter transport). With --obstacles K it adds
+K pillars of radius 0.2 m at the centres of the goal lattice's cells outside the start disc
+(bench_obstacles.lattice_pillars: 1.41 m from the nearest places) with b_o = 0.5 m, so the
+plant tells every robot its obstacles with every state. It byte-compiles the
 install first, then measures the start-up (launch until the plant starts its clock: every
 robot has answered; and the CPU time of every process until then), then for MEASURE wall
 seconds the CPU time and memory of every process of the run (resident, RSS, and
@@ -48,6 +51,7 @@ ROOT = os.path.dirname(BENCH)
 sys.path[:0] = [ROOT, BENCH]
 
 from bench_core import params_for  # noqa: E402
+from bench_obstacles import CLEARANCE, lattice_pillars  # noqa: E402
 from bench_soak import (find_run_processes, LAUNCHER, read_pss_kib,  # noqa: E402
                         read_rss_kib)
 from formation_ros.core.settings.declarations import BY_NAME  # noqa: E402, I100
@@ -94,6 +98,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument('--reference-rate', type=float, default=REFERENCE_RATE,
                         help='reference.rate, Hz; 0: the control rate, a sample per state '
                              '(default: %(default)g)')
+    parser.add_argument('--obstacles', type=int, default=0, metavar='K',
+                        help='K pillars among the goal places, outside the start, b_o '
+                             f'{CLEARANCE:g} m (default: %(default)s)')
     parser.add_argument('--lockstep', action='store_true',
                         help='run the plant in lockstep and report steps per second')
     parser.add_argument('--prefix', default=os.path.join(ROOT, 'install', 'formation_ros'),
@@ -115,6 +122,8 @@ def parse_args(argv: Optional[Sequence[str]] = None) -> argparse.Namespace:
     args = parser.parse_args(argv)
     if min(args.sizes) < 1 or args.robots_per_process < 1:
         parser.error('--sizes and --robots-per-process must be >= 1')
+    if args.obstacles < 0:
+        parser.error('--obstacles must be >= 0')
     if min(args.rates) <= 0.0 or max(args.rates) > PLANT_RATE:
         parser.error(f'--rates must be > 0 and at most the plant rate, {PLANT_RATE:g} Hz')
     if not args.measure > 0.0 or not args.startup_timeout > 0.0:
@@ -159,17 +168,21 @@ def fresh_fraction(age_steps: Sequence[int], max_age: int) -> Optional[float]:
 
 def case_params(n: int, rate: float, lockstep: bool, transport: str = 'robot',
                 parameter_services: bool = True,
-                reference_rate: float = REFERENCE_RATE) -> Dict[str, Any]:
+                reference_rate: float = REFERENCE_RATE, obstacles: int = 0) -> Dict[str, Any]:
     """
     Parameters of one case (Section 5 constants, N robots, control and publish at RATE).
 
-    reference_rate: reference.rate, Hz (0: RATE).
+    reference_rate: reference.rate, Hz (0: RATE). obstacles: pillars among the goal places
+    (fewer where the lattice has fewer cells outside the start; none for 0).
     """
     params = params_for(n)
     params.update({'control_rate': float(rate), 'plant.publish_rate': float(rate),
                    'reference.rate': float(reference_rate or rate), 'plant.rate': PLANT_RATE,
                    'duration': 1e4,
                    'transport': transport, 'fleet.parameter_services': parameter_services})
+    if obstacles:
+        params.update({'obstacles.circles': lattice_pillars(params, obstacles),
+                       'obstacles.clearance': CLEARANCE})
     if lockstep:
         params.update({'plant.lockstep': True, 'plant.realtime_factor': 1e3})
     return params
@@ -211,8 +224,9 @@ def run_case(args: argparse.Namespace, mode: str, n: int, rate: float,
              folder: str, transport: str = 'robot') -> Dict[str, Any]:
     """Run one case and return its row."""
     params = os.path.join(folder, 'params.yaml')
-    write_params_file(params, case_params(n, rate, args.lockstep, transport,
-                                          args.parameter_services, args.reference_rate))
+    case = case_params(n, rate, args.lockstep, transport, args.parameter_services,
+                       args.reference_rate, args.obstacles)
+    write_params_file(params, case)
     run_dir = os.path.join(folder, 'run')
     log = os.path.join(folder, 'launcher.txt')
     command = ['bash', os.path.join(ROOT, 'scripts', 'launch_formation.sh'), params,
@@ -222,7 +236,8 @@ def run_case(args: argparse.Namespace, mode: str, n: int, rate: float,
     row: Dict[str, Any] = {'transport': transport, 'mode': mode, 'robots': n, 'rate_hz': rate,
                            'lockstep': args.lockstep,
                            'reference_rate_hz': args.reference_rate or rate,
-                           'parameter_services': args.parameter_services}
+                           'parameter_services': args.parameter_services,
+                           'obstacles': len(case.get('obstacles.circles', ())) // 3}
     with open(log, 'wb') as output:
         started = time.monotonic()
         process = subprocess.Popen(command, stdout=output, stderr=subprocess.STDOUT,
@@ -260,6 +275,9 @@ def run_case(args: argparse.Namespace, mode: str, n: int, rate: float,
     two_periods = int(round(2.0 * PLANT_RATE / rate))
     row['fresh_fraction'] = fresh_fraction(stats['command_age_steps'], two_periods)
     row['latency_ms'] = stats['answer_latency']
+    if row['obstacles']:
+        row['obstacle_contacts'] = stats.get('obstacle_contacts')
+        row['min_obstacle_gap'] = stats.get('min_obstacle_gap')
     return row
 
 
@@ -280,7 +298,11 @@ def format_row(row: Mapping[str, Any]) -> str:
     reference = row.get('reference_rate_hz', rate)
     shown = f'{rate:g}' + (f', reference {reference:g}' if reference != rate else '')
     head = f"| {row['mode']}{lean} | {row['robots']} | {shown} |"
-    transport = f" {row.get('transport', 'robot')} |"
+    pillars = row.get('obstacles', 0)
+    contacts = row.get('obstacle_contacts')
+    transport = (f" {row.get('transport', 'robot')}"
+                 + (f', {pillars} pillars' if pillars else '')
+                 + ('' if contacts is None else f', {contacts} contacts') + ' |')
     if 'error' in row:
         return head + f" {row['error']} |" + ' |' * 9 + transport
     latency = row['latency_ms']

@@ -10,6 +10,7 @@ import subprocess
 import sys
 import time
 
+from formation_ros.core.settings.params import validate
 import numpy as np
 import pytest
 
@@ -266,7 +267,8 @@ def test_capacity_benchmark_refuses_bad_arguments(fake_install, tmp_path):
                        (['--sizes', '0'], '--sizes and --robots-per-process must be >= 1'),
                        (['--measure', '0'], '--measure and --startup-timeout must be > 0'),
                        (['--reference-rate', '-1'], '--reference-rate must be 0'),
-                       (['--reference-rate', '2'], 'above 2 Hz')):
+                       (['--reference-rate', '2'], 'above 2 Hz'),
+                       (['--obstacles', '-1'], '--obstacles must be >= 0')):
         result = subprocess.run([sys.executable, script, *args, '--prefix', str(fake_install),
                                  '--out', str(tmp_path / 'out')],
                                 capture_output=True, text=True, timeout=120)
@@ -288,6 +290,23 @@ def test_capacity_rows_name_a_reference_rate_other_than_the_control_rate():
         '| process | 20 | 50, reference 10 | 22 |')
     assert capacity.case_params(20, 50.0, False)['reference.rate'] == 10.0
     assert capacity.case_params(20, 50.0, False, reference_rate=0.0)['reference.rate'] == 50.0
+
+
+def test_capacity_pillars_are_valid_among_the_team_and_named_in_the_row():
+    capacity = load_bench(os.path.join(ROOT, 'bench', 'bench_capacity.py'))
+    assert 'obstacles.circles' not in capacity.case_params(100, 50.0, False, 'team')
+    params = capacity.case_params(100, 50.0, False, 'team', obstacles=20)
+    config = validate(params)  # no start touching, no place within b_o
+    assert config.obstacles is not None and config.obstacles.count == 20
+    centres = np.array(params['obstacles.circles']).reshape(-1, 3)[:, :2]
+    places = np.array(params['formation.vertices']).reshape(-1, 2)
+    assert np.all(np.abs(centres) <= np.abs(places).max())  # among the places
+    row = {'mode': 'fleet', 'robots': 100, 'rate_hz': 50.0, 'processes': 6, 'startup_s': 4.0,
+           'step_rate': 99.8, 'fresh_fraction': 1.0, 'cpu_percent': {'plant': 16.0},
+           'rss_mib': {'plant': 132.0}, 'transport': 'team', 'obstacles': 20,
+           'obstacle_contacts': 0,
+           'latency_ms': {'p50_ms': 3.5, 'p99_ms': 10.0, 'max_ms': 45.0}}
+    assert capacity.format_row(row).endswith('| team, 20 pillars, 0 contacts |')
 
 
 def test_capacity_figure_is_drawn_from_earlier_results_alone(tmp_path):
