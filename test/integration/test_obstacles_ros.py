@@ -71,9 +71,6 @@ def test_robots_go_round_a_pillar_they_are_told_of(processes, install, probe, tm
     stats = json.loads((out / 'plant_stats.json').read_text())
     assert stats['obstacle_contacts'] == 0 and stats['min_obstacle_gap'] > 0.0, stats
     assert commands and np.max(np.abs(commands)) <= bound + 1e-9
-    passed = [m.pose.position for m in poses[1].values()]
-    assert min(np.hypot(p.x, p.y) for p in passed) > 0.3, 'robot 1 went round, not through'
-    assert max(p.x for p in passed) > 0.9 and min(p.x for p in passed) < -1.0
 
     both = [stamp for stamp in told[1] if stamp in poses[1]]
     assert len(both) > 50, (len(told[1]), len(poses[1]))
@@ -96,6 +93,11 @@ def test_robots_go_round_a_pillar_they_are_told_of(processes, install, probe, tm
 
     run = Trajectory.load(str(out / 'trajectory.npz'))
     assert len(run.t) > 200
+    # Robot 1's whole path from the plant's run: with the team transport the probe hears its
+    # own pose topic only once the plant has seen the probe listen (topics made on demand).
+    path = run.q[:, 0]
+    assert np.min(np.hypot(path[:, 0], path[:, 1])) > 0.3, 'robot 1 went round, not through'
+    assert np.max(path[:, 0]) > 0.9 and np.min(path[:, 0]) < -1.0
     dt, law, grown = config.plant.step_ns * 1e-9, config.law(), config.law_obstacles()
     q = run.q[0]
     for k in range(len(run.t) - 1):
