@@ -214,15 +214,22 @@ def test_the_command_stays_bounded_on_and_inside_obstacles():
     assert command.u_hat[0, 1] == pytest.approx(law.u_bound)
 
 
+def random_map(rng, dim, side, counts):
+    """Return random circles, walls and (3D) spheres, ``counts`` of each, within +-side m."""
+    circles = np.column_stack([rng.uniform(-side, side, (counts[0], 2)),
+                               rng.uniform(0.1, 0.6, counts[0])])
+    walls = np.column_stack([rng.uniform(-side, side, (counts[1], 4)),
+                             rng.uniform(0.05, 0.2, counts[1])])
+    spheres = (np.column_stack([rng.uniform(-side, side, (counts[2], 3)),
+                                rng.uniform(0.2, 0.8, counts[2])]) if dim == 3 else [])
+    return Obstacles(circles, walls, spheres, 0.9, dim)
+
+
 @pytest.mark.parametrize('dim', [2, 3])
 def test_the_terms_measured_near_only_are_the_terms_of_every_surface(dim):
     """Obstacles.terms skips far pairs: the same sums as obstacle_terms of the whole surface."""
     rng = np.random.default_rng(7 + dim)
-    circles = np.column_stack([rng.uniform(-8.0, 8.0, (30, 2)), rng.uniform(0.1, 0.6, 30)])
-    walls = np.column_stack([rng.uniform(-8.0, 8.0, (6, 4)), rng.uniform(0.05, 0.2, 6)])
-    spheres = (np.column_stack([rng.uniform(-8.0, 8.0, (5, 3)), rng.uniform(0.2, 0.8, 5)])
-               if dim == 3 else [])
-    obstacles = Obstacles(circles, walls, spheres, 0.9, dim)
+    obstacles = random_map(rng, dim, 8.0, (30, 6, 5))
     q = rng.uniform(-9.0, 9.0, size=(400, dim))
     radii = rng.uniform(0.5, 2.0, size=len(q))
     jump = make_jump('poly', 2)
@@ -235,11 +242,7 @@ def test_the_terms_measured_near_only_are_the_terms_of_every_surface(dim):
 @pytest.mark.parametrize('dim', [2, 3])
 def test_the_distances_alone_are_the_surfaces_distances(dim):
     rng = np.random.default_rng(11 + dim)
-    circles = np.column_stack([rng.uniform(-5.0, 5.0, (8, 2)), rng.uniform(0.1, 0.6, 8)])
-    walls = np.column_stack([rng.uniform(-5.0, 5.0, (3, 4)), rng.uniform(0.05, 0.2, 3)])
-    spheres = (np.column_stack([rng.uniform(-5.0, 5.0, (2, 3)), rng.uniform(0.2, 0.8, 2)])
-               if dim == 3 else [])
-    obstacles = Obstacles(circles, walls, spheres, 0.9, dim)
+    obstacles = random_map(rng, dim, 5.0, (8, 3, 2))
     q = rng.uniform(-6.0, 6.0, size=(200, dim))
     assert np.allclose(obstacles.distances(q), obstacles.surface(q).distances, rtol=0.0,
                        atol=1e-12)
