@@ -21,7 +21,7 @@ docs/ros_interface.md.
 """
 
 import time
-from typing import Any, Dict, List, Optional
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.maths.unicycle import quaternions_from_headings
@@ -387,24 +387,29 @@ class WorldNode(Node):
 
     def _log_contacts(self) -> None:
         """Log each new contact (two robots; a robot and an obstacle) once, with its time."""
-        events = self.engine.contacts.events
-        for number in range(self.contacts_logged + 1, min(len(events), CONTACT_LINES) + 1):
-            event = events[number - 1]
-            last = ('; further contacts are counted in /diagnostics only'
-                    if number == CONTACT_LINES else '')
-            self.get_logger().error(f'contact {number}: robots {event.i} and {event.j} '
-                                    f'touched at t = {event.t:.3f} s{last}')
-        self.contacts_logged = len(events)
-        hits = self.engine.obstacle_contacts.events
         labels = self.engine.labels
-        for number in range(self.obstacle_contacts_logged + 1,
-                            min(len(hits), CONTACT_LINES) + 1):
-            hit = hits[number - 1]
-            last = ('; further contacts with obstacles are counted in /diagnostics only'
+        self.contacts_logged = self._log_new(
+            self.engine.contacts.events, self.contacts_logged, ('contact', 'contacts'),
+            lambda event: f'robots {event.i} and {event.j} touched at t = {event.t:.3f} s')
+        self.obstacle_contacts_logged = self._log_new(
+            self.engine.obstacle_contacts.events, self.obstacle_contacts_logged,
+            ('obstacle contact', 'contacts with obstacles'),
+            lambda hit: f'robot {hit.robot} touched {labels[hit.obstacle]} at t = {hit.t:.3f} s')
+
+    def _log_new(self, events: Sequence[Any], logged: int, names: Tuple[str, str],
+                 line: Callable[[Any], str]) -> int:
+        """
+        Log the events after the first ``logged``, up to CONTACT_LINES; return how many there are.
+
+        names: (one, the rest), e.g. ('contact', 'contacts'): how a line and the last line's
+        note name them; line: the text of an event.
+        """
+        one, rest = names
+        for number in range(logged + 1, min(len(events), CONTACT_LINES) + 1):
+            last = (f'; further {rest} are counted in /diagnostics only'
                     if number == CONTACT_LINES else '')
-            self.get_logger().error(f'obstacle contact {number}: robot {hit.robot} touched '
-                                    f'{labels[hit.obstacle]} at t = {hit.t:.3f} s{last}')
-        self.obstacle_contacts_logged = len(hits)
+            self.get_logger().error(f'{one} {number}: {line(events[number - 1])}{last}')
+        return len(events)
 
     def on_diagnostics(self) -> None:
         """Publish the world's status: time, step rate, real-time factor, contacts, refusals."""

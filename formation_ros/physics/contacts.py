@@ -165,7 +165,7 @@ class ObstacleContactEvent:
 def obstacle_gaps(obstacles: Obstacles, positions: NDArray[np.float64],
                   footprint: float) -> NDArray[np.float64]:
     """Return each body's gap to each obstacle's surface (N, M), m: footprint radius subtracted."""
-    gaps: NDArray[np.float64] = obstacles.surface(positions).distances - footprint
+    gaps: NDArray[np.float64] = obstacles.distances(positions) - footprint
     return gaps
 
 

@@ -316,7 +316,7 @@ def log_obstacle_factor(q: ArrayLike, obstacles: Obstacles, jump: JumpFunction,
     Its gradient with respect to q_i is kappa times minus the sum of :func:`obstacle_terms`
     (every obstacle counted, whatever R_i): the check of the terms. +inf at a contact.
     """
-    distances = obstacles.surface(q).distances
+    distances = obstacles.distances(q)
     with np.errstate(divide='ignore'):
         logs = np.log(obstacle_beta(distances, jump, obstacles.clearance))
     return -kappa * float(np.sum(logs))
@@ -374,7 +374,7 @@ def told_obstacles(obstacles: Obstacles, positions: ArrayLike, control_points: A
     control point, with the outward normal there (docs/ros_interface.md, "Obstacles").
     """
     radii = np.asarray(sensing_radii, dtype=float).reshape(-1, 1)
-    listed = obstacles.surface(positions).distances < radii
+    listed = obstacles.distances(positions) < radii
     closest = obstacles.surface(control_points)
     return Told(listed, closest.points, closest.normals)
 

@@ -45,7 +45,7 @@ class ObstacleWatch:
         A line for each robot-obstacle pair that comes into contact (its gap <= 0): logged
         once, counted once until the pair is apart again.
         """
-        gaps = self.obstacles.surface(q).distances - self.body_radius
+        gaps = self.obstacles.distances(q) - self.body_radius
         if gaps.size:
             self.min_gap = min(self.min_gap, float(gaps.min()))
         touching = gaps <= 0.0

@@ -721,14 +721,14 @@ def _obstacle_places(obstacles: Obstacles, body: BodySettings,
         points = start
         if body.is_unicycle and headings is not None:
             points = make_bodies(body).control_points(start, headings)
-        distances = grown.surface(points).distances
+        distances = grown.distances(points)
         i, o = np.unravel_index(int(np.argmin(distances)), distances.shape)
         if distances[i, o] <= 0.0:
             problems.append(('start.positions', f'robot {i + 1} starts touching {labels[o]} '
                                                 f'({where} {distances[i, o]:.4g} m from its '
                                                 'surface)'))
     if rest is not None:
-        distances = grown.surface(rest).distances
+        distances = grown.distances(rest)
         i, o = np.unravel_index(int(np.argmin(distances)), distances.shape)
         if distances[i, o] < obstacles.clearance:
             problems.append(('obstacles.clearance', f"robot {i + 1}'s place in the formation "
