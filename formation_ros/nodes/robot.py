@@ -28,20 +28,21 @@ from formation_ros.core.maths.law import Command
 from formation_ros.core.maths.obstacles import MAX_TOLD, quaternion_normals
 from formation_ros.core.maths.units import NS_PER_S
 from formation_ros.core.rules.admission import Reason
-from formation_ros.core.rules.answers import AnswerPolicy
+from formation_ros.core.rules.answers import AnswerPolicy, INPUTS
 from formation_ros.core.rules.control import Control, Sensed
 from formation_ros.core.rules.reference_track import ReferenceTrack
 from formation_ros.core.rules.robot_core import Answer, Note, RobotCore, Said, Wake as Due
 from formation_ros.core.rules.robot_intake import Refused, StateIntake
 from formation_ros.core.rules.robot_status import startup_line, status_level, status_values
+from formation_ros.core.rules.scan_obstacles import MAX_RAYS, ScanObstacles
 from formation_ros.core.runs.timeline import Shape, TeamState
 from formation_ros.core.settings.declarations import CommandFrame, Exe, PoseType
 from formation_ros.core.settings.names import robot_name
 from formation_ros.core.settings.team import reference_values, team_values
 from formation_ros.nodes.robots_link import Linked, RobotsLink
 from formation_ros.ros import messages, qos, topics
-from formation_ros.ros.cdr import (PoseArrayData, PoseData, read_odometry, read_pose_array,
-                                   read_pose_stamped, StatusData)
+from formation_ros.ros.cdr import (PoseArrayData, PoseData, read_laser_scan, read_odometry,
+                                   read_pose_array, read_pose_stamped, StatusData)
 from formation_ros.ros.changes import Changes
 from formation_ros.ros.command_output import CmdVel, CmdVelOutput, Output
 from formation_ros.ros.diagnostics import encode_statuses, make_status, PERIOD
@@ -60,6 +61,7 @@ import rclpy
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
 from rclpy.publisher import Publisher
+from sensor_msgs.msg import LaserScan
 
 LAST_WORD = 0.5
 """How long a stopping robot waits for its last (zero) command to be received, s."""
@@ -112,12 +114,18 @@ class RobotNode(Node):
             self.once, leader.inputs.expected if shares and leader is not None else {})
         period = settings.answer_period(self.sim_time)
         self.watch_ns = max(1, int(round(NS_PER_S / settings.control_rate)))
+        self.scan = (None if settings.scan is None else
+                     ScanObstacles(settings.scan, self.sensing_radius, config.body.radius))
+        """This robot's obstacles from its own scans (``obstacles.source: scan``), or None."""
         self.policy = AnswerPolicy(max(1, int(round(period * NS_PER_S))), self.timeout_ns,
-                                   self.watch_ns, settings.wait_for_subscribers)
+                                   self.watch_ns, settings.wait_for_subscribers,
+                                   INPUTS if self.scan is None else INPUTS + ('scan',))
         self.pose: Optional[PoseData] = None
         self.neighbours: Optional[PoseArrayData] = None
         self.obstacles: Optional[PoseArrayData] = None
         """The latest obstacles admitted (None: none heard: the law as without obstacles)."""
+        self.unplaced_stamp: Optional[int] = None
+        """The stamp of the latest scan counted as unplaced (counted once)."""
         self.core: Optional[RobotCore] = None
         """What decides this robot's answers (a link's first robot: all of its robots'); None
         for a link's other robots, answered by the first."""
@@ -133,6 +141,9 @@ class RobotNode(Node):
         """The policy of the robot that answers for this one (its link's leader, or itself)."""
         if not config.team_transport:
             self._subscribe_to_states(settings.pose_type)
+        if self.scan is not None:
+            self.create_subscription(LaserScan, topics.SCAN, self.on_scan, qos.MEASUREMENT,
+                                     raw=True)
         if shares and leader is not None:
             self.first = leader
             leader.followers.append(self)
@@ -201,7 +212,7 @@ class RobotNode(Node):
                                      raw=True)
         self.create_subscription(PoseArray, topics.NEIGHBOURS, self.on_neighbours,
                                  qos.STATE_INPUT, raw=True)
-        if self.config.obstacle_clearance is not None:
+        if self.config.obstacle_clearance is not None and self.scan is None:
             self.create_subscription(PoseArray, topics.OBSTACLES, self.on_obstacles,
                                      qos.STATE_INPUT, raw=True)
 
@@ -231,8 +242,11 @@ class RobotNode(Node):
     def _store_pose(self, pose: PoseData) -> None:
         state = PoseArrayData(pose.stamp_ns, pose.frame_id, np.array([pose.position]),
                               np.array([pose.orientation]))
-        if self.admit_state('pose', state, self.needs_orientation, pose.finite):
+        if self.admit_state('pose', state, self.needs_orientation or self.scan is not None,
+                            pose.finite):
             self.pose = pose
+            if self.scan is not None:
+                self.scan.pose_heard(pose.stamp_ns, pose.position, pose.orientation)
             assert self.core is not None
             self._arm(self.core.pose_heard(pose.stamp_ns, self.now_ns()))
 
@@ -264,6 +278,30 @@ class RobotNode(Node):
         self.obstacles = heard
         assert self.core is not None
         self._arm(self.core.obstacles_heard(heard.stamp_ns, self.now_ns()))
+
+    def on_scan(self, data: bytes) -> None:
+        """
+        Keep the latest scan, read from the serialized LaserScan (untrusted).
+
+        Admitted in ``obstacles.scan_frame``, with at most MAX_RAYS rays, readable fields, no
+        NaN or -inf range and a stamp on this robot's clock (within input_timeout); placed in
+        the world frame when a state is answered (``core.rules.scan_obstacles``).
+        """
+        scan = self.inputs.read('scan', lambda raw: read_laser_scan(raw, MAX_RAYS), data)
+        if scan is None or self.scan is None:
+            return
+        refused = self.scan.refusal(scan)
+        clock_ns = self.get_clock().now().nanoseconds
+        gap = self.inputs.intake.gap_ns(scan.stamp_ns, clock_ns, False)
+        if refused is None and abs(gap) > self.timeout_ns:
+            refused = Refused(Reason.CLOCK, gap_s=gap / NS_PER_S)
+        if refused is not None:
+            self.inputs.refuse('scan', refused)
+            return
+        self.inputs.on_clock('scan', 'scan messages on this clock again')
+        self.scan.scan_heard(scan)
+        assert self.core is not None
+        self.core.scan_heard(self.now_ns())
 
     def _arm(self, due: Due) -> None:
         """Arm the answer when the core says it is due."""
@@ -324,16 +362,37 @@ class RobotNode(Node):
         """Admit reference samples as fast as the reference in force may be."""
         self.track.widen(state.reference(self.config.reference()).rate_limits())
 
-    def _sensed_alone(self) -> Sensed:
-        """Return what this robot knows of the state stored (``Control.alone``)."""
+    def _alone(self) -> Sensed:
+        """Return this robot's own point and its neighbours' of the state stored."""
         assert self.pose is not None and self.neighbours is not None
-        sensed = self.control.alone(self.index, self.pose.position, self.pose.orientation,
-                                    self.neighbours.positions, self.neighbours.orientations)
+        return self.control.alone(self.index, self.pose.position, self.pose.orientation,
+                                  self.neighbours.positions, self.neighbours.orientations)
+
+    def _sensed_alone(self) -> Sensed:
+        """Return what this robot knows of the state stored, its obstacles with it."""
+        sensed = self._alone()
+        if self.scan is not None:
+            return self._scanned(sensed)
         if self.obstacles is None:
             return sensed
         heard = self.control.heard_obstacles([(self.obstacles.positions,
                                                self.obstacles.orientations)])
         return dataclasses.replace(sensed, obstacles=heard)
+
+    def _scanned(self, sensed: Sensed) -> Sensed:
+        """Give ``sensed`` the obstacles of the latest scan; unseen if it cannot be placed."""
+        assert self.scan is not None and self.pose is not None and self.neighbours is not None
+        placed = self.scan.place(self.timeout_ns)
+        if placed is None:
+            stamp = None if self.scan.scan is None else self.scan.scan.stamp_ns
+            if stamp is not None and stamp != self.unplaced_stamp:
+                self.unplaced_stamp = stamp
+                self.inputs.refuse('scan', Refused(Reason.UNPLACED))
+            return dataclasses.replace(sensed, unseen='its scan cannot be placed')
+        points, normals = self.scan.obstacles(placed, self.pose.position, sensed.points[0],
+                                              self.neighbours.positions)
+        return dataclasses.replace(sensed, obstacles=self.control.scanned_obstacles(points,
+                                                                                    normals))
 
     def on_state(self) -> None:
         """Answer a state as soon as its pose and neighbours are in (armed by the callbacks)."""
@@ -406,13 +465,15 @@ class RobotNode(Node):
         policy, now = self.answering, self.now_ns()
         points = None
         if self.neighbours is not None and self.pose is not None:
-            sensed = self._sensed_alone()
+            sensed = self._alone()
             points = np.vstack([sensed.points, sensed.neighbours])
         values = status_values({name: None if heard is None else (now - heard) / NS_PER_S
                                 for name, heard in self.policy.received_ns.items()}, points,
                                self.sensing_radius, self.law.repulsion_radius, self.last,
                                self.unicycle)
         values['bound c*M1 [m/s]'] = self.law.u_bound
+        if self.scan is not None:
+            values['obstacle points from the scan'] = self.scan.kept
         values.update(self._announcement(self.pose.stamp_ns if self.pose is not None else 0))
         values.update({f'rejected {name} messages ({reason.value})': count
                        for (name, reason), count in self.inputs.refused.items()})

@@ -38,7 +38,7 @@ from formation_ros.core.runs.trajectory import TRAJECTORY_FILE
 from formation_ros.core.runs.world_stats import WORLD_STATS_FILE
 from formation_ros.core.settings.declarations import CommandFrame, Exe
 from formation_ros.core.settings.exits import ENGINE_FAILED, REFUSED
-from formation_ros.core.settings.names import robot_name
+from formation_ros.core.settings.names import scan_frame
 from formation_ros.core.settings.params import world_size_problem
 from formation_ros.physics.engine import Engine, Unstable, unstable_line
 from formation_ros.physics.intake import CommandInbox
@@ -146,7 +146,7 @@ class WorldNode(Node):
         scanner = self.engine.scanner
         self.steps_per_scan = 0 if scanner is None else steps_per_scan(self.world)
         self.scan_time = 0.0 if scanner is None else scan_period(self.world)
-        self.scan_frames = [f'{robot_name(i)}/{topics.SCAN_FRAME}' for i in range(1, self.n + 1)]
+        self.scan_frames = [scan_frame(i) for i in range(1, self.n + 1)]
         self.scan_pubs = [] if scanner is None else [self.create_publisher(
             LaserScan, topics.robot_topic(i, topics.SCAN), qos.MEASUREMENT)
             for i in range(1, self.n + 1)]

@@ -30,6 +30,7 @@ from formation_ros.core.maths.frames import frame_from_pose, FrameSample
 from formation_ros.core.maths.obstacles import normal_quaternions, Told
 from formation_ros.core.maths.unicycle import quaternions_from_headings
 from formation_ros.core.maths.units import NS_PER_S
+from formation_ros.core.rules.scan_obstacles import Scan
 from formation_ros.core.rules.transport import NAME as ROBOT_NAME, robot_indices, state_rows
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -176,6 +177,9 @@ class _Reader:
     def skip_doubles(self, count: int) -> None:
         self._take('', 8 * count, 8)
 
+    def floats(self, count: int) -> Tuple[float, ...]:
+        return self._take(f'{count}f', 4 * count, 4)
+
     def uint32(self) -> int:
         return self._take('I', 4, 4)[0]
 
@@ -256,6 +260,37 @@ def read_odometry(data: bytes, exact: bool = False) -> OdometryData:
     if exact:
         reader.end()
     return OdometryData(stamp_ns, frame_id, child, pose[:3], pose[3:], twist[:3], twist[3:])
+
+
+class TooManyRays(CdrError):
+    """A whole LaserScan header, but more rays than the reader accepts."""
+
+
+def read_laser_scan(data: bytes, max_rays: int) -> Scan:
+    """
+    Read a serialized sensor_msgs/LaserScan; refuse one with more than ``max_rays`` rays.
+
+    The count is checked before the ranges are read (:class:`TooManyRays`); the intensities
+    are checked to be whole and skipped. Raises :class:`CdrError` for anything that is not a
+    whole LaserScan. The ranges are a float64 copy, independent of ``data``.
+    """
+    reader = _Reader(data, 'LaserScan')
+    stamp_ns, frame_id = reader.header()
+    angle_min, _, increment, _, _, range_min, range_max = reader.floats(7)
+    count = reader.uint32()
+    if count > max_rays:
+        raise TooManyRays(f'{count} rays')
+    if reader.offset + 4 * count > len(reader.view):
+        raise CdrError(f'cut short: {count} ranges do not fit in {len(reader.view)} bytes')
+    ranges = np.frombuffer(reader.view, dtype=np.dtype(np.float32).newbyteorder(reader.endian),
+                           count=count, offset=reader.offset).astype(np.float64)
+    reader.offset += 4 * count
+    intensities = reader.uint32()
+    if intensities > max_rays or reader.offset + 4 * intensities > len(reader.view):
+        raise CdrError(f'{intensities} intensities do not fit in {len(reader.view)} bytes')
+    reader.offset += 4 * intensities
+    reader.end()
+    return Scan(stamp_ns, frame_id, angle_min, increment, range_min, range_max, ranges)
 
 
 def _string(text: str) -> bytes:

@@ -16,7 +16,7 @@ from typing import Callable, Dict, Optional, TypeVar
 
 from formation_ros.core.rules.admission import Reason, Refusals
 from formation_ros.core.rules.robot_intake import Refused, StateIntake
-from formation_ros.ros.cdr import CdrError, PoseArrayData, TooManyPoses
+from formation_ros.ros.cdr import CdrError, PoseArrayData, TooManyPoses, TooManyRays
 from formation_ros.ros.once import OnceLog, RefusalLog
 from formation_ros.ros.sim_clock import clock_advice, StateClock
 from formation_ros.ros.team import PublisherWatch
@@ -63,7 +63,7 @@ class InputGate:
         """
         try:
             return reader(data)
-        except TooManyPoses as exc:
+        except (TooManyPoses, TooManyRays) as exc:
             self.refuse(name, Refused(too_many, f' ({exc})'))
         except CdrError as exc:
             self.refuse(name, Refused(Reason.MALFORMED, f' ({exc})'))

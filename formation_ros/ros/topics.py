@@ -46,8 +46,6 @@ ODOM = 'odom'
 """The world's wheel odometry of a differential-drive robot i, ``/robot_<i>/odom``."""
 SCAN = 'scan'
 """A world robot's laser scan, ``/robot_<i>/scan`` (a TurtleBot3's ``/scan`` in its namespace)."""
-SCAN_FRAME = 'base_scan'
-"""A world robot's scanner frame, ``robot_<i>/base_scan``: at its body's position, x forward."""
 MEASUREMENT_TYPES: Dict[str, str] = {
     'pose': 'geometry_msgs/msg/PoseStamped',
     'odometry': 'nav_msgs/msg/Odometry',

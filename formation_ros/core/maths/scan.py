@@ -4,12 +4,14 @@
 """
 A planar laser scan as obstacle points: returns in the world frame, neighbours left out, thinned.
 
-Beyond the paper (issue 37, groundwork: no node reads scans yet). A robot that senses obstacles
-with its own scanner turns each return into a point in the world frame with its pose at the
-scan's stamp; returns on a known neighbour's body are the pair terms' business and are left
-out; the rest within R_i become the surface points p_io of ``core.maths.obstacles``, at most
-one per sector of directions about the robot (the nearest), so that the law's cost stays
-bounded whatever the scanner's resolution.
+Beyond the paper (docs/equations.md, "Obstacles from a scan"). A robot that senses obstacles
+with its own scanner (``obstacles.source: scan``) turns each return into a point in the world
+frame with its pose at the scan's stamp; returns on a known neighbour's body are the pair
+terms' business and are left out; the rest within R_i become the surface points p_io of
+``core.maths.obstacles``, at most one per sector of directions about the robot (the nearest),
+so that the law's cost stays bounded whatever the scanner's resolution, each with the normal
+that faces the robot (:func:`facing_normals`): a return is a point obstacle.
+``core.rules.scan_obstacles`` keeps the scans and poses and applies these in order.
 
 Angles in rad, counter-clockwise from the scanner's +x; ranges and positions in m. Nothing here
 modifies its arguments.
@@ -130,3 +132,20 @@ def nearest_by_sector(points: ArrayLike, centre: ArrayLike, radius: float,
     first[1:] = sector[order][1:] != sector[order][:-1]
     nearest: NDArray[np.float64] = p[order[first]]
     return nearest
+
+
+def facing_normals(points: ArrayLike, control_point: ArrayLike) -> NDArray[np.float64]:
+    """
+    Return the unit normals (K, 2) of point obstacles ``points`` (K, 2) facing ``control_point``.
+
+    control_point: (2,) the point the law acts on, m. The normal of return p is
+    ``(q - p) / |q - p|``: ``core.maths.obstacles.HeardObstacles`` then puts the robot at
+    ``|q - p| - f`` from it, the distance from its footprint to the point itself. A return at q
+    itself (no direction) gets +x.
+    """
+    q = np.asarray(control_point, dtype=float)[:2]
+    offset = q - np.asarray(points, dtype=float).reshape(-1, 2)
+    norm = np.linalg.norm(offset, axis=1, keepdims=True)
+    normals: NDArray[np.float64] = np.where(norm > 0.0, offset / np.where(norm > 0.0, norm, 1.0),
+                                            (1.0, 0.0))
+    return normals

@@ -35,6 +35,10 @@ class Reason(enum.Enum):
     TOO_MANY = 'more neighbours than there are robots'
     TOO_MANY_POINTS = 'more obstacle points than a robot takes'
     NO_NORMAL = 'a normal (the x axis of an orientation) with no direction in the plane'
+    SCAN_FRAME = 'a frame other than obstacles.scan_frame'
+    SCAN_FIELDS = 'angle or range fields no scan can have'
+    TOO_MANY_RAYS = 'more rays than a robot takes'
+    UNPLACED = 'a stamp no pose of the robot was kept near (its returns cannot be placed)'
     TOO_FAST = 'a speed or turn rate its reference kind cannot have'
     OTHER_REFERENCE = ('a frame other than the one its reference parameters and the announced '
                        'changes give')

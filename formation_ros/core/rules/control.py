@@ -36,7 +36,9 @@ class Sensed:
     (:meth:`Control.points`); headings: (K,) rad; orientations: (K, 4) quaternions (x, y, z,
     w); (observer, neighbours): (P,) indices into the K robots and (P, dim) the points each
     sensed, in order (``core.maths.law.robot_commands``); obstacles: the obstacles they
-    heard with this state (:meth:`Control.heard_obstacles`), None: none heard, as without any.
+    heard with this state (:meth:`Control.heard_obstacles`) or saw in their scans
+    (:meth:`Control.scanned_obstacles`), None: none, as without any; unseen: why the robots
+    cannot tell their obstacles now (they then hold still), None: they can.
     """
 
     indices: NDArray[np.intp]
@@ -46,6 +48,7 @@ class Sensed:
     observer: NDArray[np.intp]
     neighbours: Float
     obstacles: Optional[HeardObstacles] = None
+    unseen: Optional[str] = None
 
 
 @dataclass(frozen=True)
@@ -144,6 +147,17 @@ class Control:
                                               self.dim))
                  for pair in heard]
         return HeardObstacles.from_lists(lists, self.dim, self.footprint,
+                                         self.obstacle_clearance)
+
+    def scanned_obstacles(self, points: ArrayLike, normals: ArrayLike) -> HeardObstacles:
+        """
+        Return one robot's obstacles from its scan, as the law takes them (K = 1).
+
+        points: (M, 2) returns kept and normals: (M, 2) unit, facing the robot
+        (``core.rules.scan_obstacles``); needs ``obstacles.clearance`` (b_o).
+        """
+        assert self.obstacle_clearance is not None
+        return HeardObstacles.from_lists([(points, normals)], self.dim, self.footprint,
                                          self.obstacle_clearance)
 
     def zero(self) -> Float:

@@ -87,6 +87,13 @@ class Transport(Choice):
     TEAM = 'team'
 
 
+class ObstacleSource(Choice):
+    """Where a robot takes its obstacles from: ``obstacles.source``."""
+
+    MAP = 'map'
+    SCAN = 'scan'
+
+
 class SourceType(Choice):
     """The message the relay reads a measured pose from: ``relay.source_type``."""
 
@@ -297,6 +304,28 @@ DECLARATIONS = (
           'b_o, m: an obstacle repels a robot whose footprint is nearer than this to its '
           'surface; required with obstacles, at most every R_i.', low=above(0.0),
           high=at_least(LENGTH_LIMIT), users=MAPPED | {Exe.ROBOT}),
+    Param('obstacles.source', Kind.STRING, ObstacleSource.MAP.value,
+          "Where a robot takes its obstacles from: 'map' (the points the plant or relay tells "
+          "it on obstacles, from their obstacles.* map) or 'scan' (its own laser scan, "
+          "sensor_msgs/LaserScan on the relative topic scan: remap it onto a lab robot's "
+          '/scan). Beyond the paper: docs/equations.md, "Obstacles from a scan".',
+          choices=_choices(ObstacleSource), users=ROBOT),
+    Param('obstacles.scan_frame', Kind.STRING, '',
+          "frame_id a robot's scans must carry (others are refused); empty: "
+          "robot_<i>/base_scan, the world's (a TurtleBot3 driver's: 'base_scan').",
+          users=ROBOT),
+    Param('obstacles.scan_mount', Kind.DOUBLE_ARRAY, None,
+          "[x, y, yaw]: the scanner's place in the base's frame, m, m, rad (a TurtleBot3 "
+          "Burger's LDS: [-0.032, 0.0, 0.0]); absent: at the pose's position, facing +x (the "
+          "world's).", low=at_least(-LENGTH_LIMIT), high=at_least(LENGTH_LIMIT), users=ROBOT),
+    Param('obstacles.scan_margin', Kind.DOUBLE, 0.05,
+          "A scan return within body.radius plus this of a neighbour's position is that "
+          "neighbour (left to the pair terms), m: the pose's age and noise.",
+          low=at_least(0.0), high=at_least(LENGTH_LIMIT), users=ROBOT),
+    Param('obstacles.scan_sectors', Kind.INT, 72,
+          'A robot keeps the nearest scan return of each of this many equal sectors of '
+          "directions about it (72: 5 degrees) as its obstacle points: the law's cost stays "
+          'bounded whatever the scanner.', low=at_least(4), high=at_least(3600), users=ROBOT),
     Param('robot_id', Kind.INT, REQUIRED, 'This robot: 1..num_robots (robot node only).',
           low=at_least(1), users=frozenset({Exe.ROBOT})),
     Param('control_rate', Kind.DOUBLE, 50.0,

@@ -15,3 +15,12 @@ process.
 def robot_name(robot_id: int) -> str:
     """Return the name of robot ``robot_id`` (1-based): ``robot_<i>``."""
     return f'robot_{robot_id}'
+
+
+SCAN_FRAME = 'base_scan'
+"""A robot's laser scanner frame below its name (a TurtleBot3 driver's ``base_scan``)."""
+
+
+def scan_frame(robot_id: int) -> str:
+    """Return the frame of robot ``robot_id``'s scans in the world: ``robot_<i>/base_scan``."""
+    return f'{robot_name(robot_id)}/{SCAN_FRAME}'

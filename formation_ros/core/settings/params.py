@@ -35,9 +35,11 @@ from formation_ros.core.model.dynamics import IDEAL, Imperfections
 from formation_ros.core.model.plant import start_positions, StartSpec
 from formation_ros.core.settings.declarations import (BY_NAME, check_values, CommandFrame,
                                                       CommandType, DEFAULT_WORLD_FRAME, Exe,
-                                                      ParamError, PoseType, range_problem,
+                                                      ObstacleSource, ParamError, PoseType,
+                                                      range_problem,
                                                       SHAPE_NAME, shape_vertices_name, SourceType,
                                                       Transport, type_problem)
+from formation_ros.core.settings.names import scan_frame
 from formation_ros.core.settings.params_file import load_params_file, PathText
 import numpy as np
 from numpy.typing import NDArray
@@ -108,6 +110,24 @@ def state_period(rate: float, publish_rate: float, lockstep: bool) -> float:
 
 
 @dataclass(frozen=True)
+class ScanSettings:
+    """
+    How a robot with ``obstacles.source: scan`` reads its own scans (``obstacles.scan_*``).
+
+    frame: the frame_id its scans must carry; mount: (x, y) of the scanner in the base's frame,
+    m, and mount_yaw its rotation there, rad; margin: a return within body.radius plus this of
+    a neighbour's position is that neighbour's, m; sectors: the sectors of directions about
+    the robot that keep their nearest return each (``core.maths.scan.nearest_by_sector``).
+    """
+
+    frame: str
+    mount: Tuple[float, float] = (0.0, 0.0)
+    mount_yaw: float = 0.0
+    margin: float = 0.05
+    sectors: int = 72
+
+
+@dataclass(frozen=True)
 class RobotSettings:
     """
     A robot node's own parameters.
@@ -116,7 +136,8 @@ class RobotSettings:
     relay_period: the time between two relay cycles, s (1 / ``relay.rate``: wall-clock time in
     a lab, simulated time beside a world);
     parameter_services: whether every robot node of a fleet offers the parameter services
-    (``fleet.parameter_services``; the fleet's first robot always does).
+    (``fleet.parameter_services``; the fleet's first robot always does); scan: how it reads its
+    scans with ``obstacles.source: scan`` (None: its obstacles are told, ``map``).
     """
 
     robot_id: int
@@ -127,6 +148,7 @@ class RobotSettings:
     plant_period: float = 0.02
     relay_period: float = 0.02
     parameter_services: bool = True
+    scan: Optional[ScanSettings] = None
 
     def answer_period(self, sim_time: bool) -> float:
         """
@@ -660,6 +682,33 @@ def _body_geometry(body: BodySettings, start: NDArray[np.float64],
                                                f'points at the same point ({gap:.3g} m apart)'))
 
 
+def _scan_settings(values: Mapping[str, Any], robot_id: int,
+                   problems: Problems) -> Optional[ScanSettings]:
+    """``obstacles.source`` and ``obstacles.scan_*`` of robot ``robot_id``; None: ``map``."""
+    if ObstacleSource(values['obstacles.source']) is ObstacleSource.MAP:
+        return None
+    if values.get('obstacles.clearance') is None:
+        problems.append(('obstacles.source', 'scan needs obstacles.clearance: b_o > 0, m, the '
+                                             "distance from an obstacle's surface within which "
+                                             'it repels'))
+    if values['dim'] != 2:
+        problems.append(('obstacles.source', f"scan is a planar scanner's: dim must be 2, got "
+                                             f"{values['dim']}"))
+    if values.get('transport') == Transport.TEAM.value:
+        problems.append(('obstacles.source', 'scan takes transport: robot (each robot answers '
+                                             'its own states with its own scan)'))
+    mount = values.get('obstacles.scan_mount') or [0.0, 0.0, 0.0]
+    if len(mount) != 3:
+        problems.append(('obstacles.scan_mount', f'takes [x, y, yaw], got {len(mount)} numbers'))
+        mount = [0.0, 0.0, 0.0]
+    frame = values['obstacles.scan_frame'] or scan_frame(robot_id)
+    if not FRAME_ID.fullmatch(frame):
+        problems.append(('obstacles.scan_frame', f'{frame!r} is not a frame id (no leading '
+                                                 'slash, no spaces)'))
+    return ScanSettings(frame, (float(mount[0]), float(mount[1])), float(mount[2]),
+                        values['obstacles.scan_margin'], values['obstacles.scan_sectors'])
+
+
 OBSTACLE_LISTS = ('obstacles.circles', 'obstacles.walls', 'obstacles.spheres')
 
 
@@ -767,7 +816,8 @@ def _own_settings(values: Mapping[str, Any], exe: Exe, n: int,
             plant_period=state_period(values['plant.rate'], values['plant.publish_rate'],
                                       values.get('plant.lockstep', False)),
             relay_period=1.0 / values['relay.rate'],
-            parameter_services=values['fleet.parameter_services'])}
+            parameter_services=values['fleet.parameter_services'],
+            scan=_scan_settings(values, values['robot_id'], problems))}
     if exe is Exe.REFERENCE:
         step_ns = NS_PER_S / values['plant.rate']
         if not math.isfinite(step_ns):
@@ -1034,5 +1084,5 @@ def validate_for_every_executable(raw: Mapping[str, Any]) -> Dict[Exe, Formation
 
 __all__ = ['CommandSettings', 'fill_template', 'FormationConfig', 'load_config', 'ParamError',
            'PlantSettings', 'RecorderSettings', 'ReferenceSettings', 'RelaySettings',
-           'RobotSettings', 'template_problems', 'validate', 'validate_for_every_executable',
-           'world_settings', 'WorldSettings']
+           'RobotSettings', 'ScanSettings', 'template_problems', 'validate',
+           'validate_for_every_executable', 'world_settings', 'WorldSettings']

@@ -1,0 +1,193 @@
+# Copyright 2026 The formation_ros authors.
+# SPDX-License-Identifier: Apache-2.0
+
+"""
+A robot's obstacles from its own laser scan (``obstacles.source: scan``), without ROS.
+
+Beyond the paper (docs/equations.md, "Obstacles from a scan"). :class:`ScanObstacles` admits a
+scan (:meth:`ScanObstacles.refusal`: its frame, its fields, its size), keeps the latest one
+and the robot's own poses of the last :data:`POSES_KEPT` states, and when the robot answers a
+state gives the law its obstacle points (:meth:`ScanObstacles.obstacles`): the returns placed
+in the world frame with the pose at the scan's stamp (interpolated between the two poses
+about it), the ones on a neighbour's body left out, the nearest of each sector within R_i
+kept, each a point obstacle facing the robot (``core.maths.scan``). The node counts what it
+refuses and holds still while the scan is older than ``input_timeout``
+(``core.rules.answers``: the input ``scan``).
+"""
+
+from collections import deque
+from dataclasses import dataclass
+import math
+from typing import Deque, Optional, Tuple
+
+from formation_ros.core.maths.scan import (facing_normals, nearest_by_sector, off_neighbours,
+                                           scan_points, scan_problem, ScanShape)
+from formation_ros.core.maths.unicycle import headings_from_quaternions
+from formation_ros.core.rules.admission import Reason
+from formation_ros.core.rules.robot_intake import Refused
+from formation_ros.core.settings.params import ScanSettings
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+POSES_KEPT = 256
+"""The robot's latest poses kept to place a scan at its stamp (2.56 s of states at 100 Hz)."""
+MAX_RAYS = 16384
+"""The most rays a scan may have (an LDS has 360, a 2D lidar a few thousand)."""
+
+
+@dataclass(frozen=True)
+class Scan:
+    """
+    One ``sensor_msgs/LaserScan`` as a robot takes it.
+
+    stamp_ns: its stamp, ns; frame_id: its frame; angle_min, angle_increment: rad;
+    range_min, range_max: m; ranges: (R,) m (+inf: no return).
+    """
+
+    stamp_ns: int
+    frame_id: str
+    angle_min: float
+    angle_increment: float
+    range_min: float
+    range_max: float
+    ranges: NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Placed:
+    """A scan's returns placed in the world frame: points (K, 2), m; the scan's stamp, ns."""
+
+    stamp_ns: int
+    points: NDArray[np.float64]
+
+
+class ScanObstacles:
+    """
+    One robot's obstacle points from its scans.
+
+    settings: ``obstacles.scan_*``; sensing_radius: R_i, m (a return at or beyond it is not
+    kept); body_radius: ``body.radius``, m (a neighbour's body: with the margin, the reach of
+    its returns about its position).
+    """
+
+    def __init__(self, settings: ScanSettings, sensing_radius: float,
+                 body_radius: float) -> None:
+        """Start with no scan and no pose."""
+        self.settings = settings
+        self.sensing_radius = float(sensing_radius)
+        self.reach = float(body_radius) + settings.margin
+        self.poses: Deque[Tuple[int, Tuple[float, ...], Tuple[float, ...]]] = deque(
+            maxlen=POSES_KEPT)
+        """(stamp ns, position, orientation quaternion) of the latest poses, oldest first."""
+        self.scan: Optional[Scan] = None
+        """The latest scan admitted (None: none yet)."""
+        self.placed: Optional[Placed] = None
+        """The latest scan's returns in the world frame, once placed."""
+        self.kept = 0
+        """Obstacle points given to the law at the last answer."""
+
+    def shape(self, scan: Scan) -> ScanShape:
+        """Return the fields of ``scan`` and the scanner's mount (``core.maths.scan``)."""
+        return ScanShape(scan.angle_min, scan.angle_increment, scan.range_min, scan.range_max,
+                         self.settings.mount, self.settings.mount_yaw)
+
+    def refusal(self, scan: Scan) -> Optional[Refused]:
+        """Return why ``scan`` is refused (frame, size, fields, NaN or -inf ranges), or None."""
+        if scan.frame_id != self.settings.frame:
+            return Refused(Reason.SCAN_FRAME,
+                           f' (got {scan.frame_id!r}, expected {self.settings.frame!r})')
+        if len(scan.ranges) > MAX_RAYS:
+            return Refused(Reason.TOO_MANY_RAYS, f' ({len(scan.ranges)} > {MAX_RAYS})')
+        problem = scan_problem(scan.ranges, self.shape(scan))
+        if problem is None:
+            return None
+        reason = (Reason.NON_FINITE if problem.startswith(('non-finite', 'a range'))
+                  else Reason.SCAN_FIELDS)
+        return Refused(reason, f' ({problem})')
+
+    def pose_heard(self, stamp_ns: int, position: Tuple[float, ...],
+                   orientation: Tuple[float, ...]) -> None:
+        """
+        Keep an admitted pose of the robot: stamp ns, position (>= 2,) m, quaternion.
+
+        A copy of the newest is not kept again; an older stamp (time went back: a plant or
+        world started again) starts the poses anew.
+        """
+        if self.poses and stamp_ns == self.poses[-1][0]:
+            return
+        if self.poses and stamp_ns < self.poses[-1][0]:
+            self.poses.clear()
+        self.poses.append((stamp_ns, position, orientation))
+
+    def scan_heard(self, scan: Scan) -> None:
+        """Keep an admitted scan (:meth:`refusal` said None); it is placed when first used."""
+        self.scan = scan
+        self.placed = None
+
+    def pose_at(self, stamp_ns: int,
+                tolerance_ns: int) -> Optional[Tuple[NDArray[np.float64], float]]:
+        """
+        Return the robot's (position (2,) m, heading rad) at ``stamp_ns``, or None.
+
+        Between two poses kept: linear in position, along the shorter turn in heading. After
+        the newest (a scan stamped before its state arrives), the newest, if at most
+        ``tolerance_ns`` ago; before the oldest kept: None.
+        """
+        if not self.poses:
+            return None
+        stamps = np.array([pose[0] for pose in self.poses], dtype=np.int64)
+        later = int(np.searchsorted(stamps, stamp_ns, side='left'))
+        if later == len(stamps):
+            if stamp_ns - int(stamps[-1]) > tolerance_ns:
+                return None
+            return self._pose(-1)
+        if stamps[later] == stamp_ns:
+            return self._pose(later)
+        if later == 0:
+            return None
+        (p0, h0), (p1, h1) = self._pose(later - 1), self._pose(later)
+        share = (stamp_ns - int(stamps[later - 1])) / float(stamps[later] - stamps[later - 1])
+        turn = math.remainder(h1 - h0, 2.0 * math.pi)
+        return p0 + share * (p1 - p0), h0 + share * turn
+
+    def _pose(self, k: int) -> Tuple[NDArray[np.float64], float]:
+        _, position, orientation = self.poses[k]
+        heading = float(headings_from_quaternions(np.asarray([orientation], dtype=float))[0])
+        return np.asarray(position[:2], dtype=float), heading
+
+    def place(self, tolerance_ns: int) -> Optional[Placed]:
+        """
+        Return the latest scan's returns in the world frame, placed once; None if it cannot be.
+
+        tolerance_ns: how long after the newest pose a scan may be stamped (``input_timeout``).
+        None without a scan, or when no pose was kept near its stamp (:data:`Reason.UNPLACED`).
+        """
+        if self.placed is not None or self.scan is None:
+            return self.placed
+        pose = self.pose_at(self.scan.stamp_ns, tolerance_ns)
+        if pose is None:
+            return None
+        position, heading = pose
+        self.placed = Placed(self.scan.stamp_ns, scan_points(self.scan.ranges,
+                                                             self.shape(self.scan), position,
+                                                             heading))
+        return self.placed
+
+    def obstacles(self, placed: Placed, position: ArrayLike, control_point: ArrayLike,
+                  neighbours: ArrayLike) -> Tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """
+        Return the robot's obstacle points (K, 2) and their normals (K, 2) for the law.
+
+        placed: the scan's returns (:meth:`place`); position: (>= 2,) the robot's position
+        now (its scanner's body), m; control_point: (2,) the point the law acts on, m;
+        neighbours: (M, >= 2), 2-D also for M = 0: the positions of the neighbours it heard,
+        m. Returns on a neighbour's body (within the reach of its position) are left out; of
+        the rest within R_i of the position, the nearest of each sector
+        (``obstacles.scan_sectors``).
+        """
+        others = np.asarray(neighbours, dtype=float)[:, :2]
+        points = placed.points[off_neighbours(placed.points, others, self.reach)]
+        kept = nearest_by_sector(points, np.asarray(position, dtype=float)[:2],
+                                 self.sensing_radius, self.settings.sectors)
+        self.kept = len(kept)
+        return kept, facing_normals(kept, control_point)
