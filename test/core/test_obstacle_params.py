@@ -131,3 +131,36 @@ def test_the_law_sees_the_obstacles_grown_by_the_footprint():
     assert np.allclose(grown.circles, [[3.0, 0.0, 0.3]])
     assert np.allclose(grown.walls, [[0.0, 3.0, 2.0, 3.0, 0.15]])
     assert np.allclose(config.obstacles.circles, [[3.0, 0.0, 0.2]])
+
+
+def test_a_robot_on_its_scanner_reads_the_scan_settings():
+    raw = square(**{'obstacles.clearance': 0.4, 'obstacles.source': 'scan', 'robot_id': 3})
+    scan = validate(raw, 'robot').robot.scan
+    assert scan.frame == 'robot_3/base_scan' and scan.mount == (0.0, 0.0)
+    assert scan.mount_yaw == 0.0 and scan.sectors == 72 and scan.margin == 0.05
+    lab = validate({**raw, 'obstacles.scan_frame': 'base_scan',
+                    'obstacles.scan_mount': [-0.032, 0.0, 0.1]}, 'robot').robot.scan
+    assert lab.frame == 'base_scan' and lab.mount == (-0.032, 0.0) and lab.mount_yaw == 0.1
+    assert validate({**raw, 'obstacles.source': 'map'}, 'robot').robot.scan is None
+
+
+@pytest.mark.parametrize('extra, name, words', [
+    ({}, 'obstacles.source', 'needs obstacles.clearance'),
+    ({'obstacles.clearance': 0.4, 'transport': 'team'}, 'obstacles.source', 'transport: robot'),
+    ({'obstacles.clearance': 0.4, 'obstacles.scan_mount': [0.1, 0.0]}, 'obstacles.scan_mount',
+     'takes [x, y, yaw]'),
+    ({'obstacles.clearance': 0.4, 'obstacles.scan_frame': '/base scan'},
+     'obstacles.scan_frame', 'not a frame id'),
+    ({'obstacles.clearance': 0.4, 'obstacles.source': 'lidar'}, 'obstacles.source', 'map, scan'),
+])
+def test_a_scanning_robot_with_what_cannot_hold_is_refused(extra, name, words):
+    raw = square(**{'obstacles.source': 'scan', 'robot_id': 1, **extra})
+    error, names = problems_of(raw, 'robot')
+    assert names == [name] and words in str(error)
+
+
+def test_a_scanning_robot_in_3d_is_refused():
+    raw = load_params_file(os.path.join(CONFIG_DIR, 'helix_3d.yaml'))
+    error, names = problems_of({**raw, 'obstacles.clearance': 0.2, 'obstacles.source': 'scan',
+                                'robot_id': 1}, 'robot')
+    assert names == ['obstacles.source'] and 'dim must be 2' in str(error)

@@ -3,13 +3,13 @@
 
 """A robot's answers without ROS: lockstep, start-up, watchdog, flood, stale inputs, stop."""
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 import os
-from typing import Tuple
+from typing import Optional, Tuple
 
 from formation_ros.core.maths.frames import FrameSample
 from formation_ros.core.maths.units import NS_PER_S
-from formation_ros.core.rules.answers import AnswerPolicy, BURST
+from formation_ros.core.rules.answers import AnswerPolicy, BURST, INPUTS
 from formation_ros.core.rules.control import Control
 from formation_ros.core.rules.reference_track import ReferenceTrack
 from formation_ros.core.rules.robot_core import Note, RobotCore, Said
@@ -63,10 +63,12 @@ class Robot:
     timeline: ReferenceTimeline
     listeners: list = field(default_factory=lambda: [1])
     position: np.ndarray = field(default_factory=lambda: np.array([0.3, -0.2]))
+    unseen: Optional[str] = None
 
     def sensed(self):
-        return self.control.alone(0, self.position, [0.0, 0.0, 0.0, 1.0],
-                                  np.array([[1.0, 0.5]]), np.array([[0.0, 0.0, 0.0, 1.0]]))
+        return replace(self.control.alone(0, self.position, [0.0, 0.0, 0.0, 1.0],
+                                          np.array([[1.0, 0.5]]),
+                                          np.array([[0.0, 0.0, 0.0, 1.0]])), unseen=self.unseen)
 
     def sample(self, stamp_ns):
         """Admit the reference sample of ``stamp_ns`` as the reference node sends it."""
@@ -79,7 +81,7 @@ class Robot:
         self.core.state_heard(stamp_ns, now_ns, new)
 
 
-def make_robot(lockstep, wait_subscribers=1, evaluates=True):
+def make_robot(lockstep, wait_subscribers=1, evaluates=True, inputs=INPUTS):
     config = validate(load_params_file(SQUARE))
     base = config.reference()
     states = Timeline(TeamState.of(Mode.RUNNING, config.shape_name, base))
@@ -88,7 +90,7 @@ def make_robot(lockstep, wait_subscribers=1, evaluates=True):
     control = Control(config.law(), [1.5], 2, False, 0.0, False)
     track = ReferenceTrack(timeline, 2, config.world_frame, base.rate_limits(), evaluates,
                            TIMEOUT)
-    policy = AnswerPolicy(PERIOD, TIMEOUT, WATCH, wait_subscribers)
+    policy = AnswerPolicy(PERIOD, TIMEOUT, WATCH, wait_subscribers, inputs)
     holder = {}
     core = RobotCore(control, lambda: holder['robot'].sensed(), policy, track, changes,
                      lambda: holder['robot'].listeners[0], 'cmd_vel', lockstep, evaluates,
@@ -272,3 +274,39 @@ def test_the_answer_of_k_robots_is_one_call_of_their_control():
     assert np.array_equal(answer.commands, control.commands(team, vertices,
                                                             robot.timeline.frame_at(START))
                           .published)
+
+
+def test_a_robot_on_its_scanner_waits_for_a_scan_and_holds_still_when_it_goes_stale():
+    robot = make_robot(lockstep=False, inputs=INPUTS + ('scan',))
+    answer = started(robot)
+    assert not answer.publish
+    assert said(answer, Said.START)[0].text == 'waiting for scan'
+    robot.core.scan_heard(STEADY + 1)
+    robot.state(START + PERIOD, STEADY + 2)
+    robot.sample(START + PERIOD)
+    robot.core.reference_heard(STEADY + 2)
+    answer = robot.core.on_state(STEADY + 2, START + PERIOD)
+    assert answer.started and answer.publish and answer.commands is not None
+    late = STEADY + 1 + TIMEOUT + 1
+    robot.state(START + 2 * PERIOD, late)
+    robot.sample(START + 2 * PERIOD)
+    robot.core.reference_heard(late)
+    answer = robot.core.on_watchdog(late, START + 2 * PERIOD)
+    assert answer.publish and answer.commands is None
+    assert said(answer, Said.START) == [Note(Said.START, 'stale', 'no new scan for 0.5 s: '
+                                                                  'publishing zero')]
+
+
+def test_a_robot_that_cannot_tell_its_obstacles_holds_still_and_says_why():
+    robot = make_robot(lockstep=True)
+    robot.unseen = 'its scan cannot be placed'
+    answer = started(robot)
+    assert answer.publish and answer.commands is None
+    assert Note(Said.START, 'unseen', 'its scan cannot be placed: holding still') in answer.notes
+    robot.unseen = None
+    robot.sample(START + PERIOD)
+    robot.core.reference_heard(STEADY + PERIOD)
+    robot.state(START + PERIOD, STEADY + PERIOD)
+    answer = robot.core.on_state(STEADY + PERIOD, START + PERIOD)
+    assert answer.commands is not None
+    assert Note(Said.END, 'unseen', 'obstacles seen again: controlling') in answer.notes

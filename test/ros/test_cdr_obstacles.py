@@ -5,11 +5,13 @@
 
 from formation_ros.core.maths.obstacles import Obstacles, quaternion_normals, told_obstacles
 from formation_ros.ros.cdr import (CdrError, encode_obstacles, encode_team_obstacles,
-                                   read_pose_array, read_team_obstacles, TooManyPoses)
+                                   read_laser_scan, read_pose_array, read_team_obstacles,
+                                   TooManyPoses, TooManyRays)
 from geometry_msgs.msg import PoseArray, Transform
 import numpy as np
 import pytest
 from rclpy.serialization import deserialize_message, serialize_message
+from sensor_msgs.msg import LaserScan
 from trajectory_msgs.msg import MultiDOFJointTrajectory, MultiDOFJointTrajectoryPoint
 
 MAP = Obstacles([0.0, 0.0, 1.0, 3.0, 2.0, 0.4], [-2.0, -3.0, 2.0, -3.0, 0.1], [], 0.5, 2)
@@ -85,3 +87,34 @@ def test_untrusted_team_obstacles_are_refused():
     other.points = [point, MultiDOFJointTrajectoryPoint()]
     with pytest.raises(CdrError, match='one trajectory point'):
         read_team_obstacles(serialize_message(other), 3, 256)
+
+
+def laser_scan(rays=360):
+    message = LaserScan()
+    message.header.frame_id = 'robot_2/base_scan'
+    message.header.stamp.sec, message.header.stamp.nanosec = 12, 34
+    message.angle_min, message.angle_max = 0.25, 6.0
+    message.angle_increment = 0.0175
+    message.range_min, message.range_max = 0.12, 3.5
+    message.ranges = [float(k % 7) / 2.0 for k in range(rays - 1)] + [float('inf')]
+    message.intensities = [1.0] * rays
+    return message
+
+
+def test_a_laser_scan_reads_as_rclpy_wrote_it():
+    scan = read_laser_scan(serialize_message(laser_scan()), 1000)
+    assert (scan.stamp_ns, scan.frame_id) == (12_000_000_034, 'robot_2/base_scan')
+    assert np.isclose(scan.angle_min, 0.25) and np.isclose(scan.angle_increment, 0.0175)
+    assert np.isclose(scan.range_min, 0.12) and np.isclose(scan.range_max, 3.5)
+    assert np.array_equal(scan.ranges, np.float32(laser_scan().ranges).astype(float))
+
+
+def test_untrusted_scan_bytes_are_refused_whole():
+    data = serialize_message(laser_scan())
+    with pytest.raises(TooManyRays):
+        read_laser_scan(data, 359)
+    for cut in (10, len(data) // 2, len(data) - 8):
+        with pytest.raises(CdrError):
+            read_laser_scan(data[:cut], 1000)
+    with pytest.raises(CdrError):
+        read_laser_scan(serialize_message(PoseArray()), 1000)

@@ -129,22 +129,22 @@ class ScanObstacles:
         """
         Return the robot's (position (2,) m, heading rad) at ``stamp_ns``, or None.
 
-        Between two poses kept: linear in position, along the shorter turn in heading. After
-        the newest (a scan stamped before its state arrives), the newest, if at most
-        ``tolerance_ns`` ago; before the oldest kept: None.
+        Between two poses kept: linear in position, along the shorter turn in heading. Beyond
+        them, the nearest end, if at most ``tolerance_ns`` away: after the newest, a scan
+        stamped before its state arrives; before the oldest, a scan taken as the first states
+        came (the robot not yet commanded). Farther: None.
         """
         if not self.poses:
             return None
         stamps = np.array([pose[0] for pose in self.poses], dtype=np.int64)
         later = int(np.searchsorted(stamps, stamp_ns, side='left'))
-        if later == len(stamps):
-            if stamp_ns - int(stamps[-1]) > tolerance_ns:
+        if later in (0, len(stamps)):
+            end = 0 if later == 0 else -1
+            if abs(stamp_ns - int(stamps[end])) > tolerance_ns:
                 return None
-            return self._pose(-1)
+            return self._pose(end)
         if stamps[later] == stamp_ns:
             return self._pose(later)
-        if later == 0:
-            return None
         (p0, h0), (p1, h1) = self._pose(later - 1), self._pose(later)
         share = (stamp_ns - int(stamps[later - 1])) / float(stamps[later] - stamps[later - 1])
         turn = math.remainder(h1 - h0, 2.0 * math.pi)
