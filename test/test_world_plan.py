@@ -107,9 +107,104 @@ def test_an_install_without_the_world_is_refused(world_install):
 
 def test_help_tells_the_world_option():
     usage = run('launch_formation.sh', '--help').stdout
-    assert '[--world]' in usage and '--world        a simulated lab' in usage
+    assert '[--world [--world-params' in usage and '--world        a simulated lab' in usage
 
 
 def test_world_launch_file_refuses_a_lab_file(world_launch_file):
     with pytest.raises(ValueError, match="the world's relay reads the world"):
         launched_nodes(world_launch_file, params_file=LAB)
+
+
+def world_file(tmp_path, changes, source=WORLD_OBSTACLES, name='lab.yaml'):
+    """Write the world's own parameters file: ``source`` with ``changes``; return its path."""
+    path = str(tmp_path / name)
+    write_params_file(path, dict(load_params_file(source), **changes))
+    return path
+
+
+CHAIR = {'obstacles.circles': [-0.4, 0.05, 0.15, 1.2, 1.5, 0.1, 0.0, -0.9, 0.12]}
+"""The world's obstacles of config/world_turtlebot3_obstacles.yaml and a pillar off the map."""
+THREE = {'num_robots': 3, 'formation.vertices': [1.8, 0.6, 0.6, 0.6, 0.6, -0.6],
+         'start.positions': [-1.35, 0.45, -2.1, 0.4, -2.0, -0.45],
+         'start.headings': [0.3, 0.0, -0.2]}
+"""Three of the file's four robots: a world file with one robot less than the team's."""
+
+
+def test_world_params_start_the_world_alone_from_its_own_file(tmp_path):
+    lab = world_file(tmp_path, dict(CHAIR, **{'world.realtime_factor': 2.0}))
+    views = launcher_views(WORLD_OBSTACLES, ['--world', '--world-params', lab, '--record',
+                                             '/nonexistent/w_bag'])
+    files = {view['executable']: view['params_file'] for view in views}
+    assert [view['executable'] for view in views] == ['record', 'world', 'relay',
+                                                      'reference'] + ['robot'] * 4
+    assert files['world'] == lab
+    assert {view['params_file'] for view in views if view['executable'] != 'world'} == {
+        WORLD_OBSTACLES}
+    assert [dict(view, params_file=WORLD_OBSTACLES) for view in views] == launcher_views(
+        WORLD_OBSTACLES, ['--world', '--record', '/nonexistent/w_bag'])
+
+
+def test_world_params_give_the_run_the_worlds_realtime_factor(tmp_path):
+    from formation_ros.tools import launcher
+    lab = world_file(tmp_path, dict(CHAIR, **{'world.realtime_factor': 2.0}))
+    options = launcher.check_paths(launcher.parse_args([WORLD_OBSTACLES, '--world']))
+    alone = launcher.read_parameters(options)
+    apart = launcher.read_parameters(launcher.check_paths(launcher.parse_args(
+        [WORLD_OBSTACLES, '--world', '--world-params', lab])))
+    duration = load_params_file(WORLD_OBSTACLES)['duration']
+    assert alone.wall_seconds == duration and apart.wall_seconds == duration / 2.0
+    assert apart.num_robots == alone.num_robots and apart.relay_rate == alone.relay_rate
+
+
+@pytest.mark.parametrize('changes, args, says', [
+    (None, ('--no-plant',), "--world-params needs --world: it is the world's own parameters "
+                            'file'),
+    (None, (), "--world-params needs --world: it is the world's own parameters file"),
+    ('missing', ('--world',), "--world-params file '{lab}' not found"),
+    (THREE, ('--world',), '--world-params {lab} gives the world another num_robots 3 '
+                          '(PARAMS: 4); sensing radii '),
+    ({'world_frame': 'map', 'controller.gain': 0.1}, ('--world',),
+     '--world-params {lab} gives the world another law c=0.1 kappa=10.0 psi=tanh '
+     'jump=poly/2 b=0.8 (PARAMS: c=0.15 kappa=10.0 psi=tanh jump=poly/2 b=0.8); world_frame '
+     'map (PARAMS: world): the world and the team must share them'),
+    ({'body.hand_distance': 0.1}, ('--world',), '--world-params {lab} gives the world another '
+                                                'body unicycle l=0.1 (PARAMS: unicycle '
+                                                'l=0.08)'),
+])
+def test_world_params_that_cannot_work_are_refused_in_one_line(world_install, tmp_path,
+                                                               changes, args, says):
+    lab = (str(tmp_path / 'no such lab.yaml') if changes == 'missing'
+           else world_file(tmp_path, changes or {}))
+    result = run('launch_formation.sh', WORLD_OBSTACLES, *args, '--world-params', lab,
+                 '--prefix', str(world_install))
+    assert result.returncode == 2
+    assert result.stderr.startswith('launch_formation.sh: ' + says.format(lab=lab)), \
+        result.stderr
+    assert len(result.stderr.splitlines()) == 1, result.stderr
+    assert result.stdout == ''
+
+
+def test_a_world_file_the_world_would_refuse_is_refused_before_anything_starts(world_install,
+                                                                               tmp_path):
+    lab = world_file(tmp_path, {'world.timestep': -0.002})
+    result = run('launch_formation.sh', WORLD_OBSTACLES, '--world', '--world-params', lab,
+                 '--prefix', str(world_install))
+    assert result.returncode == 2
+    assert result.stderr.startswith(f'launch_formation.sh: invalid parameters in {lab}:\n'), \
+        result.stderr
+    assert 'world.timestep' in result.stderr
+    assert result.stdout == ''
+    broken = tmp_path / 'broken.yaml'
+    broken.write_text('/**:\n  ros__parameters: [\n')
+    result = run('launch_formation.sh', WORLD_OBSTACLES, '--world', '--world-params',
+                 str(broken), '--prefix', str(world_install))
+    assert result.returncode == 2
+    assert result.stderr.startswith(f'launch_formation.sh: --world-params file {broken}'), \
+        result.stderr
+    assert len(result.stderr.splitlines()) == 1, result.stderr
+
+
+def test_help_tells_the_world_params_option():
+    usage = run('launch_formation.sh', '--help').stdout
+    assert '[--world [--world-params WORLD.yaml]]' in usage
+    assert "--world-params WORLD.yaml\n                 (with --world) the world's own" in usage

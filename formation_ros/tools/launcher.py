@@ -42,7 +42,8 @@ from formation_ros.tools.system import (DISCOVERY, DISCOVERY_ENV, discovery_prob
                                         domain_problem, ESSENTIAL, FLEET_REMAP, Formation,
                                         network_variables, NodePlan, ON_RECORD_FAILURE, plan,
                                         PlanError, read_formation, RECORDER, recorder_plan,
-                                        ros_arguments, Run, stop_stages, with_variables)
+                                        ros_arguments, Run, stop_stages, with_variables,
+                                        WORLD)
 
 PROG = 'launch_formation.sh'
 PACKAGE = 'formation_ros'
@@ -51,6 +52,8 @@ RECORDER_START_TIMEOUT = 15.0
 POLL = 0.2
 ON_EXIT = ('continue', 'stop', 'respawn')
 MAX_RESTARTS = 5
+WORLD_PARAMS_COPY = 'world_params.yaml'
+"""The name of ``--world-params``'s file in ``--out``."""
 
 USAGE = """\
 Usage: scripts/launch_formation.sh PARAMS.yaml [--duration S] [--out DIR] [--record DIR]
@@ -59,7 +62,7 @@ Usage: scripts/launch_formation.sh PARAMS.yaml [--duration S] [--out DIR] [--rec
                                    [--robots-per-process K] [--prefix DIR] [--no-plots]
                                    [--discovery localhost|subnet] [--domain-id N]
                                    [--no-plant [--cmd-topic TEMPLATE] [--source-topic TEMPLATE]]
-                                   [--world]
+                                   [--world [--world-params WORLD.yaml]]
 
 Starts the plant, the reference node and N robot nodes (N = num_robots in PARAMS.yaml), robot i
 in namespace /robot_<i>, all with the same parameters file, the reference node and robots
@@ -145,6 +148,17 @@ Options:
                  outputs there and the report is made from them; its contacts and
                  closest approach end the output. Not with --no-plant, --cmd-topic or
                  plant.lockstep
+  --world-params WORLD.yaml
+                 (with --world) the world's own parameters file: the world starts from
+                 WORLD.yaml (the lab as it is: its obstacles, start.*, world.*), the relay,
+                 the reference node, the robots and the recorder from PARAMS.yaml (the
+                 robots' map, which may lack an obstacle the world has: an unmapped
+                 chair). Obstacles are not among the values the team must share; those
+                 (num_robots, dim, the law, the sensing radii, the bodies, world_frame) must
+                 be the same in both files, else nothing starts (exit code 2). The run's
+                 default length is PARAMS.yaml's duration over WORLD.yaml's
+                 world.realtime_factor; with --out WORLD.yaml is copied there as
+                 world_params.yaml
   --cmd-topic TEMPLATE
                  (with --no-plant) remap each robot's cmd_vel onto its base's topic:
                  {i} is the robot id, {name} its entry of relay.source_names, e.g.
@@ -168,28 +182,69 @@ could not write; its bag is readable and shorter than the run).
 
 def read_parameters(options: 'Options') -> Formation:
     """
-    Validate PARAMS for every program the launcher starts; return what the run needs of it.
+    Validate PARAMS (and ``--world-params``) for every program the launcher starts.
 
-    The number of robots, the default duration of a run (``duration`` divided by
-    ``plant.realtime_factor``; in a lab, ``duration``) and the command topics of
-    ``--cmd-topic``. This is the launcher's only use of the parameter code. Raises UsageError
-    listing every problem, or naming the option at fault.
+    Return what the run needs of them: the number of robots, the default duration of a run
+    (``duration`` divided by ``plant.realtime_factor``; in a lab, ``duration``; on a world,
+    by the world's ``world.realtime_factor``) and the command topics of ``--cmd-topic``. This
+    and :func:`read_world_parameters` are the launcher's only use of the parameter code.
+    Raises UsageError listing every problem, or naming the option at fault.
     """
     # Imported here so that --help and usage errors need nothing but the standard library.
     from formation_ros.core.settings.declarations import ParamError
     from formation_ros.core.settings.file_guard import ParamsFileError
     try:
-        return read_formation(options.params, plant=not (options.no_plant or options.world),
-                              cmd_topic=options.cmd_topic, source_topic=options.source_topic,
-                              robots_per_process=options.robots_per_process,
-                              cmd_option='--cmd-topic', source_option='--source-topic',
-                              world=options.world)
+        formation = read_formation(options.params,
+                                   plant=not (options.no_plant or options.world),
+                                   cmd_topic=options.cmd_topic,
+                                   source_topic=options.source_topic,
+                                   robots_per_process=options.robots_per_process,
+                                   cmd_option='--cmd-topic', source_option='--source-topic',
+                                   world=options.world)
     except ParamsFileError as exc:
         raise UsageError(f'parameters file {exc.summary}') from None
     except ParamError as exc:
         raise UsageError(f'invalid parameters in {options.params}:\n{exc}') from None
     except PlanError as exc:
         raise UsageError(str(exc)) from None
+    if options.world_params is None:
+        return formation
+    return read_world_parameters(options, formation)
+
+
+def read_world_parameters(options: 'Options', formation: Formation) -> Formation:
+    """
+    Validate ``--world-params`` for the world; return ``formation`` with the world's run length.
+
+    ``formation``: what :func:`read_parameters` read of PARAMS. The run's default length is
+    PARAMS's ``duration`` over the world file's ``world.realtime_factor``. Raises UsageError for
+    a file the world would refuse, and for one that gives another value of what the team must
+    share (``core.settings.team.team_values`` but the shape: the world announces none of them,
+    so no running node would compare them; obstacles are not among them).
+    """
+    from formation_ros.core.settings.declarations import Exe, ParamError
+    from formation_ros.core.settings.file_guard import ParamsFileError
+    from formation_ros.core.settings.params import validate
+    from formation_ros.core.settings.params_file import load_params_file
+    from formation_ros.core.settings.team import team_values
+    assert options.world_params is not None
+    try:
+        world = validate(load_params_file(options.world_params), Exe.WORLD)
+    except ParamsFileError as exc:
+        raise UsageError(f'--world-params file {exc.summary}') from None
+    except ParamError as exc:
+        raise UsageError(f'invalid parameters in {options.world_params}:\n{exc}') from None
+    robots = validate(load_params_file(options.params), Exe.RELAY)
+    theirs = team_values(world, world.vertices)
+    ours = team_values(robots, robots.vertices)
+    differ = [f'{name} {theirs[name]} (PARAMS: {ours[name]})' for name in ours
+              if name != 'shape in force' and name in theirs and theirs[name] != ours[name]]
+    if differ:
+        raise UsageError(f'--world-params {options.world_params} gives the world another '
+                         f"{'; '.join(differ)}: the world and the team must share them")
+    assert world.world is not None
+    return dataclasses.replace(formation,
+                               wall_seconds=robots.duration / world.world.realtime_factor)
 
 
 class UsageError(Exception):
@@ -219,6 +274,8 @@ class Options:
     world: bool = False
     relay_rate: float = 50.0
     """``relay.rate`` of PARAMS (:func:`read_parameters`): the robots' state rate on a world."""
+    world_params: Optional[str] = None
+    """The world's own parameters file (``--world-params``; None: the world reads PARAMS)."""
 
 
 def parse_args(argv: Sequence[str]) -> Optional[Options]:
@@ -228,7 +285,7 @@ def parse_args(argv: Sequence[str]) -> Optional[Options]:
              'on-record-failure': '|'.join(ON_RECORD_FAILURE),
              'robots-per-process': 'a number of robots', 'discovery': '|'.join(DISCOVERY),
              'domain-id': 'a number', 'cmd-topic': 'a topic template',
-             'source-topic': 'a topic template'}
+             'source-topic': 'a topic template', 'world-params': 'a parameters file'}
     values: dict[str, Optional[str]] = dict.fromkeys(needs)
     params = None
     no_plant = False
@@ -284,12 +341,15 @@ def parse_args(argv: Sequence[str]) -> Optional[Options]:
     return Options(params, None if duration is None else float(duration), values['out'],
                    values['record'], prefix, on_exit, on_record_failure, int(per_process),
                    discovery, None if domain_id is None else int(domain_id), no_plant,
-                   plots, values['cmd-topic'], values['source-topic'], world=world)
+                   plots, values['cmd-topic'], values['source-topic'], world=world,
+                   world_params=values['world-params'])
 
 
 def _check_lab_options(no_plant: bool, values: Mapping[str, Optional[str]],
                        world: bool = False) -> None:
     """Refuse the options that a run with (or without) the plant or with a world cannot honour."""
+    if values.get('world-params') is not None and not world:
+        raise UsageError("--world-params needs --world: it is the world's own parameters file")
     if world:
         if no_plant:
             raise UsageError('--world is a lab of its own: leave out --no-plant (the world '
@@ -329,6 +389,11 @@ def check_paths(options: Options) -> Options:
     """Check the files and directories of ``options`` (changing nothing); return them absolute."""
     if not os.path.isfile(options.params):
         raise UsageError(f"parameters file '{options.params}' not found")
+    world_params = options.world_params
+    if world_params is not None:
+        if not os.path.isfile(world_params):
+            raise UsageError(f"--world-params file '{world_params}' not found")
+        world_params = os.path.abspath(world_params)
     out, record = options.out, options.record
     if out is not None:
         if os.path.isdir(out) and os.listdir(out):
@@ -341,7 +406,7 @@ def check_paths(options: Options) -> Options:
             raise UsageError(f"--record directory '{record}' exists already; choose a new one")
         record = os.path.abspath(record)
     return dataclasses.replace(options, params=os.path.abspath(options.params), out=out,
-                               record=record)
+                               record=record, world_params=world_params)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -419,8 +484,10 @@ def recorder_spec(install: Install, options: Options, env: Mapping[str, str]) ->
 
 def _spec(install: Install, node: NodePlan, options: Options,
           env: Mapping[str, str]) -> ProcessSpec:
+    params = (options.world_params if node.executable == WORLD and options.world_params
+              else options.params)
     return ProcessSpec(node.name, install.command(node.executable) +
-                       ros_arguments(node, options.params), env)
+                       ros_arguments(node, params), env)
 
 
 class Launch:
@@ -789,6 +856,9 @@ def main(argv: Optional[Sequence[str]] = None, make: Optional[Callable[..., 'Lau
         if options.out is not None:
             os.makedirs(options.out, exist_ok=True)
             shutil.copyfile(options.params, os.path.join(options.out, 'params.yaml'))
+            if options.world_params is not None:
+                shutil.copyfile(options.world_params,
+                                os.path.join(options.out, WORLD_PARAMS_COPY))
         if options.record is not None:
             if os.path.isdir(options.record):
                 os.rmdir(options.record)
@@ -803,6 +873,8 @@ def main(argv: Optional[Sequence[str]] = None, make: Optional[Callable[..., 'Lau
     network = discovery_environment(options, os.environ)
     lab = (', no plant (relay, wall-clock time)' if options.no_plant else
            ", on the world (world and relay, the world's /clock)" if options.world else '')
+    if options.world_params is not None:
+        lab += f', the world from {options.world_params}'
     domain = network.get(DOMAIN_ENV) or '0'
     join = (f' (a free domain of its own: {chosen}; to join it: export ROS_DOMAIN_ID={domain} '
             'before ros2 topic echo ...)' if chosen else '')
