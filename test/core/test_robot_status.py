@@ -52,6 +52,16 @@ def test_the_startup_line_names_the_robot_its_constants_and_modes():
     assert line.startswith('robot 2/4: vertex ') and 'R_i = 2 m' in line
     assert line.endswith("lockstep, simulated time from the states' stamps"), line
     assert 'Hz' in startup_line(square(), 1, 'world', False)
+    assert 'obstacles' not in line
+
+
+def test_the_startup_line_says_where_the_obstacles_come_from():
+    told = startup_line(square(**{'obstacles.clearance': 0.4}), 1, 'world', False)
+    assert told.endswith(', obstacles as told (b_o = 0.4 m)'), told
+    seen = startup_line(square(**{'obstacles.clearance': 0.4, 'obstacles.source': 'scan'}), 1,
+                        'world', True)
+    assert (", obstacles from its scan in robot_2/base_scan (b_o = 0.4 m), simulated time "
+            "from the states' stamps") in seen, seen
 
 
 def test_robots_share_a_track_only_with_the_values_that_decide_it():

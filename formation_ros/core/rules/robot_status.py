@@ -86,4 +86,17 @@ def startup_line(config: FormationConfig, index: int, command_frame: str, sim_ti
               f'{command_frame}, '
             + ('lockstep' if config.lockstep else f'{robot.control_rate:g} Hz')
             + (', team transport' if config.team_transport else '')
+            + _obstacles_part(config)
             + (", simulated time from the states' stamps" if sim_time else ''))
+
+
+def _obstacles_part(config: FormationConfig) -> str:
+    """Return where a robot takes its obstacles from, for its start-up line ('': none)."""
+    robot = config.robot
+    assert robot is not None
+    if robot.scan is not None:
+        return (f', obstacles from its scan in {robot.scan.frame} (b_o = '
+                f'{config.obstacle_clearance:g} m)')
+    if config.obstacle_clearance is not None:
+        return f', obstacles as told (b_o = {config.obstacle_clearance:g} m)'
+    return ''
