@@ -60,7 +60,7 @@ def test_the_startup_line_says_where_the_obstacles_come_from():
     assert told.endswith(', obstacles as told (b_o = 0.4 m)'), told
     seen = startup_line(square(**{'obstacles.clearance': 0.4, 'obstacles.source': 'scan'}), 1,
                         'world', True)
-    assert (", obstacles from its scan in robot_2/base_scan (b_o = 0.4 m), simulated time "
+    assert (', obstacles from its scan in robot_2/base_scan (b_o = 0.4 m), simulated time '
             "from the states' stamps") in seen, seen
 
 

@@ -5,8 +5,8 @@
 
 import math
 
-from formation_ros.core.maths.law import make_law, PsiKind
 from formation_ros.core.maths.jump import JumpKind
+from formation_ros.core.maths.law import make_law, PsiKind
 from formation_ros.core.maths.obstacles import HeardObstacles, Obstacles
 from formation_ros.core.maths.unicycle import quaternions_from_headings
 from formation_ros.core.rules.admission import Reason
@@ -34,7 +34,7 @@ def ray_hit(origin, angle, centre, radius):
 
 
 def synthetic(origin, heading, circles, stamp_ns=SECOND, frame=FRAME, mount=(0.0, 0.0, 0.0)):
-    """A 360-ray scan from a scanner mounted at ``mount`` on a base at ``origin``/``heading``."""
+    """Return a 360-ray scan from a scanner at ``mount`` on a base at ``origin``, ``heading``."""
     c, s = math.cos(heading), math.sin(heading)
     scanner = np.asarray(origin, dtype=float) + (c * mount[0] - s * mount[1],
                                                  s * mount[0] + c * mount[1])
@@ -158,8 +158,8 @@ def test_a_scan_from_long_before_any_pose_kept_is_not_placed():
     ({'ranges': np.ones(MAX_RAYS + 1)}, Reason.TOO_MANY_RAYS),
 ])
 def test_a_scan_that_cannot_be_read_is_refused(change, reason):
-    fields = dict(stamp_ns=SECOND, frame_id=FRAME, angle_min=0.0, angle_increment=STEP,
-                  range_min=RANGE_MIN, range_max=RANGE_MAX, ranges=np.full(RAYS, np.inf))
+    fields = {'stamp_ns': SECOND, 'frame_id': FRAME, 'angle_min': 0.0, 'angle_increment': STEP,
+              'range_min': RANGE_MIN, 'range_max': RANGE_MAX, 'ranges': np.full(RAYS, np.inf)}
     assert rule().refusal(Scan(**fields)) is None
     refused = rule().refusal(Scan(**{**fields, **change}))
     assert refused is not None and refused.reason is reason

@@ -34,7 +34,7 @@ UNSEEN = {
 
 
 def ranges_from(origin, heading):
-    """The LDS's ranges from ``origin`` facing ``heading`` with the pillar about (360,) m."""
+    """Return the LDS's ranges from ``origin`` facing ``heading``, the pillar about: (360,) m."""
     angles = heading + np.arange(RAYS) * (2.0 * math.pi / RAYS)
     d = np.column_stack([np.cos(angles), np.sin(angles)])
     f = np.asarray(origin, dtype=float) - PILLAR
@@ -83,7 +83,7 @@ def test_robots_go_round_a_pillar_only_their_scanners_see(processes, install, pr
                                                           tmp_path):
     params = write_params(tmp_path, 'square_4.yaml', UNSEEN)
     config = load_config(params, 'plant')
-    assert config.obstacles is None, 'the pillar is on nobody\'s map'
+    assert config.obstacles is None, "the pillar is on nobody's map"
     scanners = [StandInScanner(probe, i) for i in range(1, 5)]
     statuses = Statuses(probe)
     launch(processes, install, params, out=tmp_path / 'out', per_process=4)
@@ -108,7 +108,7 @@ def test_robots_go_round_a_pillar_only_their_scanners_see(processes, install, pr
 
     scanners[0].frame = 'base_scan'
     log = logged(probe, processes, 'launcher',
-                 "ignoring scan messages with a frame other than obstacles.scan_frame (got "
+                 'ignoring scan messages with a frame other than obstacles.scan_frame (got '
                  "'base_scan', expected 'robot_1/base_scan')",
                  'no new scan for 0.5 s: publishing zero')
     assert log.count('ignoring scan messages with a frame other') == 1

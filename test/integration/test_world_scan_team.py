@@ -8,7 +8,7 @@ Three TurtleBot3-like bases on the world through the relay, as ``launch_formatio
 starts them; a pillar stands on robot 1's way to its vertex. The robots read no map (a robot
 never does) and, with ``obstacles.source: scan``, do not listen to what the relay tells: they
 see the pillar in the world's LDS-like scans only. The run stops once robot 1's hand point is
-past the pillar and on its way to its vertex (0.3 m from it); the world counted no contact, robot 1 reported returns
+past the pillar, 0.3 m from its vertex; the world counted no contact, robot 1 reported returns
 used, and the world's commands stayed within the law's bound.
 """
 
