@@ -50,9 +50,9 @@ def quaternion(heading):
     return tuple(quaternions_from_headings(np.array([heading]))[0])
 
 
-def rule(mount=(0.0, 0.0, 0.0), radius=2.0, sectors=72, margin=0.05, body=0.1):
-    return ScanObstacles(ScanSettings(FRAME, mount[:2], mount[2], margin, sectors), radius,
-                         body)
+def rule(mount=(0.0, 0.0, 0.0), radius=2.0, sectors=72, margin=0.05, body=0.1, join=0.2):
+    return ScanObstacles(ScanSettings(FRAME, mount[:2], mount[2], margin, join, sectors),
+                         radius, body)
 
 
 def held(rule_, origin, heading, stamp_ns=SECOND):
@@ -78,11 +78,10 @@ def test_neighbour_returns_left_to_the_pair_terms_and_the_rest_kept():
     scans.scan_heard(synthetic(origin, 0.0, [pillar, (neighbour, 0.1)]))
     placed = scans.place(SECOND)
     points, normals = scans.obstacles(placed, origin, origin, neighbour[None, :])
-    assert len(points) > 0
-    assert np.all(np.linalg.norm(points - neighbour, axis=1) > 0.15)
-    assert np.allclose(np.linalg.norm(points - pillar[0], axis=1), 0.15, atol=1e-6)
+    assert len(points) == 1, 'the pillar, by its nearest return'
+    assert np.allclose(points[0], (0.0, 0.85), atol=1e-6)
     alone, _ = scans.obstacles(placed, origin, origin, np.zeros((0, 3)))
-    assert np.any(np.linalg.norm(alone - neighbour, axis=1) < 0.15)
+    assert len(alone) == 2 and np.any(np.linalg.norm(alone - neighbour, axis=1) < 0.15)
     assert np.allclose(normals, -points / np.linalg.norm(points, axis=1, keepdims=True))
 
 
@@ -105,7 +104,7 @@ def test_blind_zone_and_no_return_give_no_point():
 
 def test_beyond_r_i_dropped_and_one_point_a_sector():
     origin = np.zeros(2)
-    scans = rule(radius=1.0, sectors=8)
+    scans = rule(radius=1.0, sectors=8, join=0.0)
     held(scans, origin, 0.0)
     scans.scan_heard(synthetic(origin, 0.0, [(np.array([0.6, 0.0]), 0.2),
                                              (np.array([-2.0, 0.0]), 0.3)]))
@@ -113,8 +112,50 @@ def test_beyond_r_i_dropped_and_one_point_a_sector():
     distances = np.linalg.norm(points, axis=1)
     assert np.all(distances < 1.0)
     sectors = np.floor((np.arctan2(points[:, 1], points[:, 0]) + math.pi) / (2 * math.pi) * 8)
-    assert len(np.unique(sectors)) == len(points)
+    assert len(np.unique(sectors)) == len(points) > 1
     assert math.isclose(distances.min(), 0.4, abs_tol=1e-6)
+
+
+def wall_and_pillars(origin, heading):
+    """Return a scan of a long wall (as a row of touching discs) and two pillars."""
+    wall = [(np.array([x, -1.0]), 0.05) for x in np.arange(-1.5, 1.51, 0.05)]
+    return synthetic(origin, heading, wall + [(np.array([0.8, 0.6]), 0.1),
+                                              (np.array([-0.8, 0.6]), 0.1)])
+
+
+@pytest.mark.parametrize('heading', [0.0, math.pi / 2, -math.pi / 2, 3.0])
+def test_each_obstacle_repels_by_its_nearest_return_wherever_the_scan_starts(heading):
+    origin = np.zeros(2)
+    scans = rule(radius=2.0)
+    held(scans, origin, heading)
+    scans.scan_heard(wall_and_pillars(origin, heading))
+    points, _ = scans.obstacles(scans.place(SECOND), origin, origin, np.zeros((0, 3)))
+    assert len(points) == 3, points
+    nearest = sorted(np.linalg.norm(points, axis=1))
+    assert nearest == pytest.approx([0.9, 0.9, 0.95], abs=2e-3), 'pillars, then the wall'
+
+
+
+def test_two_runs_of_returns_apart_are_two_obstacles_and_a_half_turn_scan_does_not_wrap():
+    origin = np.zeros(2)
+    scans = rule(radius=3.0, join=0.2)
+    held(scans, origin, 0.0)
+    pillars = [(np.array([1.0, 0.0]), 0.1), (np.array([1.0, 0.35]), 0.1)]
+    scans.scan_heard(synthetic(origin, 0.0, pillars))
+    points, _ = scans.obstacles(scans.place(SECOND), origin, origin, np.zeros((0, 3)))
+    assert len(points) == 2, 'a gap of 0.15 m between them: two obstacles'
+    half = Scan(2 * SECOND, FRAME, -math.pi / 2, STEP, RANGE_MIN, RANGE_MAX,
+                np.r_[np.full(5, 1.0), np.full(170, np.inf), np.full(5, 1.0)])
+    held(scans, origin, 0.0, 2 * SECOND)
+    scans.scan_heard(half)
+    points, _ = scans.obstacles(scans.place(SECOND), origin, origin, np.zeros((0, 3)))
+    assert len(points) == 2, 'the first and last rays of a half turn are not neighbours'
+    full = Scan(3 * SECOND, FRAME, -math.pi / 2, STEP, RANGE_MIN, RANGE_MAX,
+                np.r_[np.full(5, 1.0), np.full(350, np.inf), np.full(5, 1.0)])
+    held(scans, origin, 0.0, 3 * SECOND)
+    scans.scan_heard(full)
+    points, _ = scans.obstacles(scans.place(SECOND), origin, origin, np.zeros((0, 3)))
+    assert len(points) == 1, 'a full turn wraps: one obstacle across its first ray'
 
 
 def test_the_scan_is_placed_with_the_pose_at_its_stamp():
@@ -183,5 +224,7 @@ def test_the_law_keeps_a_robot_off_a_pillar_it_only_sees():
     assert true <= nearest <= true + (true + r) * STEP
     heard = seen.terms(q, law.jump, [2.0])
     told = mapped.terms(q, law.jump, np.array([2.0]))
+    assert len(points) == 1, 'the pillar, by its nearest return'
     cosine = float(heard[0] @ told[0]) / float(np.linalg.norm(heard) * np.linalg.norm(told))
-    assert cosine > 0.999
+    assert cosine > math.cos(STEP / 2)
+    assert np.linalg.norm(heard) == pytest.approx(np.linalg.norm(told), rel=0.05)

@@ -7,10 +7,12 @@ A planar laser scan as obstacle points: returns in the world frame, neighbours l
 Beyond the paper (docs/equations.md, "Obstacles from a scan"). A robot that senses obstacles
 with its own scanner (``obstacles.source: scan``) turns each return into a point in the world
 frame with its pose at the scan's stamp; returns on a known neighbour's body are the pair
-terms' business and are left out; the rest within R_i become the surface points p_io of
-``core.maths.obstacles``, at most one per sector of directions about the robot (the nearest),
-so that the law's cost stays bounded whatever the scanner's resolution, each with the normal
-that faces the robot (:func:`facing_normals`): a return is a point obstacle.
+terms' business and are left out; of the rest, each run of returns that holds together (an
+obstacle) gives its nearest within R_i (:func:`nearest_by_object`), and of those at most one per
+sector of directions about the robot (the nearest) becomes a surface point p_io of
+``core.maths.obstacles``, so that the law's cost stays bounded whatever the scanner's
+resolution, each with the normal that faces the robot (:func:`facing_normals`): a return is a
+point obstacle.
 ``core.rules.scan_obstacles`` keeps the scans and poses and applies these in order.
 
 Angles in rad, counter-clockwise from the scanner's +x; ranges and positions in m. Nothing here
@@ -69,6 +71,25 @@ def scan_problem(ranges: ArrayLike, shape: ScanShape) -> Optional[str]:
     return None
 
 
+def returning_rays(ranges: ArrayLike, shape: ScanShape) -> NDArray[np.intp]:
+    """
+    Return the indices of the rays with a return, in scan order: (K,).
+
+    ranges: (R,) m; a return is finite and within [range_min, range_max] (+inf and a range
+    outside them are none).
+    """
+    values = np.asarray(ranges, dtype=float).reshape(-1)
+    with np.errstate(invalid='ignore'):
+        valid = np.isfinite(values) & (values >= shape.range_min) & (values <= shape.range_max)
+    rays: NDArray[np.intp] = np.flatnonzero(valid)
+    return rays
+
+
+def full_turn(shape: ScanShape, rays: int) -> bool:
+    """Tell whether ``rays`` rays of ``shape`` go round (the last ray's neighbour is the first)."""
+    return rays * shape.angle_increment >= 2.0 * math.pi * (1.0 - 1e-6)
+
+
 def scan_points(ranges: ArrayLike, shape: ScanShape, position: ArrayLike,
                 heading: float) -> NDArray[np.float64]:
     """
@@ -76,12 +97,12 @@ def scan_points(ranges: ArrayLike, shape: ScanShape, position: ArrayLike,
 
     ranges: (R,) m, ray k at ``angle_min + k * angle_increment`` in the scanner's frame;
     position: (2,) the base's position and heading its yaw, rad, at the scan's stamp. Rays
-    without a return (+inf, or outside [range_min, range_max]) give no point. The scan must have
-    passed :func:`scan_problem`.
+    without a return (+inf, or outside [range_min, range_max]) give no point: the points are
+    those of :func:`returning_rays`, in that order. The scan must have passed
+    :func:`scan_problem`.
     """
     values = np.asarray(ranges, dtype=float).reshape(-1)
-    valid = np.isfinite(values) & (values >= shape.range_min) & (values <= shape.range_max)
-    rays = np.flatnonzero(valid)
+    rays = returning_rays(values, shape)
     angles = shape.angle_min + rays * shape.angle_increment + shape.mount_yaw + heading
     c, s = math.cos(heading), math.sin(heading)
     mount_x, mount_y = shape.mount
@@ -107,6 +128,44 @@ def off_neighbours(points: ArrayLike, neighbours: ArrayLike, reach: float) -> ND
     gaps = np.linalg.norm(p[:, None, :] - others[None, :, :], axis=2)
     kept: NDArray[np.bool_] = np.all(gaps > reach, axis=1)
     return kept
+
+
+def nearest_by_object(points: ArrayLike, rays: ArrayLike, total: int, wraps: bool,
+                      centre: ArrayLike, radius: float, join: float) -> NDArray[np.float64]:
+    """
+    Return the nearest return of each obstacle a scan shows, within ``radius`` of ``centre``.
+
+    points: (K, 2) returns in scan order and rays: (K,) their rays' indices (of ``total``
+    rays; ``wraps``: the last ray's neighbour is the first, :func:`full_turn`); centre: (2,)
+    and radius: R_i, m; join: returns of neighbouring rays nearer each other than this, m,
+    belong to one obstacle. An obstacle is a run of such returns; its nearest return within
+    the radius stands for it, as a mapped obstacle's closest point does (one term an
+    obstacle). Returns (at most K, 2), in scan order.
+    """
+    p = np.asarray(points, dtype=float).reshape(-1, 2)
+    index = np.asarray(rays, dtype=np.intp).reshape(-1)
+    if len(p) == 0:
+        return np.zeros((0, 2))
+    step = np.roll(index, -1) - index
+    if wraps:
+        step = step % total
+    joined = (step == 1) & (np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1) < join)
+    if not wraps or len(p) == 1:
+        joined[-1] = False
+    starts = ~np.roll(joined, 1)
+    if not np.any(starts):
+        labels = np.zeros(len(p), dtype=np.intp)
+    else:
+        labels = np.cumsum(starts) - 1
+        labels[labels < 0] = labels[-1]
+    distance = np.linalg.norm(p - np.asarray(centre, dtype=float)[:2], axis=1)
+    near = distance < radius
+    p, labels, distance = p[near], labels[near], distance[near]
+    order = np.lexsort((distance, labels))
+    first = np.ones(len(order), dtype=bool)
+    first[1:] = labels[order][1:] != labels[order][:-1]
+    nearest: NDArray[np.float64] = p[np.sort(order[first])]
+    return nearest
 
 
 def nearest_by_sector(points: ArrayLike, centre: ArrayLike, radius: float,

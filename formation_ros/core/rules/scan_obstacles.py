@@ -20,7 +20,8 @@ from dataclasses import dataclass
 import math
 from typing import Deque, Optional, Tuple
 
-from formation_ros.core.maths.scan import (facing_normals, nearest_by_sector, off_neighbours,
+from formation_ros.core.maths.scan import (facing_normals, full_turn, nearest_by_object,
+                                           nearest_by_sector, off_neighbours, returning_rays,
                                            scan_points, scan_problem, ScanShape)
 from formation_ros.core.maths.unicycle import headings_from_quaternions
 from formation_ros.core.rules.admission import Reason
@@ -55,10 +56,19 @@ class Scan:
 
 @dataclass(frozen=True)
 class Placed:
-    """A scan's returns placed in the world frame: points (K, 2), m; the scan's stamp, ns."""
+    """
+    A scan's returns placed in the world frame.
+
+    stamp_ns: the scan's stamp, ns; points: (K, 2) m, in scan order; rays: (K,) their rays'
+    indices, of ``total`` rays; wraps: the rays go round (the last one's neighbour is the
+    first).
+    """
 
     stamp_ns: int
     points: NDArray[np.float64]
+    rays: NDArray[np.intp]
+    total: int
+    wraps: bool
 
 
 class ScanObstacles:
@@ -168,9 +178,12 @@ class ScanObstacles:
         if pose is None:
             return None
         position, heading = pose
-        self.placed = Placed(self.scan.stamp_ns, scan_points(self.scan.ranges,
-                                                             self.shape(self.scan), position,
-                                                             heading))
+        shape = self.shape(self.scan)
+        total = len(self.scan.ranges)
+        self.placed = Placed(self.scan.stamp_ns,
+                             scan_points(self.scan.ranges, shape, position, heading),
+                             returning_rays(self.scan.ranges, shape), total,
+                             full_turn(shape, total))
         return self.placed
 
     def obstacles(self, placed: Placed, position: ArrayLike, control_point: ArrayLike,
@@ -182,12 +195,16 @@ class ScanObstacles:
         now (its scanner's body), m; control_point: (2,) the point the law acts on, m;
         neighbours: (M, >= 2), 2-D also for M = 0: the positions of the neighbours it heard,
         m. Returns on a neighbour's body (within the reach of its position) are left out; of
-        the rest within R_i of the position, the nearest of each sector
+        the rest, the nearest within R_i of the position of each obstacle
+        (``obstacles.scan_join``), and of those the nearest of each sector
         (``obstacles.scan_sectors``).
         """
         others = np.asarray(neighbours, dtype=float)[:, :2]
-        points = placed.points[off_neighbours(placed.points, others, self.reach)]
-        kept = nearest_by_sector(points, np.asarray(position, dtype=float)[:2],
-                                 self.sensing_radius, self.settings.sectors)
+        off = off_neighbours(placed.points, others, self.reach)
+        centre = np.asarray(position, dtype=float)[:2]
+        objects = nearest_by_object(placed.points[off], placed.rays[off], placed.total,
+                                    placed.wraps, centre, self.sensing_radius,
+                                    self.settings.join)
+        kept = nearest_by_sector(objects, centre, self.sensing_radius, self.settings.sectors)
         self.kept = len(kept)
         return kept, facing_normals(kept, control_point)

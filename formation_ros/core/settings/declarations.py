@@ -322,6 +322,11 @@ DECLARATIONS = (
           "A scan return within body.radius plus this of a neighbour's position is that "
           "neighbour (left to the pair terms), m: the pose's age and noise.",
           low=at_least(0.0), high=at_least(LENGTH_LIMIT), users=ROBOT),
+    Param('obstacles.scan_join', Kind.DOUBLE, 0.2,
+          'Returns of neighbouring rays nearer each other than this are one obstacle, m: its '
+          "nearest return within R_i alone repels, as a mapped obstacle's closest point does "
+          '(0: every return repels).', low=at_least(0.0), high=at_least(LENGTH_LIMIT),
+          users=ROBOT),
     Param('obstacles.scan_sectors', Kind.INT, 72,
           'A robot keeps the nearest scan return of each of this many equal sectors of '
           "directions about it (72: 5 degrees) as its obstacle points: the law's cost stays "

@@ -116,14 +116,17 @@ class ScanSettings:
 
     frame: the frame_id its scans must carry; mount: (x, y) of the scanner in the base's frame,
     m, and mount_yaw its rotation there, rad; margin: a return within body.radius plus this of
-    a neighbour's position is that neighbour's, m; sectors: the sectors of directions about
-    the robot that keep their nearest return each (``core.maths.scan.nearest_by_sector``).
+    a neighbour's position is that neighbour's, m; join: returns of neighbouring rays nearer
+    each other than this are one obstacle, m (``core.maths.scan.nearest_by_object``); sectors:
+    the sectors of directions about the robot that keep their nearest return each
+    (``core.maths.scan.nearest_by_sector``).
     """
 
     frame: str
     mount: Tuple[float, float] = (0.0, 0.0)
     mount_yaw: float = 0.0
     margin: float = 0.05
+    join: float = 0.2
     sectors: int = 72
 
 
@@ -706,7 +709,8 @@ def _scan_settings(values: Mapping[str, Any], robot_id: int,
         problems.append(('obstacles.scan_frame', f'{frame!r} is not a frame id (no leading '
                                                  'slash, no spaces)'))
     return ScanSettings(frame, (float(mount[0]), float(mount[1])), float(mount[2]),
-                        values['obstacles.scan_margin'], values['obstacles.scan_sectors'])
+                        values['obstacles.scan_margin'], values['obstacles.scan_join'],
+                        values['obstacles.scan_sectors'])
 
 
 OBSTACLE_LISTS = ('obstacles.circles', 'obstacles.walls', 'obstacles.spheres')
