@@ -135,7 +135,6 @@ def test_each_obstacle_repels_by_its_nearest_return_wherever_the_scan_starts(hea
     assert nearest == pytest.approx([0.9, 0.9, 0.95], abs=2e-3), 'pillars, then the wall'
 
 
-
 def test_two_runs_of_returns_apart_are_two_obstacles_and_a_half_turn_scan_does_not_wrap():
     origin = np.zeros(2)
     scans = rule(radius=3.0, join=0.2)
