@@ -143,17 +143,17 @@ def test_two_runs_of_returns_apart_are_two_obstacles_and_a_half_turn_scan_does_n
     scans.scan_heard(synthetic(origin, 0.0, pillars))
     points, _ = scans.obstacles(scans.place(SECOND), origin, origin, np.zeros((0, 3)))
     assert len(points) == 2, 'a gap of 0.15 m between them: two obstacles'
-    half = Scan(2 * SECOND, FRAME, -math.pi / 2, STEP, RANGE_MIN, RANGE_MAX,
-                np.r_[np.full(5, 1.0), np.full(170, np.inf), np.full(5, 1.0)])
-    held(scans, origin, 0.0, 2 * SECOND)
-    scans.scan_heard(half)
-    points, _ = scans.obstacles(scans.place(SECOND), origin, origin, np.zeros((0, 3)))
-    assert len(points) == 2, 'the first and last rays of a half turn are not neighbours'
-    full = Scan(3 * SECOND, FRAME, -math.pi / 2, STEP, RANGE_MIN, RANGE_MAX,
-                np.r_[np.full(5, 1.0), np.full(350, np.inf), np.full(5, 1.0)])
-    held(scans, origin, 0.0, 3 * SECOND)
-    scans.scan_heard(full)
-    points, _ = scans.obstacles(scans.place(SECOND), origin, origin, np.zeros((0, 3)))
+
+    def ends_of(turn, stamp_ns):
+        """Return the obstacles of a scan of ``turn`` rays with returns at both ends only."""
+        held(scans, origin, 0.0, stamp_ns)
+        scans.scan_heard(Scan(stamp_ns, FRAME, -math.pi / 2, STEP, RANGE_MIN, RANGE_MAX,
+                              np.r_[np.full(5, 1.0), np.full(turn - 10, np.inf),
+                                    np.full(5, 1.0)]))
+        return scans.obstacles(scans.place(SECOND), origin, origin, np.zeros((0, 3)))[0]
+
+    assert len(ends_of(180, 2 * SECOND)) == 2, 'a half turn: its end rays are not neighbours'
+    points = ends_of(RAYS, 3 * SECOND)
     assert len(points) == 1, 'a full turn wraps: one obstacle across its first ray'
 
 
