@@ -28,7 +28,7 @@ from formation_ros.core.maths.law import Command
 from formation_ros.core.maths.obstacles import MAX_TOLD, quaternion_normals
 from formation_ros.core.maths.units import NS_PER_S
 from formation_ros.core.rules.admission import Reason
-from formation_ros.core.rules.answers import AnswerPolicy, INPUTS
+from formation_ros.core.rules.answers import AnswerPolicy
 from formation_ros.core.rules.control import Control, Sensed
 from formation_ros.core.rules.reference_track import ReferenceTrack
 from formation_ros.core.rules.robot_core import Answer, Note, RobotCore, Said, Wake as Due
@@ -118,8 +118,7 @@ class RobotNode(Node):
                      ScanObstacles(settings.scan, self.sensing_radius, config.body.radius))
         """This robot's obstacles from its own scans (``obstacles.source: scan``), or None."""
         self.policy = AnswerPolicy(max(1, int(round(period * NS_PER_S))), self.timeout_ns,
-                                   self.watch_ns, settings.wait_for_subscribers,
-                                   INPUTS if self.scan is None else INPUTS + ('scan',))
+                                   self.watch_ns, settings.wait_for_subscribers)
         self.pose: Optional[PoseData] = None
         self.neighbours: Optional[PoseArrayData] = None
         self.obstacles: Optional[PoseArrayData] = None
@@ -285,7 +284,8 @@ class RobotNode(Node):
 
         Admitted in ``obstacles.scan_frame``, with at most MAX_RAYS rays, readable fields, no
         NaN or -inf range and a stamp on this robot's clock (within input_timeout); placed in
-        the world frame when a state is answered (``core.rules.scan_obstacles``).
+        the world frame when a state is answered, if at most input_timeout older than it
+        (``core.rules.scan_obstacles``).
         """
         scan = self.inputs.read('scan', lambda raw: read_laser_scan(raw, MAX_RAYS), data)
         if scan is None or self.scan is None:
@@ -300,8 +300,6 @@ class RobotNode(Node):
             return
         self.inputs.on_clock('scan', 'scan messages on this clock again')
         self.scan.scan_heard(scan)
-        assert self.core is not None
-        self.core.scan_heard(self.now_ns())
 
     def _arm(self, due: Due) -> None:
         """Arm the answer when the core says it is due."""
@@ -380,8 +378,11 @@ class RobotNode(Node):
         return dataclasses.replace(sensed, obstacles=heard)
 
     def _scanned(self, sensed: Sensed) -> Sensed:
-        """Give ``sensed`` the obstacles of the latest scan; unseen if it cannot be placed."""
+        """Give ``sensed`` the obstacles of the latest scan; unseen if it cannot tell them."""
         assert self.scan is not None and self.pose is not None and self.neighbours is not None
+        unseen = self.scan.unseen(self.pose.stamp_ns, self.timeout_ns)
+        if unseen is not None:
+            return dataclasses.replace(sensed, unseen=unseen)
         placed = self.scan.place(self.timeout_ns)
         if placed is None:
             stamp = None if self.scan.scan is None else self.scan.scan.stamp_ns
@@ -474,6 +475,9 @@ class RobotNode(Node):
         values['bound c*M1 [m/s]'] = self.law.u_bound
         if self.scan is not None:
             values['obstacle points from the scan'] = self.scan.kept
+            if self.scan.scan is not None and self.pose is not None:
+                values['scan age at the latest state [s]'] = (
+                    (self.pose.stamp_ns - self.scan.scan.stamp_ns) / NS_PER_S)
         values.update(self._announcement(self.pose.stamp_ns if self.pose is not None else 0))
         values.update({f'rejected {name} messages ({reason.value})': count
                        for (name, reason), count in self.inputs.refused.items()})

@@ -9,7 +9,7 @@ from typing import Optional, Tuple
 
 from formation_ros.core.maths.frames import FrameSample
 from formation_ros.core.maths.units import NS_PER_S
-from formation_ros.core.rules.answers import AnswerPolicy, BURST, INPUTS
+from formation_ros.core.rules.answers import AnswerPolicy, BURST
 from formation_ros.core.rules.control import Control
 from formation_ros.core.rules.reference_track import ReferenceTrack
 from formation_ros.core.rules.robot_core import Note, RobotCore, Said
@@ -81,7 +81,7 @@ class Robot:
         self.core.state_heard(stamp_ns, now_ns, new)
 
 
-def make_robot(lockstep, wait_subscribers=1, evaluates=True, inputs=INPUTS):
+def make_robot(lockstep, wait_subscribers=1, evaluates=True):
     config = validate(load_params_file(SQUARE))
     base = config.reference()
     states = Timeline(TeamState.of(Mode.RUNNING, config.shape_name, base))
@@ -90,7 +90,7 @@ def make_robot(lockstep, wait_subscribers=1, evaluates=True, inputs=INPUTS):
     control = Control(config.law(), [1.5], 2, False, 0.0, False)
     track = ReferenceTrack(timeline, 2, config.world_frame, base.rate_limits(), evaluates,
                            TIMEOUT)
-    policy = AnswerPolicy(PERIOD, TIMEOUT, WATCH, wait_subscribers, inputs)
+    policy = AnswerPolicy(PERIOD, TIMEOUT, WATCH, wait_subscribers)
     holder = {}
     core = RobotCore(control, lambda: holder['robot'].sensed(), policy, track, changes,
                      lambda: holder['robot'].listeners[0], 'cmd_vel', lockstep, evaluates,
@@ -274,27 +274,6 @@ def test_the_answer_of_k_robots_is_one_call_of_their_control():
     assert np.array_equal(answer.commands, control.commands(team, vertices,
                                                             robot.timeline.frame_at(START))
                           .published)
-
-
-def test_a_robot_on_its_scanner_waits_for_a_scan_and_holds_still_when_it_goes_stale():
-    robot = make_robot(lockstep=False, inputs=INPUTS + ('scan',))
-    answer = started(robot)
-    assert not answer.publish
-    assert said(answer, Said.START)[0].text == 'waiting for scan'
-    robot.core.scan_heard(STEADY + 1)
-    robot.state(START + PERIOD, STEADY + 2)
-    robot.sample(START + PERIOD)
-    robot.core.reference_heard(STEADY + 2)
-    answer = robot.core.on_state(STEADY + 2, START + PERIOD)
-    assert answer.started and answer.publish and answer.commands is not None
-    late = STEADY + 1 + TIMEOUT + 1
-    robot.state(START + 2 * PERIOD, late)
-    robot.sample(START + 2 * PERIOD)
-    robot.core.reference_heard(late)
-    answer = robot.core.on_watchdog(late, START + 2 * PERIOD)
-    assert answer.publish and answer.commands is None
-    assert said(answer, Said.START) == [Note(Said.START, 'stale', 'no new scan for 0.5 s: '
-                                                                  'publishing zero')]
 
 
 def test_a_robot_that_cannot_tell_its_obstacles_holds_still_and_says_why():

@@ -227,3 +227,13 @@ def test_the_law_keeps_a_robot_off_a_pillar_it_only_sees():
     cosine = float(heard[0] @ told[0]) / float(np.linalg.norm(heard) * np.linalg.norm(told))
     assert cosine > math.cos(STEP / 2)
     assert np.linalg.norm(heard) == pytest.approx(np.linalg.norm(told), rel=0.05)
+
+
+def test_a_robot_cannot_tell_its_obstacles_without_a_recent_scan_by_the_stamps():
+    scans = rule()
+    assert scans.unseen(SECOND, SECOND // 2) == 'no scan heard yet'
+    held(scans, (0.0, 0.0), 0.0)
+    scans.scan_heard(synthetic((0.0, 0.0), 0.0, [(np.array([1.0, 0.0]), 0.2)]))
+    assert scans.unseen(SECOND + SECOND // 2, SECOND // 2) is None
+    assert scans.unseen(SECOND + SECOND // 2 + 1, SECOND // 2) == (
+        'its latest scan is more than 0.5 s older than the state')

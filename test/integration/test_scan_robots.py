@@ -110,7 +110,7 @@ def test_robots_go_round_a_pillar_only_their_scanners_see(processes, install, pr
     log = logged(probe, processes, 'launcher',
                  'ignoring scan messages with a frame other than obstacles.scan_frame (got '
                  "'base_scan', expected 'robot_1/base_scan')",
-                 'no new scan for 0.5 s: publishing zero')
+                 'its latest scan is more than 0.5 s older than the state: holding still')
     assert log.count('ignoring scan messages with a frame other') == 1
     info = stop_when(probe, processes, lambda: True)
     assert info.returncode == 0, processes.log('launcher')[-3000:]

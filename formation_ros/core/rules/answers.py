@@ -80,20 +80,17 @@ class AnswerPolicy:
 
     period_ns: the expected time between states on the robot's clock (the budget's);
     timeout_ns: ``input_timeout``; watch_ns: one period of ``control_rate``; all ns. Times
-    passed as ``now_ns`` are steady (ns), ``clock_ns`` the robot's clock (ns). inputs: what
-    start-up waits for and goes stale: :data:`INPUTS`, and ``scan`` for a robot that takes its
-    obstacles from its scanner.
+    passed as ``now_ns`` are steady (ns), ``clock_ns`` the robot's clock (ns).
     """
 
     def __init__(self, period_ns: int, timeout_ns: int, watch_ns: int,
-                 wait_subscribers: int, inputs: Sequence[str] = INPUTS) -> None:
+                 wait_subscribers: int) -> None:
         """Start waiting, nothing heard."""
         self.budget = AnswerBudget(period_ns)
         self.timeout_ns = timeout_ns
         self.watch_ns = watch_ns
         self.wait_subscribers = wait_subscribers
-        self.inputs = tuple(inputs)
-        self.received_ns: Dict[str, Optional[int]] = dict.fromkeys(self.inputs)
+        self.received_ns: Dict[str, Optional[int]] = dict.fromkeys(INPUTS)
         """Steady time each input was last heard (None: never)."""
         self.states = 0
         self.answered = 0
@@ -126,7 +123,7 @@ class AnswerPolicy:
         listeners: subscribers the command output has. Empty once every input was heard and
         ``wait_for_subscribers`` listen: the robot then no longer waits.
         """
-        never = [name for name in self.inputs if self.received_ns[name] is None]
+        never = [name for name in INPUTS if self.received_ns[name] is None]
         if listeners < self.wait_subscribers:
             never.append(f'{self.wait_subscribers} {what} subscribers (have {listeners})')
         if not never:

@@ -7,7 +7,7 @@ What K >= 1 robots of one process do with the states they hear: when and what th
 :class:`RobotCore` is the decision loop of a robot node (K = 1) and of a process's link to its
 robots (``transport: team``, K robots in one law call), without ROS: it notes the states heard
 (:meth:`RobotCore.pose_heard`, :meth:`RobotCore.neighbours_heard`,
-:meth:`RobotCore.obstacles_heard`, :meth:`RobotCore.scan_heard`, :meth:`RobotCore.state_heard`,
+:meth:`RobotCore.obstacles_heard`, :meth:`RobotCore.state_heard`,
 :meth:`RobotCore.reference_heard`), says when to look
 (:class:`Wake`), and at a look (:meth:`RobotCore.on_state`, :meth:`RobotCore.on_watchdog`)
 returns an :class:`Answer`: the commands to publish (None: zero) or the answer to send again,
@@ -183,15 +183,6 @@ class RobotCore:
             self.awaiting_neighbours = False
             return Wake(now=True)
         return Wake()
-
-    def scan_heard(self, now_ns: int) -> None:
-        """
-        Note an admitted scan heard at ``now_ns`` (steady, ns): an input that goes stale.
-
-        A scan is not of a state (the scanner keeps its own rate): the next state answered
-        uses the latest; none for input_timeout: zero (``core.rules.scan_obstacles``).
-        """
-        self.policy.heard(['scan'], now_ns)
 
     def state_heard(self, stamp_ns: int, now_ns: int, new: bool,
                     obstacles: bool = False) -> None:

@@ -9,10 +9,12 @@ scan (:meth:`ScanObstacles.refusal`: its frame, its fields, its size), keeps the
 and the robot's own poses of the last :data:`POSES_KEPT` states, and when the robot answers a
 state gives the law its obstacle points (:meth:`ScanObstacles.obstacles`): the returns placed
 in the world frame with the pose at the scan's stamp (interpolated between the two poses
-about it), the ones on a neighbour's body left out, the nearest of each sector within R_i
-kept, each a point obstacle facing the robot (``core.maths.scan``). The node counts what it
-refuses and holds still while the scan is older than ``input_timeout``
-(``core.rules.answers``: the input ``scan``).
+about it), the ones on a neighbour's body left out, of each obstacle the nearest return within
+R_i, at most one a sector, each a point obstacle facing the robot (``core.maths.scan``). The
+node counts what it refuses; the robot holds still while it cannot tell its obstacles at a
+state (:meth:`ScanObstacles.unseen`: no scan yet, or the latest older than ``input_timeout``
+by the stamps, on the robot's clock, so that a world running slower than real time is no
+reason).
 """
 
 from collections import deque
@@ -133,6 +135,20 @@ class ScanObstacles:
         """Keep an admitted scan (:meth:`refusal` said None); it is placed when first used."""
         self.scan = scan
         self.placed = None
+
+    def unseen(self, state_ns: int, timeout_ns: int) -> Optional[str]:
+        """
+        Return why the robot cannot tell its obstacles at the state stamped ``state_ns``, or None.
+
+        No scan yet, or the latest stamped more than ``timeout_ns`` (``input_timeout``) before
+        the state: a robot on its scanner does not drive on an old picture. One text a reason
+        (it is logged once while it lasts).
+        """
+        if self.scan is None:
+            return 'no scan heard yet'
+        if state_ns - self.scan.stamp_ns > timeout_ns:
+            return f'its latest scan is more than {timeout_ns / 1e9:g} s older than the state'
+        return None
 
     def pose_at(self, stamp_ns: int,
                 tolerance_ns: int) -> Optional[Tuple[NDArray[np.float64], float]]:
