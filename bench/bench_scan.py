@@ -16,8 +16,8 @@ the case's ``world.*`` changed: the scan rate, the noise, the rays, a thin chair
 also change the robots' file (``input_timeout``, against a slow scanner). It reads the world's
 DIR/world_stats.json (contacts with obstacles and between bodies, closest gaps, simulated time)
 and the report's DIR/metrics.json (settle time, stuck robots; its obstacle figures count only
-the obstacles the robots' file lists, so the chair is the world's), counts the robots' "no new
-scan" lines in the launcher's output, reads from DIR/trajectory.npz the closest any footprint
+the obstacles the robots' file lists, so the chair is the world's), counts the robots'
+"holding still" lines in the launcher's output, reads from DIR/trajectory.npz the closest any footprint
 came to the chair, which robots end at their places and how often each moves, prints a
 Markdown row per case and writes every row so far into OUT (after each run; ``--append`` adds
 to OUT's rows, ``--table`` prints OUT's). The runs use the caller's ROS_DOMAIN_ID.
@@ -84,7 +84,7 @@ HEADER = ('| case | robots | world changed | contacts with obstacles (first: rob
           'chair (m; robot, simulated s) | robot contacts | '
           'closest bodies (m) | settle (s) | '
           'stuck robots | robots at their place at the end | share of time moving | '
-          '"no new scan" lines | simulated (s) at x real time |\n'
+          '"holding still" lines | simulated (s) at x real time |\n'
           '|---|---|---|---:|---:|---|---:|---:|---:|---|---|---:|---:|---|')
 
 
@@ -166,7 +166,7 @@ def run_case(case: Dict[str, Any], folder: str, duration: float,
         'no_chair': bool(case.get('no_chair')), 'note': case.get('note', ''),
         'exit_code': code, 'wall_s': wall, 'load_before': load_before,
         'load_after': os.getloadavg(),
-        'no_new_scan_lines': sum('no new scan' in line for line in lines),
+        'holding_still_lines': sum('holding still' in line for line in lines),
         'publishing_zero_lines': sum('publishing zero' in line for line in lines),
         'command': ' '.join(command)}
     row.update(_world_stats(out))
@@ -321,7 +321,7 @@ def markdown_row(row: Dict[str, Any]) -> str:
             f"{_number(row['min_body_distance'])} | "
             f"{'not settled' if settle is None else _number(settle, 1)} | {stuck} | "
             f"{_robots(row.get('at_place'))} | {_share(row.get('moving_share'))} | "
-            f"{row['no_new_scan_lines']} | {row['simulated_time']:.1f} at "
+            f"{row['holding_still_lines']} | {row['simulated_time']:.1f} at "
             f"{row['achieved_realtime_factor']:.2f} |")
 
 
