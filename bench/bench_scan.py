@@ -17,8 +17,8 @@ also change the robots' file (``input_timeout``, against a slow scanner). It rea
 DIR/world_stats.json (contacts with obstacles and between bodies, closest gaps, simulated time)
 and the report's DIR/metrics.json (settle time, stuck robots; its obstacle figures count only
 the obstacles the robots' file lists, so the chair is the world's), counts the robots'
-"holding still" lines in the launcher's output, reads from DIR/trajectory.npz the closest any footprint
-came to the chair, which robots end at their places and how often each moves, prints a
+"holding still" lines in the launcher's output, reads from DIR/trajectory.npz the closest any
+footprint came to the chair, which robots end at their places and how often each moves, prints a
 Markdown row per case and writes every row so far into OUT (after each run; ``--append`` adds
 to OUT's rows, ``--table`` prints OUT's). The runs use the caller's ROS_DOMAIN_ID.
 """
