@@ -89,13 +89,14 @@ def test_unicycles_keep_their_bodies_off_a_pillar(dt):
     assert metrics['bound_violations'] == 0
 
 
-@pytest.mark.parametrize('name', ['pillars.yaml', 'doorway.yaml', 'helix_spheres.yaml'])
+@pytest.mark.parametrize('name', ['pillars.yaml', 'doorway.yaml', 'helix_spheres.yaml',
+                                  'world_doorway.yaml'])
 def test_the_obstacle_configs_run_without_contact(name):
     config = load_config(os.path.join(CONFIG, name))
     metrics = run_metrics(simulate(config, dt=0.02), config, 'test')
     assert metrics['obstacle_contacts'] == 0 and metrics['min_obstacle_clearance'] > 0.0
     assert metrics['bound_violations'] == 0 and metrics['min_pair_distance'] > 0.0
-    if name == 'doorway.yaml':
+    if name.endswith('doorway.yaml'):
         stuck = metrics['stuck_robots']
         assert stuck and all(robot['nearest_obstacle'].startswith('wall') for robot in stuck)
         assert 1 not in [robot['robot'] for robot in stuck]

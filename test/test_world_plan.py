@@ -14,6 +14,7 @@ from test_system_plan import launcher_views, node_view
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 WORLD = os.path.join(ROOT, 'config', 'world_turtlebot3.yaml')
 WORLD_OBSTACLES = os.path.join(ROOT, 'config', 'world_turtlebot3_obstacles.yaml')
+WORLD_DOORWAY = os.path.join(ROOT, 'config', 'world_doorway.yaml')
 LAB = os.path.join(ROOT, 'config', 'lab_turtlebot3.yaml')
 
 
@@ -31,19 +32,21 @@ def world_install(tmp_path):
                                         'record', 'fleet'))
 
 
-@pytest.mark.parametrize('config', [WORLD, WORLD_OBSTACLES])
+@pytest.mark.parametrize('config', [WORLD, WORLD_OBSTACLES, WORLD_DOORWAY])
 def test_the_world_relay_reference_and_robots_run_on_the_worlds_clock(config):
     from formation_ros.core.settings.declarations import BY_NAME as schema, Exe
     views = launcher_views(config, ['--world', '--out', '/nonexistent/w', '--record',
                                     '/nonexistent/w_bag'])
+    values = load_params_file(config)
+    robots_started = ['robot'] * values['num_robots']
     assert [view['executable'] for view in views] == ['record', 'world', 'relay',
-                                                      'reference'] + ['robot'] * 4
+                                                      'reference'] + robots_started
     record, world, relay, reference, *robots = views
     assert record['parameters'] == {'record.path': '/nonexistent/w_bag'}
     assert world['parameters'] == {'world.output_dir': '/nonexistent/w'}
     assert relay['parameters'] == {'use_sim_time': True}
     assert reference['parameters'] == {'use_sim_time': True}
-    rate = load_params_file(config)['relay.rate']
+    rate = values.get('relay.rate', schema['relay.rate'].default)
     for i, robot in enumerate(robots, start=1):
         assert robot['parameters'] == {'robot_id': i, 'wait_for_subscribers': 2,
                                        'use_sim_time': True, 'plant.rate': rate,
