@@ -9,7 +9,8 @@ import os
 from formation_ros.core.runs.obstacle_metrics import obstacle_metrics
 from formation_ros.core.settings.params import load_config, validate
 from formation_ros.core.settings.params_file import load_params_file
-from formation_ros.simulation.simulate import Progress, run_fixed_step, run_metrics, simulate
+from formation_ros.simulation.simulate import (format_summary, Progress, run_fixed_step,
+                                               run_metrics, simulate)
 from formation_ros.tools import report, sim
 import numpy as np
 import pytest
@@ -164,3 +165,19 @@ def test_the_plant_model_keeps_the_guarded_feed_forward_it_audits():
     assert metrics['obstacle_contacts'] == 0 and metrics['min_obstacle_clearance'] > 0.0
     assert np.all(run.trajectory.q[-1, :, 0] < 5.0)
     assert run.largest_u_hat <= config.law().u_bound + 1e-9
+
+
+def test_the_summary_judges_a_collision_by_the_bodies_size():
+    config = validate({**{k: v for k, v in BEHIND_A_WALL.items()
+                          if not k.startswith('obstacles.')}, 'duration': 3.0})
+    metrics = run_metrics(simulate(config, dt=0.01), config, 'test')
+    assert 'min pair distance: ' in format_summary(metrics)
+    assert '(no collision)' in format_summary(metrics)
+    apart = metrics['min_pair_distance']
+    sized = {**metrics, 'body_radius': 0.6 * apart}
+    assert f'(COLLISION; 2 x body.radius = {1.2 * apart:.4g} m)' in format_summary(sized)
+    small = {**metrics, 'body_radius': 0.4 * apart}
+    assert f'(no collision; 2 x body.radius = {0.8 * apart:.4g} m)' in format_summary(small)
+    sized_config = validate({**config.values, 'body.radius': 0.2})
+    assert run_metrics(simulate(sized_config, dt=0.01), sized_config, 'test')[
+        'body_radius'] == 0.2

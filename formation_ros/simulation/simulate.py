@@ -462,6 +462,8 @@ def run_metrics(trajectory: Trajectory, config: FormationConfig, integrator: str
     ``trajectory.q_desired``: give a trajectory of :func:`shaped` for the shape in force.
     """
     extra = {'reference_kind': config.reference_kind.value, 'integrator': integrator}
+    if config.body.radius > 0.0:
+        extra['body_radius'] = config.body.radius
     if trajectory.q_body is not None and trajectory.body_command is not None:
         body = config.body
         extra.update(body_metrics(trajectory.q_body, trajectory.body_command,
@@ -569,8 +571,8 @@ def _obstacle_lines(metrics: dict) -> list:
     if stuck:
         lines.append(f'  stuck ({len(stuck)}: within '
                      f"{metrics['stuck_still_speed'] * metrics['stuck_still_time']:g} m of where "
-                     f"it ended for the last {metrics['stuck_still_time']:g} s, farther than "
-                     f"{metrics['settle_tolerance']:g} m from its place):")
+                     f"it ended for the last {metrics['stuck_still_time']:g} s and no nearer its "
+                     f"place, farther than {metrics['settle_tolerance']:g} m from it):")
         lines += [f'    {stuck_line(robot)}' for robot in stuck]
     return lines
 
@@ -582,7 +584,11 @@ def format_summary(metrics: dict, out_dir: Optional[str] = None) -> str:
     settle_text = (f'{settle:.2f} s' if settle is not None else 'not settled by the end'
                    + (f': {stuck} robot{"s" if stuck > 1 else ""} stuck (below)' if stuck
                       else ''))
-    collision = 'no collision' if metrics['min_pair_distance'] > 0.0 else 'COLLISION'
+    touching = (0.0 if metrics.get('body_kind') == 'unicycle'
+                else 2.0 * metrics.get('body_radius', 0.0))
+    collision = 'no collision' if metrics['min_pair_distance'] > touching else 'COLLISION'
+    if touching > 0.0:
+        collision += f'; 2 x body.radius = {touching:.4g} m'
     lines = [
         f"  robots: {metrics['num_robots']} in {metrics['dim']}D, "
         f"{metrics['duration']:.2f} s, reference {metrics.get('reference_kind', '?')}",

@@ -88,12 +88,22 @@ def test_a_robot_still_moving_or_at_its_place_or_a_short_run_is_not_stuck():
     assert stuck_robots(t[:10], arrived[:10] + 5.0, q_desired[:10], PILLAR) == []
 
 
-def test_a_robot_trembling_on_the_spot_is_stuck():
+@pytest.mark.parametrize('amplitude', [0.01, 0.1])
+def test_a_robot_trembling_on_the_spot_is_stuck(amplitude):
     t = np.linspace(0.0, 20.0, 2001)
-    xs = -1.2 + 0.01 * np.where(np.arange(len(t)) % 2, 1.0, -1.0)  # 2 m/s back and forth
+    xs = -1.2 + amplitude * np.where(np.arange(len(t)) % 2, 1.0, -1.0)  # back and forth
     q = passing(xs, 0.0)
     q_desired = np.tile([[2.0, 0.0], [10.0, 10.0]], (len(t), 1, 1))
     assert [s.robot for s in stuck_robots(t, q, q_desired, PILLAR)] == [0]
+
+
+def test_a_robot_closing_in_slowly_is_not_stuck():
+    t = np.linspace(0.0, 20.0, 201)
+    q = passing(np.linspace(-1.0, -0.6, len(t)), 0.0)  # 0.1 m in the last 5 s, nearer
+    q_desired = np.tile([[2.0, 0.0], [10.0, 10.0]], (len(t), 1, 1))
+    assert stuck_robots(t, q, q_desired) == []
+    away = np.tile([[-5.0, 0.0], [10.0, 10.0]], (len(t), 1, 1))  # pushed away from its place
+    assert [s.robot for s in stuck_robots(t, q, away)] == [0]
 
 
 def test_a_base_turning_on_the_spot_is_stuck_though_its_hand_point_sweeps():
@@ -101,8 +111,8 @@ def test_a_base_turning_on_the_spot_is_stuck_though_its_hand_point_sweeps():
     axle = passing(np.full(len(t), -1.3), 0.0)
     angle = 3.0 * t
     hand = axle.copy()
-    hand[:, 0, 0] += 0.08 * np.cos(angle)
-    hand[:, 0, 1] += 0.08 * np.sin(angle)
+    hand[:, 0, 0] += 0.2 * np.cos(angle)
+    hand[:, 0, 1] += 0.2 * np.sin(angle)
     q_desired = np.tile([[2.0, 0.0], [10.0, 10.0]], (len(t), 1, 1))
     assert stuck_robots(t, hand, q_desired, PILLAR) == []  # the hand point alone: moving
     stuck = stuck_robots(t, hand, q_desired, PILLAR, bodies=axle, body_radius=0.05)

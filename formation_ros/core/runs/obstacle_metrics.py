@@ -19,10 +19,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 STILL_TIME = 5.0
-"""Seconds at the end of a run over which a stuck robot has hardly moved."""
-STILL_SPEED = 0.01
-"""m/s: a robot that stayed within this times :data:`STILL_TIME` of where it ended has hardly
-moved."""
+"""Seconds at the end of a run over which a stuck robot has not moved on."""
+STILL_SPEED = 0.05
+"""m/s: a robot that stayed within this times :data:`STILL_TIME` (0.25 m) of where it ended
+and got no nearer its place has not moved on: a body held at an obstacle trembles on the spot
+by up to tenths of a metre (measured on the physics world: 0.08 to 0.3 m)."""
 BLOCK_DISTANCES = 2_000_000
 """Robot-obstacle distances measured at once by :func:`obstacle_metrics` (about 50 MB)."""
 
@@ -130,10 +131,11 @@ def stuck_robots(t: ArrayLike, q: ArrayLike, q_desired: ArrayLike,
     Return the robots stuck at the end of a run, in index order.
 
     A robot is stuck when its control point ``q`` ends farther than ``tolerance`` (m) from its
-    place ``q_desired`` and stayed within ``still_speed * still_time`` of where it ended over
-    the last ``still_time`` seconds (a robot pressed against an obstacle may tremble on the
-    spot, which a path length would count as moving). A run shorter than ``still_time`` has
-    none. bodies: (T, N, dim) the bodies' positions when they are not the control points
+    place ``q_desired``, stayed within ``still_speed * still_time`` of where it ended over the
+    last ``still_time`` seconds and got no nearer its place over them than ``tolerance`` (a
+    robot pressed against an obstacle may tremble on the spot, which a path length would count
+    as moving; one still closing in slowly is not stuck). A run shorter than ``still_time``
+    has none. bodies: (T, N, dim) the bodies' positions when they are not the control points
     (unicycles' axle centres): whether a robot stays is told by its body (a base turning on the
     spot sweeps its hand point round it), and its footprint ``body_radius`` (m) is measured to
     the nearest obstacle.
@@ -145,8 +147,12 @@ def stuck_robots(t: ArrayLike, q: ArrayLike, q_desired: ArrayLike,
     window = times >= times[-1] - still_time
     where = q if bodies is None else np.asarray(bodies, dtype=float)
     wander = formation_errors(where[window], where[-1][None]).max(axis=0)
-    errors = formation_errors(q[-1], np.asarray(q_desired, dtype=float)[-1])
-    found = np.nonzero((errors > tolerance) & (wander < still_speed * still_time))[0]
+    desired = np.asarray(q_desired, dtype=float)
+    errors = formation_errors(q[-1], desired[-1])
+    first = int(np.argmax(window))
+    closed = formation_errors(q[first], desired[first]) - errors
+    found = np.nonzero((errors > tolerance) & (wander < still_speed * still_time)
+                       & (closed < tolerance))[0]
     places = q[-1] if bodies is None else np.asarray(bodies, dtype=float)[-1]
     gaps = (obstacle_clearances(places[None], obstacles, body_radius)[0]
             if obstacles is not None and obstacles.count and len(found) else None)
