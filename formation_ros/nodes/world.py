@@ -24,10 +24,10 @@ import time
 from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
 
 from diagnostic_msgs.msg import DiagnosticArray
-from formation_ros.core.maths.unicycle import quaternions_from_headings
+from formation_ros.core.maths.unicycle import headings_from_quaternions, quaternions_from_headings
 from formation_ros.core.maths.units import NS_PER_S
 from formation_ros.core.model.bodies import make_bodies
-from formation_ros.core.model.commanded import (commanded_velocity, HeardOrientations,
+from formation_ros.core.model.commanded import (commanded_velocity, HeardPoses,
                                                 needs_orientation)
 from formation_ros.core.rules.admission import Reason
 from formation_ros.core.rules.pacing import Pacer
@@ -152,12 +152,12 @@ class WorldNode(Node):
             for i in range(1, self.n + 1)]
         self.diagnostics_pub = self.create_publisher(DiagnosticArray, topics.DIAGNOSTICS,
                                                      qos.DIAGNOSTICS)
-        self.heard: Optional[HeardOrientations] = None
-        """The orientations of the states the robots heard (``pose``), to read what each
-        commanded (``_sample``); only when a command needs one, is stamped and is recorded."""
-        if (self.output_dir and self.stamped
-                and needs_orientation(self.unicycles, self.body_frame)):
-            self.heard = HeardOrientations(self.n, HEARD_KEPT)
+        self.heard: Optional[HeardPoses] = None
+        """The states the robots heard (``pose``), to read what each commanded (``_sample``):
+        at the orientation of the state it answered, if a command needs one, and at its
+        position (eq. 25's feed-forward); only for stamped commands, recorded."""
+        if self.output_dir and self.stamped:
+            self.heard = HeardPoses(self.n, HEARD_KEPT)
             self.state_subs = [self.create_subscription(
                 PoseStamped, topics.robot_topic(i, topics.POSE),
                 lambda data, index=i - 1: self.on_state_heard(index, data),
@@ -348,14 +348,14 @@ class WorldNode(Node):
         return np.where(self.engine.live()[:, None], self.engine.command, 0.0)
 
     def on_state_heard(self, index: int, data: bytes) -> None:
-        """Keep the orientation of a state robot ``index`` heard (its ``pose``), by its stamp."""
+        """Keep the pose of a state robot ``index`` heard (its ``pose``), by its stamp."""
         assert self.heard is not None
         try:
             pose = read_pose_stamped(data, exact=True)
         except CdrError:
             return
         if pose.frame_id == self.config.world_frame:
-            self.heard.hear(index, pose.stamp_ns, pose.orientation)
+            self.heard.hear(index, pose.stamp_ns, pose.position, pose.orientation)
 
     def _sample(self, t_ns: int) -> None:
         """
@@ -370,20 +370,28 @@ class WorldNode(Node):
         held = self._held()
         t = t_ns / NS_PER_S
         if not needs_orientation(self.unicycles, self.body_frame):
-            self.output.append(t, positions, held)
+            if self.heard is None:
+                self.output.append(t, positions, held)
+            else:
+                answered = self.heard.positions(self.engine.stamp_ns)[:, :self.dim]
+                self.output.append(t, positions, held, q_answered=answered)
             return
         answered = (self.heard.rows(self.engine.stamp_ns) if self.heard is not None
                     else np.full((self.n, 4), np.nan))
+        where = (self.heard.positions(self.engine.stamp_ns)[:, :self.dim]
+                 if self.heard is not None else np.full((self.n, self.dim), np.nan))
         distance = self.config.body.hand_distance
         commanded, at_truth = (
             commanded_velocity(held, orientations, self.unicycles, distance, self.body_frame)
             for orientations in (answered, quaternions_from_headings(headings)))
         if self.unicycles:
+            with np.errstate(invalid='ignore'):
+                points = self.bodies.control_points(where, headings_from_quaternions(answered))
             self.output.append(t, self.bodies.control_points(positions, headings), commanded,
                                heading=headings, q_body=positions, body_command=held,
-                               u_held=at_truth)
+                               u_held=at_truth, q_answered=points)
             return
-        self.output.append(t, positions, commanded, u_held=at_truth)
+        self.output.append(t, positions, commanded, u_held=at_truth, q_answered=where)
 
     def _log_contacts(self) -> None:
         """Log each new contact (two robots; a robot and an obstacle) once, with its time."""

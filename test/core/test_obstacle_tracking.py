@@ -8,10 +8,12 @@ from dataclasses import replace
 from formation_ros.core.maths.frames import stationary_frame
 from formation_ros.core.maths.law import make_law, team_command
 from formation_ros.core.maths.obstacle_tracking import (change_for, feed_forward_change,
-                                                        guarded_feed_forward, tracking_command)
+                                                        FeedForwardGuard, guarded_feed_forward,
+                                                        tracking_command)
 from formation_ros.core.maths.obstacles import (MAX_OBSTACLE_REPULSION, obstacle_terms,
                                                 Obstacles)
 from formation_ros.core.maths.reference import Reference
+from formation_ros.core.runs.trajectory import frame_velocities
 import numpy as np
 import pytest
 
@@ -88,3 +90,20 @@ def test_a_copy_of_the_command_is_returned_not_the_input_changed():
     kept = replace(command)
     tracking_command(command, q, frame, LAW, WALL, [2.0])
     assert np.array_equal(command.u, kept.u)
+
+
+def test_a_command_is_read_back_at_the_state_it_answered_not_where_the_body_went():
+    frame = Reference('line', 2, [0.0, 0.0], [4.0, 0.0]).sample(0.0)
+    state = np.array([[4.4, 0.3]])
+    command = tracking_command(team_command(state, [[0.0, 0.0]], [2.0], LAW, frame,
+                                            obstacles=WALL),
+                               state, frame, LAW, WALL, [2.0])
+    guard = FeedForwardGuard(LAW, WALL, np.array([2.0]))
+    moved = state + [[0.15, 0.0]]  # where the body is at the sample, a state later
+    at_sample = frame_velocities(command.u[None], moved[None], [frame], guard)[0]
+    answered = frame_velocities(command.u[None], moved[None], [frame], guard, state[None])[0]
+    assert answered == pytest.approx(command.u_hat, abs=1e-12)
+    assert np.max(np.abs(at_sample - command.u_hat)) > 0.1, 'read at the sample: not what it was'
+    unknown = frame_velocities(command.u[None], moved[None], [frame], guard,
+                               np.full((1, 1, 2), np.nan))[0]
+    assert unknown == pytest.approx(at_sample)

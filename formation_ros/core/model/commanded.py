@@ -56,12 +56,12 @@ def commanded_velocity(published: ArrayLike, orientations: ArrayLike, unicycle: 
     return np.where(still[:, None], 0.0, velocity)
 
 
-class HeardOrientations:
+class HeardPoses:
     """
-    The orientation of each robot's pose, by stamp, as the robots heard them.
+    Each robot's pose, by stamp, as the robots heard them: the states their commands answer.
 
-    Keeps the last ``kept`` stamps of each of ``robots`` robots (stamps in ns, quaternions (4,)
-    x, y, z, w), enough to look up the state any held command answers.
+    Keeps the last ``kept`` stamps of each of ``robots`` robots (stamps in ns; positions (3,) m
+    and quaternions (4,) x, y, z, w), enough to look up the state any held command answers.
     """
 
     def __init__(self, robots: int, kept: int) -> None:
@@ -69,18 +69,30 @@ class HeardOrientations:
         self.kept = kept
         self._heard: List['OrderedDict[int, Float]'] = [OrderedDict() for _ in range(robots)]
 
-    def hear(self, index: int, stamp_ns: int, orientation: ArrayLike) -> None:
-        """Keep robot ``index``'s (0-based) orientation of the pose stamped ``stamp_ns``."""
+    def hear(self, index: int, stamp_ns: int, position: ArrayLike,
+             orientation: ArrayLike) -> None:
+        """Keep robot ``index``'s (0-based) pose stamped ``stamp_ns``."""
         heard = self._heard[index]
-        heard[int(stamp_ns)] = np.array(orientation, dtype=float)
+        heard[int(stamp_ns)] = np.concatenate([np.asarray(position, dtype=float)[:3],
+                                               np.asarray(orientation, dtype=float)[:4]])
         while len(heard) > self.kept:
             heard.popitem(last=False)
 
     def at(self, index: int, stamp_ns: int) -> Optional[Float]:
         """Return robot ``index``'s orientation (4,) at ``stamp_ns``, None if not heard."""
-        return self._heard[index].get(int(stamp_ns))
+        pose = self._heard[index].get(int(stamp_ns))
+        return None if pose is None else pose[3:]
 
     def rows(self, stamps_ns: ArrayLike) -> Float:
         """Return every robot's orientation at its stamp, (N, 4); NaN rows where not heard."""
-        found = [self.at(i, stamp) for i, stamp in enumerate(np.asarray(stamps_ns).tolist())]
-        return np.array([UNKNOWN_ORIENTATION if row is None else row for row in found])
+        return self._poses(stamps_ns)[:, 3:]
+
+    def positions(self, stamps_ns: ArrayLike) -> Float:
+        """Return every robot's position at its stamp, (N, 3) m; NaN rows where not heard."""
+        return self._poses(stamps_ns)[:, :3]
+
+    def _poses(self, stamps_ns: ArrayLike) -> Float:
+        found = [self._heard[i].get(int(stamp))
+                 for i, stamp in enumerate(np.asarray(stamps_ns).tolist())]
+        unknown = np.full(7, np.nan)
+        return np.array([unknown if row is None else row for row in found]).reshape(-1, 7)

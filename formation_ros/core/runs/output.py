@@ -24,9 +24,9 @@ from typing import Any, Callable, Dict, Mapping, Optional, Tuple
 from formation_ros.core.maths.frames import FrameSample
 from formation_ros.core.maths.obstacle_tracking import FeedForwardGuard
 from formation_ros.core.maths.units import NS_PER_S
-from formation_ros.core.runs.trajectory import (CHUNKS_DIR, ChunkWriter, read_body_chunks,
-                                                read_chunks, read_held_chunks, save_atomically,
-                                                Trajectory, TRAJECTORY_FILE)
+from formation_ros.core.runs.trajectory import (CHUNKS_DIR, ChunkWriter, read_answered_chunks,
+                                                read_body_chunks, read_chunks, read_held_chunks,
+                                                save_atomically, Trajectory, TRAJECTORY_FILE)
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -80,7 +80,8 @@ def trajectory_from_chunks(folder: str, frame_at: FrameAt, shape_at: ShapeAt, bo
     frames = [frame_at(time_s) for time_s in t]
     shapes = (shape_at.vertices if isinstance(shape_at, FixedShape) else
               [np.asarray(shape_at(int(round(time_s * NS_PER_S))), dtype=float) for time_s in t])
-    trajectory = Trajectory.from_frames(t, q, u, frames, shapes, guard)
+    trajectory = Trajectory.from_frames(t, q, u, frames, shapes, guard,
+                                        read_answered_chunks(folder))
     body = read_body_chunks(folder) if bodies else None
     if body is not None:
         trajectory = replace(trajectory, **body)

@@ -82,21 +82,23 @@ class Trajectory:
     @classmethod
     def from_frames(cls, t: ArrayLike, q: ArrayLike, u: ArrayLike,
                     frames: Sequence[FrameSample], vertices: ArrayLike,
-                    guard: Optional[FeedForwardGuard] = None) -> 'Trajectory':
+                    guard: Optional[FeedForwardGuard] = None,
+                    answered: Optional[ArrayLike] = None) -> 'Trajectory':
         """
         Build a trajectory from states and commands and the reference frame of each sample.
 
         t: (T,) s; q, u: (T, N, dim); frames: T FrameSamples; vertices: (N, dim), or (T, N,
         dim) for a shape that changes (the shape in force at each sample). u_hat comes from
-        inverting eq. (25) (the obstacles' rule ``guard`` taken off first, if given), desired
-        positions from eq. (20).
+        inverting eq. (25) (the obstacles' rule ``guard`` taken off first, if given; at the
+        positions of the states the commands ``answered`` where known,
+        :func:`frame_velocities`), desired positions from eq. (20).
         """
         q = np.asarray(q, dtype=float)
         u = np.asarray(u, dtype=float)
         shapes = np.asarray(vertices, dtype=float)
         per_sample = shapes if shapes.ndim == 3 else [shapes] * len(frames)
         return cls(t=np.asarray(t, dtype=float), q=q, u=u,
-                   u_hat=frame_velocities(u, q, frames, guard),
+                   u_hat=frame_velocities(u, q, frames, guard, answered),
                    q_desired=np.array([desired_positions(v, f)
                                        for v, f in zip(per_sample, frames)]),
                    q_od=np.array([f.q_od for f in frames]))
@@ -126,22 +128,29 @@ class Trajectory:
 
 
 def frame_velocities(u: ArrayLike, q: ArrayLike, frames: Sequence[FrameSample],
-                     guard: Optional[FeedForwardGuard] = None) -> NDArray[np.float64]:
+                     guard: Optional[FeedForwardGuard] = None,
+                     answered: Optional[ArrayLike] = None) -> NDArray[np.float64]:
     """
     Return u (T, N, dim) m/s in the formation frame of each sample, eq. (25) inverted.
 
     guard: the obstacles' feed-forward rule the commands were given under
-    (``core.maths.obstacle_tracking``), taken off before the inversion; None: none.
+    (``core.maths.obstacle_tracking``), taken off before the inversion; None: none. answered:
+    (T, N, dim) the positions of the states the commands answered, m, where known (NaN: not):
+    eq. (25)'s feed-forward and the rule depend on the position the robot computed at, which
+    a plant or world has moved on from by the sample (near an obstacle the rule changes within
+    centimetres); None: the samples' positions.
     """
+    q = np.asarray(q, dtype=float)
+    at = q if answered is None else np.where(np.isfinite(answered), answered, q)
     return np.array([to_frame_velocity(u_k if guard is None else guard.sent(u_k, q_k, f),
                                        q_k, f)
-                     for u_k, q_k, f in zip(np.asarray(u, dtype=float),
-                                            np.asarray(q, dtype=float), frames)])
+                     for u_k, q_k, f in zip(np.asarray(u, dtype=float), at, frames)])
 
 
 CHUNKS_DIR = 'trajectory_chunks'
-CHUNK_EXTRAS = BODY_ARRAYS + ('u_held',)
-"""Arrays a chunk may hold beside t, q and u (u_hat_held is computed from u_held on reading)."""
+CHUNK_EXTRAS = BODY_ARRAYS + ('u_held', 'q_answered')
+"""Arrays a chunk may hold beside t, q and u (u_hat_held is computed from u_held on reading;
+q_answered, the positions of the states the commands answered, is used in reading u_hat)."""
 
 
 class ChunkWriter:
@@ -269,6 +278,16 @@ def read_held_chunks(folder: str) -> Optional[NDArray[np.float64]]:
     """
     parts = _optional_chunks(folder, ('u_held',))
     return None if parts is None else parts['u_held']
+
+
+def read_answered_chunks(folder: str) -> Optional[NDArray[np.float64]]:
+    """
+    Read back q_answered (T, N, dim) of the chunks in ``folder``, m (NaN: not known).
+
+    None when the chunks hold none. Call after :func:`read_chunks` succeeded.
+    """
+    parts = _optional_chunks(folder, ('q_answered',))
+    return None if parts is None else parts['q_answered']
 
 
 def _optional_chunks(folder: str,
