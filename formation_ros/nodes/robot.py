@@ -21,7 +21,7 @@ docs/faults.md. One per robot::
 
 import dataclasses
 import time
-from typing import Any, Callable, Dict, List, Optional, Tuple
+from typing import Any, Callable, Dict, List, Optional, Tuple, Union
 
 from diagnostic_msgs.msg import DiagnosticArray
 from formation_ros.core.maths.law import Command
@@ -56,7 +56,7 @@ from formation_ros.ros.wake import Wake
 from geometry_msgs.msg import PoseArray, PoseStamped
 from nav_msgs.msg import Odometry
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 import rclpy
 from rclpy.clock import Clock, ClockType
 from rclpy.node import Node
@@ -379,21 +379,36 @@ class RobotNode(Node):
 
     def _scanned(self, sensed: Sensed) -> Sensed:
         """Give ``sensed`` the obstacles of the latest scan; unseen if it cannot tell them."""
-        assert self.scan is not None and self.pose is not None and self.neighbours is not None
-        unseen = self.scan.unseen(self.pose.stamp_ns, self.timeout_ns)
+        assert self.pose is not None and self.neighbours is not None
+        seen = self.scanned(self.pose.stamp_ns, self.pose.position, sensed.points[0],
+                            self.neighbours.positions)
+        if isinstance(seen, str):
+            return dataclasses.replace(sensed, unseen=seen)
+        return dataclasses.replace(sensed, obstacles=self.control.scanned_obstacles([seen]))
+
+    def scanned(self, stamp_ns: int, position: ArrayLike, control_point: ArrayLike,
+                neighbours: ArrayLike) -> Union[str, Tuple[NDArray[np.float64],
+                                                           NDArray[np.float64]]]:
+        """
+        Return this robot's obstacles from its scan at the state ``stamp_ns``, or why none.
+
+        position: (>= 2,) its pose's position and control_point (2,) its law's point, m;
+        neighbours: (M, >= 2) the positions of the neighbours it sensed, m. Returns (points,
+        normals) (``ScanObstacles.obstacles``), or the reason it cannot tell them
+        (``ScanObstacles.unseen``; a scan it cannot place is counted once).
+        """
+        assert self.scan is not None
+        unseen = self.scan.unseen(stamp_ns, self.timeout_ns)
         if unseen is not None:
-            return dataclasses.replace(sensed, unseen=unseen)
+            return unseen
         placed = self.scan.place(self.timeout_ns)
         if placed is None:
             stamp = None if self.scan.scan is None else self.scan.scan.stamp_ns
             if stamp is not None and stamp != self.unplaced_stamp:
                 self.unplaced_stamp = stamp
                 self.inputs.refuse('scan', Refused(Reason.UNPLACED))
-            return dataclasses.replace(sensed, unseen='its scan cannot be placed')
-        points, normals = self.scan.obstacles(placed, self.pose.position, sensed.points[0],
-                                              self.neighbours.positions)
-        return dataclasses.replace(sensed, obstacles=self.control.scanned_obstacles(points,
-                                                                                    normals))
+            return 'its scan cannot be placed'
+        return self.scan.obstacles(placed, position, control_point, neighbours)
 
     def on_state(self) -> None:
         """Answer a state as soon as its pose and neighbours are in (armed by the callbacks)."""

@@ -16,7 +16,7 @@ The message layouts and rules: docs/ros_interface.md ("Transports", "Obstacles")
 """
 
 import dataclasses
-from typing import Callable, List, Optional, Protocol, Sequence, Tuple
+from typing import Callable, List, Optional, Protocol, Sequence, Tuple, Union
 
 from formation_ros.core.maths.law import Command, LawParams
 from formation_ros.core.maths.obstacles import HeardObstacles, MAX_TOLD, quaternion_normals
@@ -27,6 +27,7 @@ from formation_ros.core.rules.answers import AnswerPolicy
 from formation_ros.core.rules.control import Control, Sensed
 from formation_ros.core.rules.robot_core import RobotCore
 from formation_ros.core.rules.robot_intake import Refused
+from formation_ros.core.rules.scan_obstacles import ScanObstacles
 from formation_ros.core.rules.transport import command_vectors
 from formation_ros.core.settings.declarations import ParamError
 from formation_ros.core.settings.names import robot_name
@@ -42,7 +43,7 @@ from formation_ros.ros.sim_clock import StateClock
 from formation_ros.ros.wake import Wake
 from geometry_msgs.msg import PoseArray
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 from rclpy.clock import Clock
 from rclpy.duration import Duration
 from rclpy.node import Node
@@ -58,6 +59,7 @@ class LinkedRobot(Protocol):
     index: int
     sensing_radius: float
     config: FormationConfig
+    scan: Optional[ScanObstacles]
     law: LawParams
     control: Control
     cmd_vel: CmdVel
@@ -90,6 +92,11 @@ class LinkedRobot(Protocol):
 
     def on_state(self) -> None:
         """Answer the state taken."""
+
+    def scanned(self, stamp_ns: int, position: ArrayLike, control_point: ArrayLike,
+                neighbours: ArrayLike) -> Union[str, Tuple[NDArray[np.float64],
+                                                           NDArray[np.float64]]]:
+        """Return the robot's obstacles from its scan at a state, or why none."""
 
 
 class Linked:
@@ -172,7 +179,7 @@ class RobotsLink:
         self.wake = Wake(leader, self.on_wake, leader.steady)
         leader.create_subscription(PoseArray, topics.STATES, self.on_states, qos.STATE_INPUT,
                                    raw=True)
-        if leader.control.obstacle_clearance is not None:
+        if leader.control.obstacle_clearance is not None and leader.scan is None:
             leader.create_subscription(MultiDOFJointTrajectory, topics.TEAM_OBSTACLES,
                                        self.on_obstacles, qos.STATE_INPUT, raw=True)
         self.listeners_timer = leader.create_timer(LISTENERS_PERIOD, self.on_demand.look,
@@ -265,12 +272,33 @@ class RobotsLink:
                                  points[self.seen])
         self.bounds = np.searchsorted(self.sensed_now.observer, np.arange(len(self.nodes) + 1))
         self.state = state
+        for node in self.nodes:
+            if node.scan is not None:
+                node.scan.pose_heard(state.stamp_ns, tuple(state.positions[node.index]),
+                                     tuple(state.orientations[node.index]))
         return True
 
     def sensed(self) -> Sensed:
-        """Return what the robots know of the state taken last (``core.rules.control.Sensed``)."""
+        """
+        Return what the robots know of the state taken last (``core.rules.control.Sensed``).
+
+        Robots on their scanners (``obstacles.source: scan``) take their obstacles from them
+        (``RobotNode.scanned``); while one of them cannot tell its own, all hold still.
+        """
         assert self.sensed_now is not None
-        return self.sensed_now
+        if self.leader.scan is None or self.state is None:
+            return self.sensed_now
+        state, seen = self.state, []
+        for k, node in enumerate(self.nodes):
+            near = self.seen[self.bounds[k]:self.bounds[k + 1]]
+            view = node.scanned(state.stamp_ns, state.positions[node.index],
+                                self.sensed_now.points[k], state.positions[near])
+            if isinstance(view, str):
+                return dataclasses.replace(self.sensed_now,
+                                           unseen=f'{robot_name(node.index + 1)}: {view}')
+            seen.append(view)
+        return dataclasses.replace(self.sensed_now,
+                                   obstacles=self.control.scanned_obstacles(seen))
 
     def _give(self, node: LinkedRobot, new: bool) -> None:
         """Give robot ``node`` its pose, neighbours and latest command as of the state taken."""

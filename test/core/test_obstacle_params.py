@@ -146,7 +146,6 @@ def test_a_robot_on_its_scanner_reads_the_scan_settings():
 
 @pytest.mark.parametrize('extra, name, words', [
     ({}, 'obstacles.source', 'needs obstacles.clearance'),
-    ({'obstacles.clearance': 0.4, 'transport': 'team'}, 'obstacles.source', 'transport: robot'),
     ({'obstacles.clearance': 0.4, 'obstacles.scan_mount': [0.1, 0.0]}, 'obstacles.scan_mount',
      'takes [x, y, yaw]'),
     ({'obstacles.clearance': 0.4, 'obstacles.scan_frame': '/base scan'},

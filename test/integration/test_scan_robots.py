@@ -8,8 +8,9 @@ A pillar stands between robot 1's start and its place; nobody's parameters file 
 plant knows no obstacle, and the robots see the pillar only in the scans of a stand-in scanner
 written here, as a lab's LDS driver sends them (best effort, 5 Hz on the robot's clock, its own
 frame, a return per degree from 0.12 to 3.5 m, the scan published a state after the pose it
-was taken at). Robot 1 goes round the pillar; then its scanner sends scans in the driver's
-frame ``base_scan`` (refused, counted once) and it holds still and says why.
+was taken at). Robot 1 goes round the pillar, with either transport (the team's robots of one
+process read their own scans); then its scanner sends scans in the driver's frame
+``base_scan`` (refused, counted once) and it holds still and says why.
 """
 
 import math
@@ -19,6 +20,7 @@ from formation_ros.ros import fields
 from geometry_msgs.msg import PoseStamped
 from helpers import launch, logged, Statuses, stop_when, write_params
 import numpy as np
+import pytest
 from rclpy.qos import qos_profile_sensor_data
 from sensor_msgs.msg import LaserScan
 
@@ -79,9 +81,10 @@ class StandInScanner:
         self.taken = scan
 
 
+@pytest.mark.parametrize('transport', ['robot', 'team'])
 def test_robots_go_round_a_pillar_only_their_scanners_see(processes, install, probe,
-                                                          tmp_path):
-    params = write_params(tmp_path, 'square_4.yaml', UNSEEN)
+                                                          tmp_path, transport):
+    params = write_params(tmp_path, 'square_4.yaml', {**UNSEEN, 'transport': transport})
     config = load_config(params, 'plant')
     assert config.obstacles is None, "the pillar is on nobody's map"
     scanners = [StandInScanner(probe, i) for i in range(1, 5)]

@@ -149,15 +149,15 @@ class Control:
         return HeardObstacles.from_lists(lists, self.dim, self.footprint,
                                          self.obstacle_clearance)
 
-    def scanned_obstacles(self, points: ArrayLike, normals: ArrayLike) -> HeardObstacles:
+    def scanned_obstacles(self, seen: Sequence[Tuple[ArrayLike, ArrayLike]]) -> HeardObstacles:
         """
-        Return one robot's obstacles from its scan, as the law takes them (K = 1).
+        Return K robots' obstacles from their scans, as the law takes them.
 
-        points: (M, 2) returns kept and normals: (M, 2) unit, facing the robot
-        (``core.rules.scan_obstacles``); needs ``obstacles.clearance`` (b_o).
+        seen: per robot, (points (M, 2) returns kept, normals (M, 2) unit, facing the robot:
+        ``core.rules.scan_obstacles``); needs ``obstacles.clearance`` (b_o).
         """
         assert self.obstacle_clearance is not None
-        return HeardObstacles.from_lists([(points, normals)], self.dim, self.footprint,
+        return HeardObstacles.from_lists(list(seen), self.dim, self.footprint,
                                          self.obstacle_clearance)
 
     def zero(self) -> Float:

@@ -697,9 +697,6 @@ def _scan_settings(values: Mapping[str, Any], robot_id: int,
     if values['dim'] != 2:
         problems.append(('obstacles.source', f"scan is a planar scanner's: dim must be 2, got "
                                              f"{values['dim']}"))
-    if values.get('transport') == Transport.TEAM.value:
-        problems.append(('obstacles.source', 'scan takes transport: robot (each robot answers '
-                                             'its own states with its own scan)'))
     mount = values.get('obstacles.scan_mount') or [0.0, 0.0, 0.0]
     if len(mount) != 3:
         problems.append(('obstacles.scan_mount', f'takes [x, y, yaw], got {len(mount)} numbers'))

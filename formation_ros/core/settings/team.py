@@ -29,10 +29,11 @@ LAW_VALUES = ('controller.gain', 'controller.kappa', 'controller.psi', 'jump.kin
               'jump.order', 'body.kind', 'body.hand_distance')
 """Parameters of the law and the bodies, announced by :func:`team_values`."""
 LINK_VALUES = FRAME_VALUES + LAW_VALUES + ('command.type', 'command.frame', 'plant.lockstep',
-                                           'transport', 'body.radius', 'obstacles.clearance')
+                                           'transport', 'body.radius', 'obstacles.clearance',
+                                           'obstacles.source')
 """Parameters the robots of one process with ``transport: team`` share: one call of the law
-computes their commands, with one footprint and clearance b_o against obstacles (the watchdog
-and input timeout are the first robot's)."""
+computes their commands, with one footprint and clearance b_o against obstacles, told or seen
+(the watchdog and input timeout are the first robot's)."""
 REFERENCE_PREFIXES = ('reference.', 'formation.', 'formations.')
 """Prefixes of the parameters that decide the reference a robot follows and its changes."""
 DUPLICATE_GRACE = 25.0
