@@ -289,16 +289,16 @@ class ObstacleGrid:
             first = last = np.zeros_like(xy)
             entries = np.ones(len(xy))
         self.cell = cell
-        self.shape = shape
-        width = int(shape[1])
+        self.top = shape + 1.0
+        self.width = int(shape[1]) + 2
         cells = np.concatenate([np.zeros(0, dtype=np.intp)] + [
-            (np.arange(a[0], b[0] + 1, dtype=np.intp)[:, None] * width
-             + np.arange(a[1], b[1] + 1, dtype=np.intp)[None, :]).ravel()
+            (np.arange(a[0] + 1, b[0] + 2, dtype=np.intp)[:, None] * self.width
+             + np.arange(a[1] + 1, b[1] + 2, dtype=np.intp)[None, :]).ravel()
             for a, b in zip(first.astype(np.intp), last.astype(np.intp))])
         owners = np.repeat(np.arange(len(centres), dtype=np.intp), entries.astype(np.intp))
         self.members = owners[np.argsort(cells, kind='stable')]
-        filed = np.bincount(cells, minlength=int(np.prod(shape)))
-        self.starts = np.concatenate([[0], np.cumsum(filed)]).astype(np.intp)
+        self.filed = np.bincount(cells, minlength=int(self.top[0] + 1.0) * self.width)
+        self.starts = np.concatenate([[0], np.cumsum(self.filed)]).astype(np.intp)
 
     def near(self, q: NDArray[np.float64], acts: NDArray[np.float64]
              ) -> Tuple[NDArray[np.intp], NDArray[np.intp], NDArray[np.float64]]:
@@ -308,18 +308,18 @@ class ObstacleGrid:
         q: (N, dim) positions, m; acts: (N,) how near each robot's obstacles act, m (at most
         the grid's b_o). The pairs with squared centre distance (P,) m**2 below
         (acts_i + reach_k)**2, sorted by robot, then obstacle: exactly those, in the order, of
-        the test over every pair.
+        the test over every pair. The cells are numbered with a ring of empty ones round the
+        grid, where a robot outside it (or not a number) falls.
         """
         if math.isinf(self.cell):
-            robots = np.arange(len(q))
-            cells = np.zeros(len(q), dtype=np.intp)
+            cells = np.full(len(q), self.width + 1)
         else:
             with np.errstate(invalid='ignore', over='ignore'):
-                scaled = (q[:, :2] - self.low) / self.cell
-                inside = np.all((scaled >= 0.0) & (scaled < self.shape), axis=1)
-            robots = np.flatnonzero(inside)
-            where = scaled[robots].astype(np.intp)
-            cells = where[:, 0] * int(self.shape[1]) + where[:, 1]
+                scaled = (q[:, :2] - self.low) / self.cell + 1.0
+            where = np.fmin(np.fmax(scaled, 0.0), self.top).astype(np.intp)
+            cells = where[:, 0] * self.width + where[:, 1]
+        robots = np.flatnonzero(self.filed[cells])
+        cells = cells[robots]
         first = self.starts[cells]
         count = self.starts[cells + 1] - first
         robots = np.repeat(robots, count)
