@@ -8,7 +8,8 @@ Usage: python bench/bench_obstacles.py [--cost-sizes 1000] [--pillars 100] [--re
 [--sweep] [--out DIR]
 
 Cost: for each N, the whole ``formation_sim PARAMS --out DIR --dt 0.01 --sample-dt 0.1
---no-plots --quiet`` command as a child process (as a user runs it), wall time, with and
+--no-plots --quiet`` command as a child process (as a user runs it), wall time and its CPU
+time (user plus system: what other work on the machine does not stretch), with and
 without ``--pillars`` pillars: Section 5 constants (``bench_core.params_for``: random start at
 about 10 robots per m^2, lattice goal 2 m apart, 20 s), pillars of radius 0.2 m at the centres
 of the goal lattice's cells (1.41 m from the nearest places) outside the start disc, b_o = 0.5 m.
@@ -23,6 +24,7 @@ import argparse
 import json
 import math
 import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -57,23 +59,31 @@ def lattice_pillars(params, count):
 
 
 def run_command(params, dt=0.01, sample_dt=0.1):
-    """Run formation_sim on ``params`` as a child process; return (wall s, metrics)."""
+    """Run formation_sim on ``params`` as a child process; return (wall s, CPU s, metrics)."""
     with tempfile.TemporaryDirectory() as folder:
         path = os.path.join(folder, 'params.yaml')
         write_params_file(path, params)
         out = os.path.join(folder, 'run')
         command = [sys.executable, '-m', 'formation_ros.tools.sim', path, '--out', out,
                    '--dt', f'{dt:g}', '--sample-dt', f'{sample_dt:g}', '--no-plots', '--quiet']
+        used = _child_cpu()
         begun = time.perf_counter()
         subprocess.run(command, check=True, cwd=ROOT, stdout=subprocess.DEVNULL,
                        env={**os.environ, 'PYTHONPATH': ROOT})
         wall = time.perf_counter() - begun
+        cpu = _child_cpu() - used
         with open(os.path.join(out, 'metrics.json'), encoding='utf-8') as stream:
-            return wall, json.load(stream)
+            return wall, cpu, json.load(stream)
+
+
+def _child_cpu():
+    """Return the user plus system CPU seconds of the children waited for so far."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
 
 
 def cost(sizes, pillars, repeats):
-    """Return the rows of the cost table: N, pillars, wall times, contacts, clearance."""
+    """Return the rows of the cost table: N, pillars, wall and CPU times, contacts, clearance."""
     rows = []
     for n in sizes:
         base = params_for(n)
@@ -82,16 +92,18 @@ def cost(sizes, pillars, repeats):
             if count:
                 params.update({'obstacles.circles': lattice_pillars(base, count),
                                'obstacles.clearance': CLEARANCE})
-            walls, metrics = [], {}
+            walls, cpus, metrics = [], [], {}
             for _ in range(repeats):
-                wall, metrics = run_command(params)
+                wall, cpu, metrics = run_command(params)
                 walls.append(wall)
+                cpus.append(cpu)
             placed = len(params.get('obstacles.circles', ())) // 3
-            rows.append({'robots': n, 'pillars': placed, 'walls': walls,
+            rows.append({'robots': n, 'pillars': placed, 'walls': walls, 'cpu': cpus,
                          'obstacle_contacts': metrics.get('obstacle_contacts'),
                          'min_obstacle_clearance': metrics.get('min_obstacle_clearance'),
                          'settle_time': metrics.get('settle_time')})
-            print(f'| {n} | {placed} | ' + ', '.join(f'{w:.2f}' for w in walls)
+            print(f'| {n} | {placed} | ' + ', '.join(f'{w:.2f}' for w in walls) + ' | '
+                  + ', '.join(f'{c:.2f}' for c in cpus)
                   + f" | {metrics.get('obstacle_contacts')} | "
                   f"{_number(metrics.get('min_obstacle_clearance'))} |", flush=True)
     return rows
@@ -170,8 +182,9 @@ def main(argv=None):
     args = build_parser().parse_args(argv)
     result = {'machine': os.uname().machine, 'cpus': os.cpu_count(),
               'load': os.getloadavg()}
-    print('| N | pillars | wall time of formation_sim (s) | contacts | closest approach (m) |')
-    print('|---:|---:|---|---:|---:|')
+    print('| N | pillars | wall time of formation_sim (s) | its CPU time (s) | contacts | '
+          'closest approach (m) |')
+    print('|---:|---:|---|---|---:|---:|')
     result['cost'] = cost(args.cost_sizes, args.pillars, args.repeats)
     if args.sweep:
         print('\n| swept | seed | settle (s) | closest pair (m) | closest to an obstacle (m) '

@@ -117,3 +117,37 @@ def test_a_base_turning_on_the_spot_is_stuck_though_its_hand_point_sweeps():
     assert stuck_robots(t, hand, q_desired, PILLAR) == []  # the hand point alone: moving
     stuck = stuck_robots(t, hand, q_desired, PILLAR, bodies=axle, body_radius=0.05)
     assert [s.robot for s in stuck] == [0] and stuck[0].position == pytest.approx([-1.3, 0.0])
+
+
+def every_pair(q, obstacles, body_radius):
+    """Return the closest gap and the contacts from every robot-obstacle gap of every sample."""
+    gaps = obstacles.distances(q.reshape(-1, q.shape[2])).reshape(len(q), q.shape[1], -1)
+    touching = gaps - body_radius <= 0.0
+    starts = np.count_nonzero(touching[0]) + np.count_nonzero(touching[1:] & ~touching[:-1])
+    return {'min_obstacle_clearance': float(gaps.min()) - body_radius,
+            'obstacle_contacts': int(starts)}
+
+
+@pytest.mark.parametrize('dim', [2, 3])
+def test_the_pairs_measured_near_give_the_numbers_of_every_pair(dim, monkeypatch):
+    """Random walks among random maps: contacts, near misses, and runs far from everything."""
+    monkeypatch.setattr(obstacle_metrics_module, 'BLOCK_DISTANCES', 5000)
+    touched = far = 0
+    for seed in range(30):
+        rng = np.random.default_rng(10 * dim + seed)
+        count = rng.integers(1, 20)
+        circles = np.column_stack([rng.uniform(-5.0, 5.0, (count, 2)),
+                                   rng.uniform(0.05, 1.5, count)])
+        walls = np.column_stack([rng.uniform(-5.0, 5.0, (3, 4)), rng.uniform(0.02, 0.3, 3)])
+        spheres = ([] if dim == 2 else np.column_stack([rng.uniform(-5.0, 5.0, (2, 3)),
+                                                        rng.uniform(0.1, 1.0, 2)]))
+        obstacles = Obstacles(circles, walls, spheres, float(rng.choice([0.05, 0.5])), dim)
+        start = rng.uniform(-6.0, 6.0, (1, 30, dim)) * rng.choice([1.0, 10.0])
+        q = start + np.cumsum(rng.normal(0.0, 0.3, (40, 30, dim)), axis=0)
+        radius = float(rng.choice([0.0, 0.1, 1.0]))
+        measured = obstacle_metrics(q, obstacles, radius)
+        assert measured == every_pair(q, obstacles, radius)
+        touched += measured['obstacle_contacts'] > 0
+        nearest = measured['min_obstacle_clearance'] + radius
+        far += nearest >= max(obstacles.clearance, 2.0 * radius)
+    assert touched >= 5 and far >= 3

@@ -248,3 +248,64 @@ def test_the_distances_alone_are_the_surfaces_distances(dim):
                        atol=1e-12)
     assert obstacles.distances(q).shape == (200, obstacles.count)
     assert Obstacles([], [], [], 0.9, dim).distances(q).shape == (200, 0)
+
+
+def mixed_map(rng, dim):
+    """Return a random map: pillars, short and long walls, (3D) balls, b_o from 5 cm to 3 m."""
+    side = float(rng.choice([3.0, 20.0]))
+    count = rng.integers(1, 40)
+    circles = np.column_stack([rng.uniform(-side, side, (count, 2)),
+                               rng.uniform(0.05, 1.5, count)])
+    ends = rng.uniform(-side, side, (rng.integers(0, 6), 2))
+    walls = np.column_stack([ends, ends + rng.normal(0.0, rng.choice([0.3, side]), ends.shape),
+                             rng.uniform(0.02, 0.3, len(ends))])
+    balls = rng.integers(0, 8) if dim == 3 else 0
+    spheres = np.column_stack([rng.uniform(-side, side, (balls, 3)),
+                               rng.uniform(0.1, 1.0, balls)]) if dim == 3 else []
+    return Obstacles(circles, walls, spheres, float(rng.choice([0.05, 0.5, 3.0])), dim), side
+
+
+@pytest.mark.parametrize('dim', [2, 3])
+def test_the_grid_gives_the_terms_of_every_surface_on_random_maps(dim):
+    """The grid's pairs are those of the test over every pair, in the same order."""
+    jump = make_jump('smooth', 2)
+    acting = 0
+    for seed in range(20):
+        rng = np.random.default_rng(100 * dim + seed)
+        obstacles, side = mixed_map(rng, dim)
+        q = rng.uniform(-1.5 * side, 1.5 * side, size=(200, dim))
+        radii = rng.uniform(0.5, 2.0, size=len(q)) * obstacles.clearance
+        every = obstacle_terms(q, obstacles.surface(q), jump, obstacles.clearance, radii)
+        near = obstacles.terms(q, jump, radii)
+        acting += int(np.count_nonzero(np.any(every != 0.0, axis=1)))
+        assert np.max(np.abs(near - every)) <= 1e-12 * max(1.0, float(np.max(np.abs(every))))
+    assert acting > 200
+
+
+def test_a_map_wider_than_the_doubles_is_searched_whole():
+    """Pillars 2e308 m apart (no grid divides that) act as each would alone."""
+    jump = make_jump('poly', 2)
+    obstacles = Obstacles([1e308, 0.0, 1.0, -1e308, 0.0, 1.0, 0.0, 0.0, 1.0], [], [], 0.5, 2)
+    q = np.array([[0.0, 1.3], [0.0, 1.6], [-1e308, 1.2]])
+    with np.errstate(over='ignore', invalid='ignore'):
+        terms = obstacles.terms(q, jump, [1.0, 1.0, 1.0])
+    alone = [Obstacles([x, 0.0, 1.0], [], [], 0.5, 2).terms(q[k:k + 1], jump, [1.0])[0]
+             for k, x in enumerate([0.0, 0.0, -1e308])]
+    assert terms[0, 1] > 0.0 and terms[1, 1] == 0.0 and terms[2, 1] > 0.0
+    assert np.array_equal(terms, alone)
+
+
+@pytest.mark.parametrize('dim', [2, 3])
+def test_the_pairs_nearby_hold_every_near_pair_with_its_distance(dim):
+    for seed in range(20):
+        rng = np.random.default_rng(300 * dim + seed)
+        obstacles, side = mixed_map(rng, dim)
+        q = rng.uniform(-1.5 * side, 1.5 * side, size=(200, dim))
+        every = obstacles.distances(q)
+        within = float(rng.choice([0.1, 1.0, 4.0]))
+        robots, kinds, distances = obstacles.nearby(q, within)
+        assert np.array_equal(distances, every[robots, kinds])
+        listed = np.zeros(every.shape, dtype=bool)
+        listed[robots, kinds] = True
+        assert np.all(listed[every < within])
+        assert len(robots) == np.count_nonzero(listed) < every.size

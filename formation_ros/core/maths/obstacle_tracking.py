@@ -77,8 +77,8 @@ def feed_forward_change(q: ArrayLike, frame: Optional[FrameSample], law: LawPara
     (no obstacle, a reference that does not move, no robot heading into its obstacles). Whoever
     audits a command against c M1 by inverting eq. (25) must subtract this first.
     """
-    if obstacles is None or obstacles.count == 0 or frame is None:
-        return None
+    if obstacles is None or obstacles.count == 0 or frame is None or frame.still:
+        return None  # a still frame's feed-forward is zero
     q = np.asarray(q, dtype=float)
     if not np.any(from_frame_velocity(np.zeros_like(q), q, frame)):
         return None

@@ -42,6 +42,12 @@ MAX_TOLD = 256
 refused unread (an arena's map gives a robot far fewer within its R_i)."""
 NORMAL_FLOOR = 1e-6
 """A heard normal whose part in the team's space is shorter than this has no direction there."""
+GRID_CELLS = 1 << 20
+"""The most cells of an :class:`ObstacleGrid`, and the most (cell, obstacle) entries it files:
+wider cells beyond (a grid is built once for a map and never takes more than about 16 MB)."""
+GRID_MARGIN = 1e-9
+"""How much wider than its reach plus b_o an obstacle is filed, relative to the map's largest
+coordinate and reach, so that no rounding in a cell index loses a pair the exact test keeps."""
 
 
 class Surface(NamedTuple):
@@ -184,18 +190,17 @@ class Obstacles:
         q: (N, dim) positions, m; sensing_radii: (N,) R_i, m. An obstacle acts on robot i only
         where d_io < min(R_i, b_o); d_io is at least the distance to the obstacle's centre (a
         wall's middle) less its reach (radius; half-length plus t), so pairs farther than that
-        are never measured. The same sums as ``obstacle_terms(q, self.surface(q), ...)`` at a
-        cost that grows with the pairs near each other, not with N x M surfaces. (N, dim), 1/m.
+        are never measured; an :class:`ObstacleGrid` of the map offers each robot only the
+        obstacles filed in its cell of the plane. The same sums as ``obstacle_terms(q,
+        self.surface(q), ...)`` at a cost that grows with the pairs near each other, not with
+        N x M. (N, dim), 1/m.
         """
         q = np.asarray(q, dtype=float).reshape(-1, self.dim)
         radii = np.broadcast_to(np.asarray(sensing_radii, dtype=float).reshape(-1), (len(q),))
         acts = np.minimum(radii, self.clearance)
         summed = np.zeros_like(q)
-        for rows, pairs in self._kinds():
-            centres, reach = _bounds(rows, pairs)
-            apart_sq = _apart_sq(q, centres)
-            within = acts[:, None] + reach[None, :]
-            robots, kinds = np.nonzero(apart_sq < within * within)
+        for (rows, pairs), grid in zip(self._kinds(), self._grids(self.clearance)):
+            robots, kinds, _ = grid.near(q, acts)
             if len(robots) == 0:
                 continue
             points, distances, normals = pairs(q[robots], rows[kinds])
@@ -204,11 +209,129 @@ class Obstacles:
                                                      radii[robots]))
         return summed
 
+    def nearby(self, q: ArrayLike, within: float
+               ) -> Tuple[NDArray[np.intp], NDArray[np.intp], NDArray[np.float64]]:
+        """
+        Return the pairs that may be nearer than ``within`` m: robots (P,), obstacles (P,), d_io.
+
+        q: (N, dim) positions, m; within > 0, m. Every pair (i, o) with d_io < within is
+        among them (to rounding at ``within`` itself), none whose centre (a wall's middle) is
+        farther than ``within`` plus the obstacle's reach; obstacles numbered in :attr:`count`
+        order; d_io (P,) in m exactly as :meth:`distances` gives it, at a cost that grows with
+        the pairs near each other, not with N x M.
+        """
+        q = np.asarray(q, dtype=float).reshape(-1, self.dim)
+        found = [(np.zeros(0, dtype=np.intp),) * 2 + (np.zeros(0),)]
+        first = 0
+        for (rows, pairs), grid in zip(self._kinds(), self._grids(float(within))):
+            robots, kinds, apart_sq = grid.near(q, np.full(len(q), float(within)))
+            if pairs is _wall_pairs:
+                measured = pairs(q[robots], rows[kinds])[1]
+            else:
+                measured = np.sqrt(apart_sq) - grid.reach[kinds]
+            found.append((robots, kinds + first, measured))
+            first += len(rows)
+        robots, obstacles, distances = (np.concatenate(part) for part in zip(*found))
+        return robots, obstacles, distances
+
+    def _grids(self, within: float) -> Tuple['ObstacleGrid', ...]:
+        """Return the :class:`ObstacleGrid` of each kind present for ``within`` m (built once)."""
+        built = self.__dict__.setdefault('_built_grids', {})
+        if within not in built:
+            built[within] = tuple(ObstacleGrid(*_bounds(rows, pairs), within)
+                                  for rows, pairs in self._kinds())
+        grids: Tuple[ObstacleGrid, ...] = built[within]
+        return grids
+
     def _kinds(self) -> Tuple[Tuple[NDArray[np.float64], Callable[..., Pairs]], ...]:
         """Return (rows, their pair function) of each kind present, in :attr:`count` order."""
         kinds = ((self.circles, _circle_pairs), (self.walls, _wall_pairs),
                  (self.spheres, _sphere_pairs))
         return tuple((rows, pairs) for rows, pairs in kinds if len(rows))
+
+
+class ObstacleGrid:
+    """
+    The obstacles of one kind filed by the square cells of the plane where they can act.
+
+    centres: (K, 2 or 3) and reach: (K,) of each obstacle (:func:`_bounds`), m; clearance:
+    b_o, m. Obstacle k is filed in every cell that the square about its centre (in the plane)
+    of half-side reach_k + b_o (and :data:`GRID_MARGIN` of the map's size) meets, so a robot
+    nearer than reach_k + b_o to the centre (in the plane, hence also in space) lies in a cell
+    that files k. Cells are about as wide as that half-side (the median over the kind), wider
+    when the map would need more than :data:`GRID_CELLS` of them or entries; numpy only.
+    """
+
+    def __init__(self, centres: NDArray[np.float64], reach: NDArray[np.float64],
+                 clearance: float):
+        """File obstacles with centres (K, 2 or 3) and reach (K,), m, for b_o = clearance."""
+        self.centres = centres
+        self.reach = reach
+        xy = centres[:, :2]
+        spread = reach + clearance
+        spread = (spread + GRID_MARGIN * (np.max(spread) + np.max(np.abs(xy))))[:, None]
+        self.low = np.min(xy - spread, axis=0)
+        high = np.max(xy + spread, axis=0)
+        with np.errstate(over='ignore'):
+            extent = high - self.low
+        cell = float(np.median(spread))
+        for _ in range(80) if np.all(np.isfinite(extent)) else ():
+            first = np.floor((xy - spread - self.low) / cell)
+            last = np.floor((xy + spread - self.low) / cell)
+            shape = np.floor(extent / cell) + 1.0
+            entries = np.prod(last - first + 1.0, axis=1)
+            if (np.prod(shape) <= GRID_CELLS
+                    and np.sum(entries) <= max(GRID_CELLS, len(centres))):
+                break
+            cell *= 2.0
+        else:  # a map wider than the doubles can divide: one cell files every obstacle
+            cell, shape = math.inf, np.ones(2)
+            first = last = np.zeros_like(xy)
+            entries = np.ones(len(xy))
+        self.cell = cell
+        self.top = shape + 1.0
+        self.width = int(shape[1]) + 2
+        cells = np.concatenate([np.zeros(0, dtype=np.intp)] + [
+            (np.arange(a[0] + 1, b[0] + 2, dtype=np.intp)[:, None] * self.width
+             + np.arange(a[1] + 1, b[1] + 2, dtype=np.intp)[None, :]).ravel()
+            for a, b in zip(first.astype(np.intp), last.astype(np.intp))])
+        owners = np.repeat(np.arange(len(centres), dtype=np.intp), entries.astype(np.intp))
+        self.members = owners[np.argsort(cells, kind='stable')]
+        self.filed = np.bincount(cells, minlength=int(self.top[0] + 1.0) * self.width)
+        self.starts = np.concatenate([[0], np.cumsum(self.filed)]).astype(np.intp)
+
+    def near(self, q: NDArray[np.float64], acts: NDArray[np.float64]
+             ) -> Tuple[NDArray[np.intp], NDArray[np.intp], NDArray[np.float64]]:
+        """
+        Return the pairs (robots (P,), obstacles (P,)) whose centres are near, and their apart**2.
+
+        q: (N, dim) positions, m; acts: (N,) how near each robot's obstacles act, m (at most
+        the grid's b_o). The pairs with squared centre distance (P,) m**2 below
+        (acts_i + reach_k)**2, sorted by robot, then obstacle: exactly those, in the order, of
+        the test over every pair. The cells are numbered with a ring of empty ones round the
+        grid, where a robot outside it (or not a number) falls.
+        """
+        if math.isinf(self.cell):
+            cells = np.full(len(q), self.width + 1)
+        else:
+            with np.errstate(invalid='ignore', over='ignore'):
+                scaled = (q[:, :2] - self.low) / self.cell + 1.0
+            where = np.fmin(np.fmax(scaled, 0.0), self.top).astype(np.intp)
+            cells = where[:, 0] * self.width + where[:, 1]
+        robots = np.flatnonzero(self.filed[cells])
+        cells = cells[robots]
+        first = self.starts[cells]
+        count = self.starts[cells + 1] - first
+        robots = np.repeat(robots, count)
+        slots = np.arange(len(robots)) + np.repeat(first - (np.cumsum(count) - count), count)
+        kinds = self.members[slots]
+        apart_sq = np.zeros(len(robots))
+        for axis in range(self.centres.shape[1]):
+            offset = q[robots, axis] - self.centres[kinds, axis]
+            apart_sq += offset * offset
+        within = acts[robots] + self.reach[kinds]
+        keep = apart_sq < within * within
+        return robots[keep], kinds[keep], apart_sq[keep]
 
 
 def _toward(offset: NDArray[np.float64]) -> Tuple[NDArray[np.float64], NDArray[np.float64]]:

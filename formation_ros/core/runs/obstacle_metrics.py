@@ -26,6 +26,10 @@ and got no nearer its place has not moved on: a body held at an obstacle tremble
 by up to tenths of a metre (measured on the physics world: 0.08 to 0.3 m)."""
 BLOCK_DISTANCES = 2_000_000
 """Robot-obstacle distances measured at once by :func:`obstacle_metrics` (about 50 MB)."""
+NEAR_MARGIN = 1e-9
+"""The closest pair measured near is the closest of all when it is this much (relative)
+nearer than how near :func:`obstacle_metrics` measures: rounding cannot have left out a
+nearer one."""
 
 
 def _blocks(steps: int, robots: int, count: int) -> Iterator[slice]:
@@ -57,23 +61,36 @@ def obstacle_metrics(q: ArrayLike, obstacles: Optional[Obstacles],
 
     ``min_obstacle_clearance``: the smallest gap of any body to any obstacle's surface over the
     samples, m, footprint subtracted (None without obstacles); ``obstacle_contacts``: the
-    contacts, each robot-obstacle pair counted once per stretch of samples in contact. The
-    samples are measured a block at a time (:data:`BLOCK_DISTANCES`), so a long run of a large
-    team needs no (T, N, M) array.
+    contacts, each robot-obstacle pair counted once per stretch of samples in contact. Only
+    the pairs that can be within max(b_o, 2 body_radius) are measured (``Obstacles.nearby``),
+    a block of samples at a time (:data:`BLOCK_DISTANCES`): every contact is among them, and so
+    is the closest approach unless no body came that near (then every pair is measured). The
+    numbers are those of every pair's gap (:func:`obstacle_clearances`).
     """
     if obstacles is None or obstacles.count == 0:
         return {'min_obstacle_clearance': None, 'obstacle_contacts': 0}
     q = np.asarray(q, dtype=float)
-    smallest, starts = math.inf, 0
-    before: Optional[NDArray[np.bool_]] = None
-    for block in _blocks(len(q), q.shape[1], obstacles.count):
-        gaps = obstacle_clearances(q[block], obstacles, body_radius)
+    steps, robots, dim = q.shape
+    pairs = robots * obstacles.count
+    within = max(obstacles.clearance, 2.0 * body_radius)
+    nearest, smallest = math.inf, math.inf
+    touching = [np.zeros(0, dtype=np.int64)]
+    for block in _blocks(steps, robots, obstacles.count):
+        which, kinds, distances = obstacles.nearby(q[block].reshape(-1, dim), within)
+        if not len(distances):
+            continue
+        gaps = distances - body_radius
+        nearest = min(nearest, float(distances.min()))
         smallest = min(smallest, float(gaps.min()))
-        touching = gaps <= 0.0
-        earlier = (np.zeros_like(touching[0]) if before is None else before)
-        starts += int(np.count_nonzero(touching[0] & ~earlier))
-        starts += int(np.count_nonzero(touching[1:] & ~touching[:-1]))
-        before = touching[-1]
+        contact = gaps <= 0.0
+        sample = block.start + which[contact] // robots
+        touching.append(sample * pairs + (which[contact] % robots) * obstacles.count
+                        + kinds[contact])
+    if not nearest < within * (1.0 - NEAR_MARGIN):
+        smallest = min(float(obstacle_clearances(q[block], obstacles, body_radius).min())
+                       for block in _blocks(steps, robots, obstacles.count))
+    keys = np.concatenate(touching)
+    starts = int(np.count_nonzero(~np.isin(keys - pairs, keys)))
     return {'min_obstacle_clearance': smallest, 'obstacle_contacts': starts}
 
 
