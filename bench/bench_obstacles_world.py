@@ -43,6 +43,7 @@ ROOT = os.path.dirname(BENCH)
 sys.path[:0] = [ROOT, BENCH]
 
 from bench_obstacles import field  # noqa: E402
+from bench_soak import write_json  # noqa: E402
 from formation_ros.core.runs.obstacle_metrics import STILL_TIME, stuck_robots  # noqa: E402, I100
 from formation_ros.core.runs.trajectory import Trajectory  # noqa: E402
 from formation_ros.core.settings.params import FormationConfig, validate  # noqa: E402
@@ -200,11 +201,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     if args.append and os.path.exists(args.out):
         with open(args.out, encoding='utf-8') as stream:
             runs = json.load(stream)['runs'] + runs
-    result = {'runs': runs}
-    os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
-    with open(args.out, 'w', encoding='utf-8') as stream:
-        json.dump(result, stream, indent=2)
-        stream.write('\n')
+    write_json(args.out, {'runs': runs})
     return 0
 
 

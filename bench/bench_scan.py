@@ -37,9 +37,10 @@ from typing import Any, Dict, List, Optional, Sequence
 
 BENCH = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(BENCH)
-sys.path[:0] = [ROOT]
+sys.path[:0] = [ROOT, BENCH]
 
-from formation_ros.core.settings.params_file import (load_params_file,  # noqa: E402
+from bench_soak import write_json  # noqa: E402
+from formation_ros.core.settings.params_file import (load_params_file,  # noqa: E402, I100
                                                      write_params_file)
 import numpy as np  # noqa: E402, I201
 
@@ -361,10 +362,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         row['folder'] = folder
         result['rows'].append(row)
         print(markdown_row(row), flush=True)
-        os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
-        with open(args.out, 'w', encoding='utf-8') as stream:
-            json.dump(result, stream, indent=2)
-            stream.write('\n')
+        write_json(args.out, result)
     return 0
 
 
