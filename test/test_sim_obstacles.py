@@ -181,3 +181,14 @@ def test_the_summary_judges_a_collision_by_the_bodies_size():
     sized_config = validate({**config.values, 'body.radius': 0.2})
     assert run_metrics(simulate(sized_config, dt=0.01), sized_config, 'test')[
         'body_radius'] == 0.2
+
+
+def test_formation_sim_says_it_gives_a_scanning_team_the_map(tmp_path, capsys):
+    params = write_params(tmp_path / 'scan.yaml', {**BEHIND_A_WALL, 'duration': 2.0,
+                                                   'obstacles.source': 'scan'})
+    assert sim.main([params, '--out', str(tmp_path / 'run'), '--dt', '0.01', '--quiet',
+                     '--no-plots']) == 0
+    said = capsys.readouterr().err
+    assert said.count('obstacles.source is scan, but the simulator has no scanner') == 1
+    with open(tmp_path / 'run' / 'metrics.json', encoding='utf-8') as stream:
+        assert json.load(stream)['obstacle_count'] == 1, 'the map, as told'

@@ -37,7 +37,7 @@ from typing import Optional, Sequence, Tuple
 from formation_ros.core.runs.output import stats_text
 from formation_ros.core.runs.trajectory import TRAJECTORY_FILE
 from formation_ros.core.runs.world_stats import WORLD_STATS_FILE
-from formation_ros.core.settings.declarations import Exe, ParamError
+from formation_ros.core.settings.declarations import Exe, ObstacleSource, ParamError
 from formation_ros.core.settings.exits import ENGINE_FAILED
 from formation_ros.core.settings.file_guard import ParamsFileError
 from formation_ros.core.settings.params import (FormationConfig, load_config,
@@ -195,6 +195,10 @@ def main(argv: Optional[list] = None) -> int:
               'formation_sim, plant, reference and robot')
         return 0
     duration = config.duration if args.duration is None else args.duration
+    if config.values.get('obstacles.source') == ObstacleSource.SCAN.value:
+        print('formation_sim: obstacles.source is scan, but the simulator has no scanner: the '
+              'law is given the map (obstacles.*), as robots told their obstacles; the scan '
+              'runs through the robot nodes (launch_formation.sh --world)', file=sys.stderr)
     if args.engine == 'mujoco':
         return run_engine_command(args, config, duration)
     problem = ((continuous_time_problem(config) if args.dt is None else None)

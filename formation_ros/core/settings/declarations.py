@@ -308,8 +308,9 @@ DECLARATIONS = (
           "Where a robot takes its obstacles from: 'map' (the points the plant or relay tells "
           "it on obstacles, from their obstacles.* map) or 'scan' (its own laser scan, "
           "sensor_msgs/LaserScan on the relative topic scan: remap it onto a lab robot's "
-          '/scan). Beyond the paper: docs/equations.md, "Obstacles from a scan".',
-          choices=_choices(ObstacleSource), users=ROBOT),
+          '/scan). Beyond the paper: docs/equations.md, "Obstacles from a scan". formation_sim '
+          'has no scanner: it says so and gives the law the map.',
+          choices=_choices(ObstacleSource), users=ROBOT | {Exe.SIM}),
     Param('obstacles.scan_frame', Kind.STRING, '',
           "frame_id a robot's scans must carry (others are refused); empty: "
           "robot_<i>/base_scan, the world's (a TurtleBot3 driver's: 'base_scan').",
