@@ -63,7 +63,9 @@ class InputGate:
         """
         try:
             return reader(data)
-        except (TooManyPoses, TooManyRays) as exc:
+        except TooManyRays as exc:
+            self.refuse(name, Refused(Reason.TOO_MANY_RAYS, f' ({exc})'))
+        except TooManyPoses as exc:
             self.refuse(name, Refused(too_many, f' ({exc})'))
         except CdrError as exc:
             self.refuse(name, Refused(Reason.MALFORMED, f' ({exc})'))

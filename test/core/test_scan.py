@@ -5,8 +5,9 @@
 
 import math
 
-from formation_ros.core.maths.scan import (nearest_by_sector, off_neighbours, scan_points,
-                                           scan_problem, ScanShape)
+from formation_ros.core.maths.scan import (full_turn, nearest_by_sector, off_neighbours,
+                                           returning_rays, scan_points, scan_problem,
+                                           ScanShape)
 import numpy as np
 import pytest
 
@@ -74,8 +75,11 @@ def test_rays_without_a_return_give_no_point():
 
 
 @pytest.mark.parametrize('ranges, shape, words', [
-    ([1.0, math.nan], LDS, 'NaN or -inf'),
-    ([1.0, -math.inf], LDS, 'NaN or -inf'),
+    ([1.0, math.nan, math.nan], LDS, 'most ranges are NaN'),
+    ([], LDS, 'no rays'),
+    (np.ones(400), LDS, 'more than a full turn'),
+    ([1.0], ScanShape(1e300, 0.1, 0.1, 3.5), 'an angle beyond'),
+    ([1.0], ScanShape(0.0, 0.1, 0.1, 3.5, mount_yaw=20.0), 'an angle beyond'),
     ([1.0], ScanShape(0.0, 0.0, 0.1, 3.5), 'angle_increment must be > 0'),
     ([1.0], ScanShape(0.0, 0.1, 3.5, 3.5), 'range_min < range_max'),
     ([1.0], ScanShape(math.nan, 0.1, 0.1, 3.5), 'non-finite'),
@@ -86,6 +90,20 @@ def test_unreadable_scans_are_named(ranges, shape, words):
 
 def test_a_scan_of_infinities_is_readable():
     assert scan_problem(np.full(360, np.inf), LDS) is None
+
+
+def test_rep_117_a_nan_ray_tells_nothing_and_minus_inf_is_an_object_nearer_than_range_min():
+    ranges = np.full(360, np.inf)
+    ranges[[0, 90, 180]] = [math.nan, -math.inf, 1.0]
+    assert scan_problem(ranges, LDS) is None
+    points = scan_points(ranges, LDS, [0.0, 0.0], 0.0)
+    assert np.allclose(points, [[0.0, LDS.range_min], [-1.0, 0.0]])
+    assert np.array_equal(returning_rays(ranges, LDS), [90, 180])
+
+
+def test_a_full_turn_of_rays_rounded_by_a_driver_still_goes_round():
+    nearly = ScanShape(0.0, 2.0 * math.pi / 360 * (1.0 - 1e-4), 0.12, 3.5)
+    assert full_turn(nearly, 360) and not full_turn(nearly, 180)
 
 
 def test_returns_on_a_neighbour_are_left_out():

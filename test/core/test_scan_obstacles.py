@@ -10,7 +10,7 @@ from formation_ros.core.maths.law import make_law, PsiKind
 from formation_ros.core.maths.obstacles import HeardObstacles, Obstacles
 from formation_ros.core.maths.unicycle import quaternions_from_headings
 from formation_ros.core.rules.admission import Reason
-from formation_ros.core.rules.scan_obstacles import MAX_RAYS, Scan, ScanObstacles
+from formation_ros.core.rules.scan_obstacles import EDGE_NS, MAX_RAYS, Scan, ScanObstacles
 from formation_ros.core.settings.params import ScanSettings
 import numpy as np
 import pytest
@@ -89,10 +89,11 @@ def test_blind_zone_and_no_return_give_no_point():
     origin = np.zeros(2)
     scans = rule()
     held(scans, origin, 0.0)
-    scans.scan_heard(synthetic(origin, 0.0, [(np.array([0.15, 0.0]), 0.1)]))
+    raw = np.full(RAYS, np.inf)
+    raw[[0, 1, 2, 90]] = [0.05, 0.0, RANGE_MIN - 1e-6, 1.0]
+    scans.scan_heard(Scan(SECOND, FRAME, 0.0, STEP, RANGE_MIN, RANGE_MAX, raw))
     near = scans.place(SECOND)
-    assert near is not None
-    assert np.all(np.linalg.norm(near.points, axis=1) >= RANGE_MIN - 1e-9)
+    assert near is not None and np.allclose(near.points, [[0.0, 1.0]])
     scans.scan_heard(Scan(2 * SECOND, FRAME, 0.0, STEP, RANGE_MIN, RANGE_MAX,
                           np.full(RAYS, np.inf)))
     held(scans, origin, 0.0, 2 * SECOND)
@@ -190,9 +191,11 @@ def test_a_scan_from_long_before_any_pose_kept_is_not_placed():
 
 @pytest.mark.parametrize('change, reason', [
     ({'frame_id': 'base_scan'}, Reason.SCAN_FRAME),
-    ({'ranges': np.r_[np.nan, np.full(RAYS - 1, 1.0)]}, Reason.NON_FINITE),
-    ({'ranges': np.r_[-np.inf, np.full(RAYS - 1, 1.0)]}, Reason.NON_FINITE),
+    ({'ranges': np.r_[np.full(RAYS // 2 + 1, np.nan), np.full(RAYS // 2 - 1, 1.0)]},
+     Reason.NON_FINITE),
     ({'angle_min': math.nan}, Reason.NON_FINITE),
+    ({'ranges': np.zeros(0)}, Reason.SCAN_FIELDS),
+    ({'angle_increment': 1e307}, Reason.SCAN_FIELDS),
     ({'angle_increment': 0.0}, Reason.SCAN_FIELDS),
     ({'range_min': 4.0}, Reason.SCAN_FIELDS),
     ({'ranges': np.ones(MAX_RAYS + 1)}, Reason.TOO_MANY_RAYS),
@@ -237,3 +240,30 @@ def test_a_robot_cannot_tell_its_obstacles_without_a_recent_scan_by_the_stamps()
     assert scans.unseen(SECOND + SECOND // 2, SECOND // 2) is None
     assert scans.unseen(SECOND + SECOND // 2 + 1, SECOND // 2) == (
         'its latest scan is more than 0.5 s older than the state')
+
+
+def test_a_pose_without_numbers_is_not_kept_and_nothing_is_placed_with_it():
+    scans = rule()
+    scans.pose_heard(SECOND, (0.0, 0.0, 0.0), (math.nan,) * 4)
+    scans.pose_heard(SECOND, (math.nan, 0.0, 0.0), quaternion(0.0))
+    assert len(scans.poses) == 0
+    scans.scan_heard(synthetic((0.0, 0.0), 0.0, [(np.array([1.0, 0.0]), 0.2)]))
+    assert scans.place(SECOND) is None
+
+
+def test_a_scan_is_placed_at_most_an_edge_beyond_the_poses_and_kept_only_between_two():
+    scans = rule()
+    for k in range(1001):  # 10 s of poses at 100 Hz, moving along +x at 0.2 m/s
+        scans.pose_heard(k * SECOND // 100, (0.002 * k, 0.0, 0.0), quaternion(0.0))
+    assert scans.pose_at(10 * SECOND + EDGE_NS + 1, 5 * SECOND) is None
+    assert scans.pose_at(-EDGE_NS - 1, 5 * SECOND) is None
+    assert np.allclose(scans.pose_at(6 * SECOND, 5 * SECOND)[0], (1.2, 0.0))
+    scans.scan_heard(synthetic((2.0, 0.0), 0.0, [(np.array([3.0, 0.0]), 0.2)],
+                               stamp_ns=10 * SECOND + SECOND // 200))
+    ahead = scans.place(SECOND // 2)
+    assert ahead is not None and scans.placed is None, 'after the newest: placed again later'
+    scans.pose_heard(10 * SECOND + SECOND // 100, (2.002, 0.0, 0.0), quaternion(0.0))
+    between = scans.place(SECOND // 2)
+    assert scans.placed is between
+    assert np.min(np.linalg.norm(between.points - (3.0, 0.0), axis=1)) == pytest.approx(
+        0.2, abs=2e-3)

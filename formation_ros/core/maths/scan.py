@@ -48,26 +48,38 @@ class ScanShape:
     mount_yaw: float = 0.0
 
 
+ANGLE_LIMIT = 4.0 * math.pi
+"""The largest ``|angle_min|`` and ``|mount_yaw|`` a scan may give, rad."""
+
+
 def scan_problem(ranges: ArrayLike, shape: ScanShape) -> Optional[str]:
     """
     Return why a scan cannot be read, or None.
 
-    ranges: (K,) m. A range may be +inf (nothing within range_max, REP 117) but not NaN nor
-    -inf; the shape's numbers must be finite with a positive angle step and
-    0 <= range_min < range_max.
+    ranges: (K,) m, K >= 1. As REP 117 has them, +inf is no return within range_max, -inf an
+    object nearer than range_min, NaN an erroneous measurement (that ray tells nothing); a scan
+    whose rays are mostly NaN tells nothing and is refused. The shape's numbers must be finite,
+    angles within :data:`ANGLE_LIMIT`, the angle step positive and the rays at most a full
+    turn, and 0 <= range_min < range_max.
     """
     fields = (shape.angle_min, shape.angle_increment, shape.range_min, shape.range_max,
               shape.mount_yaw, *shape.mount)
     if not all(math.isfinite(value) for value in fields):
         return 'non-finite angle, range limit or mount'
+    values = np.asarray(ranges, dtype=float).reshape(-1)
+    if len(values) == 0:
+        return 'no rays'
     if shape.angle_increment <= 0.0:
         return f'angle_increment must be > 0, got {shape.angle_increment:g}'
+    if max(abs(shape.angle_min), abs(shape.mount_yaw)) > ANGLE_LIMIT:
+        return f'an angle beyond +-{ANGLE_LIMIT:.4g} rad'
+    if (len(values) - 1) * shape.angle_increment > 2.0 * math.pi:
+        return f'{len(values)} rays {shape.angle_increment:g} rad apart: more than a full turn'
     if not 0.0 <= shape.range_min < shape.range_max:
         return (f'needs 0 <= range_min < range_max, got {shape.range_min:g} and '
                 f'{shape.range_max:g}')
-    values = np.asarray(ranges, dtype=float)
-    if np.any(np.isnan(values)) or np.any(values == -np.inf):
-        return 'a range is NaN or -inf (only +inf means no return)'
+    if 2 * int(np.count_nonzero(np.isnan(values))) > len(values):
+        return 'most ranges are NaN (erroneous measurements): the scan tells nothing'
     return None
 
 
@@ -75,19 +87,21 @@ def returning_rays(ranges: ArrayLike, shape: ScanShape) -> NDArray[np.intp]:
     """
     Return the indices of the rays with a return, in scan order: (K,).
 
-    ranges: (R,) m; a return is finite and within [range_min, range_max] (+inf and a range
-    outside them are none).
+    ranges: (R,) m; a return is finite and within [range_min, range_max], or -inf (an object
+    nearer than range_min, REP 117: :func:`scan_points` puts it at range_min); +inf, NaN and
+    a range outside the limits are none.
     """
     values = np.asarray(ranges, dtype=float).reshape(-1)
     with np.errstate(invalid='ignore'):
-        valid = np.isfinite(values) & (values >= shape.range_min) & (values <= shape.range_max)
+        valid = ((np.isfinite(values) & (values >= shape.range_min)
+                  & (values <= shape.range_max)) | (values == -np.inf))
     rays: NDArray[np.intp] = np.flatnonzero(valid)
     return rays
 
 
 def full_turn(shape: ScanShape, rays: int) -> bool:
     """Tell whether ``rays`` rays of ``shape`` go round (the last ray's neighbour is the first)."""
-    return rays * shape.angle_increment >= 2.0 * math.pi * (1.0 - 1e-6)
+    return rays * shape.angle_increment >= 2.0 * math.pi - shape.angle_increment / 2.0
 
 
 def scan_points(ranges: ArrayLike, shape: ScanShape, position: ArrayLike,
@@ -108,7 +122,8 @@ def scan_points(ranges: ArrayLike, shape: ScanShape, position: ArrayLike,
     mount_x, mount_y = shape.mount
     origin = np.asarray(position, dtype=float)[:2] + (c * mount_x - s * mount_y,
                                                       s * mount_x + c * mount_y)
-    points: NDArray[np.float64] = origin + values[rays, None] * np.column_stack(
+    reach = np.where(values[rays] == -np.inf, shape.range_min, values[rays])
+    points: NDArray[np.float64] = origin + reach[:, None] * np.column_stack(
         [np.cos(angles), np.sin(angles)])
     return points
 

@@ -32,8 +32,10 @@ from formation_ros.core.settings.params import ScanSettings
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-POSES_KEPT = 256
-"""The robot's latest poses kept to place a scan at its stamp (2.56 s of states at 100 Hz)."""
+POSES_KEPT = 4096
+"""The robot's latest poses kept to place a scan at its stamp (41 s of states at 100 Hz)."""
+EDGE_NS = 100_000_000
+"""How far beyond the poses kept a scan's stamp may lie and be placed with the nearest, ns."""
 MAX_RAYS = 16384
 """The most rays a scan may have (an LDS has 360, a 2D lidar a few thousand)."""
 
@@ -113,7 +115,7 @@ class ScanObstacles:
         problem = scan_problem(scan.ranges, self.shape(scan))
         if problem is None:
             return None
-        reason = (Reason.NON_FINITE if problem.startswith(('non-finite', 'a range'))
+        reason = (Reason.NON_FINITE if problem.startswith(('non-finite', 'most ranges'))
                   else Reason.SCAN_FIELDS)
         return Refused(reason, f' ({problem})')
 
@@ -122,10 +124,12 @@ class ScanObstacles:
         """
         Keep an admitted pose of the robot: stamp ns, position (>= 2,) m, quaternion.
 
-        A copy of the newest is not kept again; an older stamp (time went back: a plant or
-        world started again) starts the poses anew.
+        A copy of the newest is not kept again, nor a pose with a non-finite number (nothing is
+        placed with it); an older stamp (time went back: a plant or world started again)
+        starts the poses anew.
         """
-        if self.poses and stamp_ns == self.poses[-1][0]:
+        if (self.poses and stamp_ns == self.poses[-1][0]) or not all(
+                map(math.isfinite, (*position[:2], *orientation))):
             return
         if self.poses and stamp_ns < self.poses[-1][0]:
             self.poses.clear()
@@ -156,9 +160,9 @@ class ScanObstacles:
         Return the robot's (position (2,) m, heading rad) at ``stamp_ns``, or None.
 
         Between two poses kept: linear in position, along the shorter turn in heading. Beyond
-        them, the nearest end, if at most ``tolerance_ns`` away: after the newest, a scan
-        stamped before its state arrives; before the oldest, a scan taken as the first states
-        came (the robot not yet commanded). Farther: None.
+        them, the nearest end, if at most ``tolerance_ns`` and :data:`EDGE_NS` away: after the
+        newest, a scan stamped before its state arrives; before the oldest, a scan taken as
+        the first states came. Farther: None.
         """
         if not self.poses:
             return None
@@ -166,7 +170,7 @@ class ScanObstacles:
         later = int(np.searchsorted(stamps, stamp_ns, side='left'))
         if later in (0, len(stamps)):
             end = 0 if later == 0 else -1
-            if abs(stamp_ns - int(stamps[end])) > tolerance_ns:
+            if abs(stamp_ns - int(stamps[end])) > min(tolerance_ns, EDGE_NS):
                 return None
             return self._pose(end)
         if stamps[later] == stamp_ns:
@@ -183,10 +187,13 @@ class ScanObstacles:
 
     def place(self, tolerance_ns: int) -> Optional[Placed]:
         """
-        Return the latest scan's returns in the world frame, placed once; None if it cannot be.
+        Return the latest scan's returns in the world frame; None if they cannot be placed.
 
-        tolerance_ns: how long after the newest pose a scan may be stamped (``input_timeout``).
-        None without a scan, or when no pose was kept near its stamp (:data:`Reason.UNPLACED`).
+        tolerance_ns: how far beyond the poses kept a scan may be stamped (``input_timeout``,
+        at most :data:`EDGE_NS`). None without a scan, or when no pose was kept near its stamp
+        (:data:`Reason.UNPLACED`). A scan placed between two poses is kept placed; one
+        stamped after the newest is placed again at the next answer, once a later pose may
+        hold its stamp between two.
         """
         if self.placed is not None or self.scan is None:
             return self.placed
@@ -196,11 +203,12 @@ class ScanObstacles:
         position, heading = pose
         shape = self.shape(self.scan)
         total = len(self.scan.ranges)
-        self.placed = Placed(self.scan.stamp_ns,
-                             scan_points(self.scan.ranges, shape, position, heading),
-                             returning_rays(self.scan.ranges, shape), total,
-                             full_turn(shape, total))
-        return self.placed
+        placed = Placed(self.scan.stamp_ns,
+                        scan_points(self.scan.ranges, shape, position, heading),
+                        returning_rays(self.scan.ranges, shape), total, full_turn(shape, total))
+        if self.scan.stamp_ns <= self.poses[-1][0]:
+            self.placed = placed
+        return placed
 
     def obstacles(self, placed: Placed, position: ArrayLike, control_point: ArrayLike,
                   neighbours: ArrayLike) -> Tuple[NDArray[np.float64], NDArray[np.float64]]:
