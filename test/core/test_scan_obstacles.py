@@ -267,3 +267,46 @@ def test_a_scan_is_placed_at_most_an_edge_beyond_the_poses_and_kept_only_between
     assert scans.placed is between
     assert np.min(np.linalg.norm(between.points - (3.0, 0.0), axis=1)) == pytest.approx(
         0.2, abs=2e-3)
+
+
+def walls(origin, segments):
+    """Return a scan of thin straight segments, each a row of touching discs 0.01 m wide."""
+    discs = []
+    for x1, y1, x2, y2 in segments:
+        for t in np.linspace(0.0, 1.0, int(math.hypot(x2 - x1, y2 - y1) / 0.02) + 1):
+            discs.append((np.array([x1 + t * (x2 - x1), y1 + t * (y2 - y1)]), 0.01))
+    return synthetic(origin, 0.0, discs)
+
+
+def test_each_wall_of_a_room_or_a_corridor_repels_as_a_mapped_wall_would():
+    scans = rule(radius=1.5)
+    held(scans, (0.0, 0.0), 0.0)
+    scans.scan_heard(walls((0.0, 0.0), [(-1, -1, 1, -1), (1, -1, 1, 1), (1, 1, -1, 1),
+                                        (-1, 1, -1, -1)]))
+    points, _ = scans.obstacles(scans.place(SECOND), np.zeros(2), np.zeros(2), np.zeros((0, 3)))
+    assert sorted(map(tuple, np.round(points, 2))) == [(-0.99, 0.0), (0.0, -0.99), (0.0, 0.99),
+                                                       (0.99, 0.0)], 'one term a wall'
+    corridor = rule(radius=1.5)
+    origin = np.array([0.0, 0.05])
+    held(corridor, origin, 0.0)
+    corridor.scan_heard(walls(origin, [(-1, -0.5, 2, -0.5), (2, -0.5, 2, 0.5),
+                                       (2, 0.5, -1, 0.5)]))
+    points, _ = corridor.obstacles(corridor.place(SECOND), origin, origin, np.zeros((0, 3)))
+    assert np.allclose(points, [[0.0, -0.49], [0.0, 0.49]], atol=1e-3), 'both sides, the end far'
+
+
+def test_a_ray_dropping_out_does_not_split_an_obstacle_and_noise_makes_no_faces():
+    ranges = np.full(RAYS, np.inf)
+    ranges[:21] = 1.0 / np.cos(np.radians(np.arange(-10, 11)))  # a flat wall ahead
+    ranges[5] = np.inf
+    scans = rule(radius=2.0)
+    held(scans, (0.0, 0.0), 0.0)
+    scans.scan_heard(Scan(SECOND, FRAME, -math.radians(10), STEP, RANGE_MIN, RANGE_MAX, ranges))
+    points, _ = scans.obstacles(scans.place(SECOND), np.zeros(2), np.zeros(2), np.zeros((0, 3)))
+    assert np.allclose(points, [[1.0, 0.0]])
+    noisy = ranges + np.random.default_rng(3).normal(0.0, 0.01, RAYS)
+    held(scans, (0.0, 0.0), 0.0, 2 * SECOND)
+    scans.scan_heard(Scan(2 * SECOND, FRAME, -math.radians(10), STEP, RANGE_MIN, RANGE_MAX,
+                          noisy))
+    points, _ = scans.obstacles(scans.place(SECOND), np.zeros(2), np.zeros(2), np.zeros((0, 3)))
+    assert len(points) == 1

@@ -21,7 +21,7 @@ modifies its arguments.
 
 from dataclasses import dataclass
 import math
-from typing import Optional, Tuple
+from typing import List, Optional, Tuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -148,14 +148,16 @@ def off_neighbours(points: ArrayLike, neighbours: ArrayLike, reach: float) -> ND
 def nearest_by_object(points: ArrayLike, rays: ArrayLike, total: int, wraps: bool,
                       centre: ArrayLike, radius: float, join: float) -> NDArray[np.float64]:
     """
-    Return the nearest return of each obstacle a scan shows, within ``radius`` of ``centre``.
+    Return the nearest returns of each obstacle a scan shows, within ``radius`` of ``centre``.
 
     points: (K, 2) returns in scan order and rays: (K,) their rays' indices (of ``total``
     rays; ``wraps``: the last ray's neighbour is the first, :func:`full_turn`); centre: (2,)
-    and radius: R_i, m; join: returns of neighbouring rays nearer each other than this, m,
-    belong to one obstacle. An obstacle is a run of such returns; its nearest return within
-    the radius stands for it, as a mapped obstacle's closest point does (one term an
-    obstacle). Returns (at most K, 2), in scan order.
+    and radius: R_i, m; join: returns of rays at most one ray apart (a dropout between) and
+    nearer each other than this, m, belong to one run. A run's nearest return stands for it,
+    as a mapped obstacle's closest point does (one term an obstacle), and so does each other
+    nearest of a face of it: a return nearer than its neighbours whose distance rises by at
+    least ``join`` on either side before anything nearer (:func:`held_minima`): the walls of
+    a room or a corridor, each of its own. Returns (at most K, 2), in scan order.
     """
     p = np.asarray(points, dtype=float).reshape(-1, 2)
     index = np.asarray(rays, dtype=np.intp).reshape(-1)
@@ -164,23 +166,58 @@ def nearest_by_object(points: ArrayLike, rays: ArrayLike, total: int, wraps: boo
     step = np.roll(index, -1) - index
     if wraps:
         step = step % total
-    joined = (step == 1) & (np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1) < join)
+    joined = ((step >= 1) & (step <= 2)
+              & (np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1) < join))
     if not wraps or len(p) == 1:
         joined[-1] = False
     starts = ~np.roll(joined, 1)
-    if not np.any(starts):
-        labels = np.zeros(len(p), dtype=np.intp)
-    else:
-        labels = np.cumsum(starts) - 1
-        labels[labels < 0] = labels[-1]
-    distance = np.linalg.norm(p - np.asarray(centre, dtype=float)[:2], axis=1)
-    near = distance < radius
-    p, labels, distance = p[near], labels[near], distance[near]
-    order = np.lexsort((distance, labels))
-    first = np.ones(len(order), dtype=bool)
-    first[1:] = labels[order][1:] != labels[order][:-1]
-    nearest: NDArray[np.float64] = p[np.sort(order[first])]
+    ring = not np.any(starts)
+    shift = 0 if ring else int(np.argmax(starts))
+    order = np.roll(np.arange(len(p)), -shift)
+    distance = np.linalg.norm(p[order] - np.asarray(centre, dtype=float)[:2], axis=1)
+    firsts = [0] if ring else np.flatnonzero(starts[order]).tolist()
+    kept: List[int] = []
+    for first, last in zip(firsts, firsts[1:] + [len(p)]):
+        kept += [first + k for k in held_minima(distance[first:last], join, ring)]
+    chosen = np.array(sorted(int(order[k]) for k in kept if distance[k] < radius),
+                      dtype=np.intp)
+    nearest: NDArray[np.float64] = p[chosen] if len(chosen) else np.zeros((0, 2))
     return nearest
+
+
+def held_minima(distance: ArrayLike, depth: float, ring: bool = False) -> List[int]:
+    """
+    Return the indices of a run's nearest return and of its other held minima, ascending.
+
+    distance: (m,) m, along the run; depth: m. A held minimum is a return no farther than the
+    one before it and nearer than the one after, from which the distance rises by at least
+    ``depth`` on both sides before anything nearer (or the run's end on that side: an end
+    itself counts as no rise); ring: the run goes round (its last return's neighbour is its
+    first).
+    """
+    d = np.asarray(distance, dtype=float).reshape(-1)
+    m = len(d)
+    if m == 0:
+        return []
+    if ring:
+        top = int(np.argmax(d))
+        turned = held_minima(np.roll(d, -top), depth)
+        return sorted((k + top) % m for k in turned)
+    best = int(np.argmin(d))
+    before = np.r_[np.inf, d[:-1]]
+    after = np.r_[d[1:], np.inf]
+    held = {best}
+    for k in np.flatnonzero((d <= before) & (d < after)).tolist():
+        if k != best and min(_rise(d[k::-1]), _rise(d[k:])) >= depth:
+            held.add(k)
+    return sorted(held)
+
+
+def _rise(side: NDArray[np.float64]) -> float:
+    """Return how far ``side`` (from a minimum outward) rises before it falls below its start."""
+    lower = np.flatnonzero(side[1:] < side[0])
+    walk = side[1:] if len(lower) == 0 else side[1:lower[0] + 1]
+    return float(np.max(walk) - side[0]) if len(walk) else 0.0
 
 
 def nearest_by_sector(points: ArrayLike, centre: ArrayLike, radius: float,

@@ -324,9 +324,11 @@ DECLARATIONS = (
           "neighbour (left to the pair terms), m: the pose's age and noise.",
           low=at_least(0.0), high=at_least(LENGTH_LIMIT), users=ROBOT),
     Param('obstacles.scan_join', Kind.DOUBLE, 0.2,
-          'Returns of neighbouring rays nearer each other than this are one obstacle, m: its '
-          "nearest return within R_i alone repels, as a mapped obstacle's closest point does "
-          '(0: every return repels).', low=at_least(0.0), high=at_least(LENGTH_LIMIT),
+          'Returns of neighbouring rays (a dropout between allowed) nearer each other than this '
+          "are one obstacle, m: its nearest return within R_i repels, as a mapped obstacle's "
+          'closest point does, and so does the nearest of each of its faces (a minimum from '
+          'which the distance rises by this much on both sides: the walls of a room); 0: '
+          'every return repels.', low=at_least(0.0), high=at_least(LENGTH_LIMIT),
           users=ROBOT),
     Param('obstacles.scan_sectors', Kind.INT, 72,
           'A robot keeps the nearest scan return of each of this many equal sectors of '
