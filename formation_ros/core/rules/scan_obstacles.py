@@ -10,7 +10,7 @@ and the robot's own poses of the last :data:`POSES_KEPT` states, and when the ro
 state gives the law its obstacle points (:meth:`ScanObstacles.obstacles`): the returns placed
 in the world frame with the pose at the scan's stamp (interpolated between the two poses
 about it), the ones on a neighbour's body left out, of each obstacle the nearest return within
-R_i, at most one a sector, each a point obstacle facing the robot (``core.maths.scan``). The
+R_i and the nearest of each of its faces, at most one a sector, each a point obstacle facing the robot (``core.maths.scan``). The
 node counts what it refuses; the robot holds still while it cannot tell its obstacles at a
 state (:meth:`ScanObstacles.unseen`: no scan yet, or the latest older than ``input_timeout``
 by the stamps, on the robot's clock, so that a world running slower than real time is no
@@ -219,8 +219,8 @@ class ScanObstacles:
         now (its scanner's body), m; control_point: (2,) the point the law acts on, m;
         neighbours: (M, >= 2), 2-D also for M = 0: the positions of the neighbours it heard,
         m. Returns on a neighbour's body (within the reach of its position) are left out; of
-        the rest, the nearest within R_i of the position of each obstacle
-        (``obstacles.scan_join``), and of those the nearest of each sector
+        the rest, the nearest within R_i of the position of each obstacle and of each of its
+        faces (``obstacles.scan_join``), and of those the nearest of each sector
         (``obstacles.scan_sectors``).
         """
         others = np.asarray(neighbours, dtype=float)[:, :2]
