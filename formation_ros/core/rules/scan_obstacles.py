@@ -10,9 +10,9 @@ and the robot's own poses of the last :data:`POSES_KEPT` states, and when the ro
 state gives the law its obstacle points (:meth:`ScanObstacles.obstacles`): the returns placed
 in the world frame with the pose at the scan's stamp (interpolated between the two poses
 about it), the ones on a neighbour's body left out, of each obstacle the nearest return within
-R_i and the nearest of each of its faces, at most one a sector, each a point obstacle facing the robot (``core.maths.scan``). The
-node counts what it refuses; the robot holds still while it cannot tell its obstacles at a
-state (:meth:`ScanObstacles.unseen`: no scan yet, or the latest older than ``input_timeout``
+R_i and the nearest of each of its faces, at most one a sector, each a point obstacle facing
+the robot (``core.maths.scan``). The node counts what it refuses; the robot holds still while
+it cannot tell its obstacles at a state (:meth:`ScanObstacles.unseen`: no scan yet, or the latest older than ``input_timeout``
 by the stamps, on the robot's clock, so that a world running slower than real time is no
 reason).
 """
