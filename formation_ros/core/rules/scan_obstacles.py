@@ -12,9 +12,9 @@ in the world frame with the pose at the scan's stamp (interpolated between the t
 about it), the ones on a neighbour's body left out, of each obstacle the nearest return within
 R_i and the nearest of each of its faces, at most one a sector, each a point obstacle facing
 the robot (``core.maths.scan``). The node counts what it refuses; the robot holds still while
-it cannot tell its obstacles at a state (:meth:`ScanObstacles.unseen`: no scan yet, or the latest older than ``input_timeout``
-by the stamps, on the robot's clock, so that a world running slower than real time is no
-reason).
+it cannot tell its obstacles at a state (:meth:`ScanObstacles.unseen`: no scan yet, or the
+latest older than ``input_timeout`` by the stamps, on the robot's clock, so that a world
+running slower than real time is no reason).
 """
 
 from collections import deque
