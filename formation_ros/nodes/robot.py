@@ -94,7 +94,12 @@ class RobotNode(Node):
         self.timeout_ns = int(settings.input_timeout * NS_PER_S)
         self.unicycle = config.body.is_unicycle
         body_frame = config.command.frame is CommandFrame.BODY
-        self.needs_orientation = body_frame
+        self.scan = (None if settings.scan is None else
+                     ScanObstacles(settings.scan, self.sensing_radius, config.body.radius))
+        """This robot's obstacles from its own scans (``obstacles.source: scan``), or None."""
+        self.needs_orientation = body_frame or self.scan is not None
+        """Whether its pose's orientation is needed besides a unicycle's heading: a body-frame
+        command, or a scan to place."""
         self.command_frame = (messages.body_frame(settings.robot_id) if body_frame
                               else config.world_frame)
         self.control = Control(self.law, [self.sensing_radius], self.dim, self.unicycle,
@@ -110,13 +115,11 @@ class RobotNode(Node):
                                          == reference_values(leader.config.values))
         self.inputs = InputGate(self, StateIntake(
             config.world_frame, self.timeout_ns, self.sim_time, self.state_clock.follows_states,
-            'a unicycle' if self.unicycle else 'command.frame body'), self.state_clock,
+            'a unicycle' if self.unicycle else
+            'command.frame body' if body_frame else 'obstacles.source scan'), self.state_clock,
             self.once, leader.inputs.expected if shares and leader is not None else {})
         period = settings.answer_period(self.sim_time)
         self.watch_ns = max(1, int(round(NS_PER_S / settings.control_rate)))
-        self.scan = (None if settings.scan is None else
-                     ScanObstacles(settings.scan, self.sensing_radius, config.body.radius))
-        """This robot's obstacles from its own scans (``obstacles.source: scan``), or None."""
         self.policy = AnswerPolicy(max(1, int(round(period * NS_PER_S))), self.timeout_ns,
                                    self.watch_ns, settings.wait_for_subscribers)
         self.pose: Optional[PoseData] = None
@@ -241,8 +244,7 @@ class RobotNode(Node):
     def _store_pose(self, pose: PoseData) -> None:
         state = PoseArrayData(pose.stamp_ns, pose.frame_id, np.array([pose.position]),
                               np.array([pose.orientation]))
-        if self.admit_state('pose', state, self.needs_orientation or self.scan is not None,
-                            pose.finite):
+        if self.admit_state('pose', state, self.needs_orientation, pose.finite):
             self.pose = pose
             if self.scan is not None:
                 self.scan.pose_heard(pose.stamp_ns, pose.position, pose.orientation)
@@ -282,8 +284,8 @@ class RobotNode(Node):
         """
         Keep the latest scan, read from the serialized LaserScan (untrusted).
 
-        Admitted in ``obstacles.scan_frame``, with at most MAX_RAYS rays, readable fields, no
-        NaN or -inf range and a stamp on this robot's clock (within input_timeout); placed in
+        Admitted in ``obstacles.scan_frame``, with at most MAX_RAYS rays, readable fields, not
+        mostly NaN ranges and a stamp on this robot's clock (within input_timeout); placed in
         the world frame when a state is answered, if at most input_timeout older than it
         (``core.rules.scan_obstacles``).
         """

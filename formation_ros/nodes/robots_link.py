@@ -60,6 +60,7 @@ class LinkedRobot(Protocol):
     sensing_radius: float
     config: FormationConfig
     scan: Optional[ScanObstacles]
+    needs_orientation: bool
     law: LawParams
     control: Control
     cmd_vel: CmdVel
@@ -142,8 +143,7 @@ class RobotsLink:
         self.control = Control(leader.law, radii, self.dim, leader.control.unicycle,
                                leader.control.hand_distance, leader.control.body_frame,
                                leader.control.footprint, leader.control.obstacle_clearance)
-        self.needs_orientation = (leader.control.unicycle or leader.control.body_frame
-                                  or leader.scan is not None)
+        self.needs_orientation = leader.control.unicycle or leader.needs_orientation
         self.reach = np.zeros(self.n)
         self.reach[self.indices] = sensor_radii(radii, make_bodies(config.body).sensing_margin)
         self.local = np.full(self.n, -1, dtype=np.intp)
